@@ -1,0 +1,1 @@
+"""Scenarios, sweeps, metrics, reports and the ``rmpc`` command line."""

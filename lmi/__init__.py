@@ -1,0 +1,1 @@
+"""LMI problem builders, solver back-ends and certificates for robust MPC."""

@@ -1,0 +1,39 @@
+"""Plants: the nonlinear rigid satellite, linearisation, discretisation, polytopes, actuators.
+
+Examples
+--------
+>>> from models import RigidSatellite
+>>> sat = RigidSatellite.paper_p()
+>>> plant = sat.polytope(sat.initial_state(), dt=0.01, spread=0.3, mode="scalar")
+>>> plant.n_vertices, plant.n_states, plant.n_inputs
+(2, 6, 3)
+"""
+
+from models.actuators import ReactionWheelActuator, TorqueLimiter
+from models.discretize import zoh
+from models.kinematics import kinematics_matrix
+from models.polytope import PolytopicModel
+from models.satellite import (
+    INPUT_NAMES,
+    PAPER_P_INERTIA,
+    PAPER_P_INITIAL_STATE,
+    PAPER_P_SAMPLE_TIME,
+    PAPER_P_TORQUE_LIMIT,
+    STATE_NAMES,
+    RigidSatellite,
+)
+
+__all__ = [
+    "INPUT_NAMES",
+    "PAPER_P_INERTIA",
+    "PAPER_P_INITIAL_STATE",
+    "PAPER_P_SAMPLE_TIME",
+    "PAPER_P_TORQUE_LIMIT",
+    "STATE_NAMES",
+    "PolytopicModel",
+    "ReactionWheelActuator",
+    "RigidSatellite",
+    "TorqueLimiter",
+    "kinematics_matrix",
+    "zoh",
+]

@@ -1,0 +1,24 @@
+"""The toolkit's exceptions, importable from one place.
+
+>>> from rmpc.errors import ToolkitError, InvalidArgumentError
+>>> issubclass(InvalidArgumentError, ValueError) and issubclass(InvalidArgumentError, ToolkitError)
+True
+"""
+
+from toolkit_common.errors import (
+    ArgumentTypeError,
+    ConfigError,
+    InvalidArgumentError,
+    SingularityError,
+    SolverError,
+    ToolkitError,
+)
+
+__all__ = [
+    "ArgumentTypeError",
+    "ConfigError",
+    "InvalidArgumentError",
+    "SingularityError",
+    "SolverError",
+    "ToolkitError",
+]

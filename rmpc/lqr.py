@@ -1,0 +1,84 @@
+"""Discrete-time LQR state feedback, the reference controller (gain from python-control)."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import control
+import numpy as np
+
+from models import PolytopicModel
+from rmpc.controller import StepInfo
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_pd, check_psd
+
+__all__ = ["LQR"]
+
+
+class LQR:
+    """Infinite-horizon discrete LQR, ``u = F (x - x_ref)`` with ``F = -K`` from ``control.dlqr``.
+
+    Parameters
+    ----------
+    plant : PolytopicModel
+        The model; the gain is designed on its nominal model or on one vertex.
+    Q : (n, n) array_like
+        State weight, symmetric positive semidefinite.
+    R : (m, m) array_like
+        Input weight, symmetric positive definite.
+    vertex : int, optional
+        Design on this vertex instead of the nominal model.
+    x_ref : (n,) array_like, optional
+        Reference state (default: the origin).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import RigidSatellite
+    >>> from rmpc import LQR
+    >>> sat = RigidSatellite.paper_p()
+    >>> lqr = LQR(sat.linear_model(sat.initial_state(), 0.01), Q=np.eye(6), R=np.eye(3))
+    >>> lqr.F.shape
+    (3, 6)
+    """
+
+    def __init__(
+        self,
+        plant: PolytopicModel,
+        Q: Any,
+        R: Any,
+        vertex: int | None = None,
+        x_ref: Any = None,
+    ) -> None:
+        if not isinstance(plant, PolytopicModel):
+            raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
+        n, m = plant.n_states, plant.n_inputs
+        self.Q = check_psd(as_matrix(Q, "Q", (n, n)), "Q")
+        self.R = check_pd(as_matrix(R, "R", (m, m)), "R")
+        a, b = plant.nominal if vertex is None else plant.vertex(vertex)
+        try:
+            k, s, _ = control.dlqr(a, b, self.Q, self.R)
+        except (ValueError, np.linalg.LinAlgError) as err:
+            raise InvalidArgumentError(
+                "plant", "a stabilisable (A, B) with detectable (Q, A)", f"dlqr failed: {err}"
+            ) from None
+        self.K = np.asarray(k)
+        self.P = np.asarray(s)
+        self.F = -self.K
+        self.dt = plant.dt
+        self.x_ref = np.zeros(n) if x_ref is None else as_vector(x_ref, "x_ref", n)
+        self._n = n
+        self.last: StepInfo | None = None
+
+    def reset(self) -> None:
+        """Nothing to forget but the last step's info."""
+        self.last = None
+
+    def step(self, x: Any) -> np.ndarray:
+        """Return ``F (x - x_ref)``."""
+        start = time.perf_counter()
+        x = as_vector(x, "x", self._n)
+        u = self.F @ (x - self.x_ref)
+        self.last = StepInfo(status="optimal", solve_time=time.perf_counter() - start)
+        return u

@@ -1,0 +1,25 @@
+"""Leaf package shared by :mod:`models`, :mod:`lmi`, :mod:`rmpc` and :mod:`benchmarks`.
+
+It holds the one exception hierarchy of the toolkit (:mod:`toolkit_common.errors`) and the
+argument checks that produce its messages (:mod:`toolkit_common.validation`). It imports
+nothing from the other packages, so ``models`` and ``lmi`` can both use it without importing
+each other.
+"""
+
+from toolkit_common.errors import (
+    ArgumentTypeError,
+    ConfigError,
+    InvalidArgumentError,
+    SingularityError,
+    SolverError,
+    ToolkitError,
+)
+
+__all__ = [
+    "ArgumentTypeError",
+    "ConfigError",
+    "InvalidArgumentError",
+    "SingularityError",
+    "SolverError",
+    "ToolkitError",
+]
