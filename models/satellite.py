@@ -65,7 +65,12 @@ def skew(v: np.ndarray) -> np.ndarray:
 
 
 def _as_inertia(inertia: Any, name: str = "inertia") -> np.ndarray:
-    arr = np.asarray(inertia, dtype=float) if not isinstance(inertia, str) else None
+    arr = None
+    if not isinstance(inertia, str | bytes):
+        try:
+            arr = np.asarray(inertia, dtype=float)
+        except (TypeError, ValueError):
+            arr = None  # not numeric or ragged: as_matrix below raises ArgumentTypeError naming it
     if arr is not None and arr.ndim == 1:
         diag = as_vector(arr, name, 3)
         if np.any(diag <= 0.0):
@@ -92,7 +97,7 @@ class RigidSatellite:
     >>> from models import RigidSatellite
     >>> sat = RigidSatellite.paper_p()
     >>> x0 = sat.initial_state()
-    >>> sat.dynamics(x0, u=[1.0, 0.0, 0.0])[3]  # p' = Mx / Ixx
+    >>> float(sat.dynamics(x0, u=[1.0, 0.0, 0.0])[3])  # p' = Mx / Ixx
     0.7735148514851485
     >>> poly = sat.polytope(x0, dt=0.01, spread=0.3, mode="box")
     >>> poly.n_vertices
@@ -262,7 +267,8 @@ class RigidSatellite:
         dt : float
             Sample time (s) of the zero-order-hold discretisation.
         spread : float
-            Relative inertia uncertainty in ``[0, 1)`` (paper P: 0.3, and 0.7 in E5).
+            Relative inertia uncertainty in ``[0, 1)``. Paper P leaves the base level out; the
+            toolkit assumes 0.3, and E5 uses 0.7.
         mode : {"scalar", "box"}
             See :meth:`inertia_vertices`.
 

@@ -1,0 +1,66 @@
+"""Sphinx configuration of the rmpc-satellite documentation.
+
+Build (warnings are errors)::
+
+    python -m sphinx -W --keep-going -b html docs docs/_build/html
+
+The build needs no network: intersphinx is deliberately not enabled, and MathJax is only
+loaded by the browser when a page is viewed.
+"""
+
+from __future__ import annotations
+
+import sys
+from importlib import metadata
+from pathlib import Path
+
+# Document the checkout this file belongs to, also when an older copy is installed.
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+# -- Project -------------------------------------------------------------------------
+project = "rmpc-satellite"
+author = "rmpc-satellite contributors"
+copyright = "rmpc-satellite contributors"
+try:
+    release = metadata.version("rmpc-satellite")
+except metadata.PackageNotFoundError:  # running from a checkout that is not installed
+    release = "0.1.0"
+version = ".".join(release.split(".")[:2])
+
+# -- General -------------------------------------------------------------------------
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.doctest",
+    "numpydoc",
+]
+exclude_patterns = ["_build", "examples", "Thumbs.db", ".DS_Store"]
+root_doc = "index"
+language = "en"
+default_role = "literal"  # a single-backtick `x` is code, as in the docstrings' double ones
+
+# -- autodoc -------------------------------------------------------------------------
+autodoc_member_order = "bysource"
+autodoc_typehints = "signature"
+autodoc_preserve_defaults = True
+
+# -- numpydoc ------------------------------------------------------------------------
+# numpydoc's own member tables duplicate autodoc's :members: and warn about missing stubs.
+numpydoc_show_class_members = False
+numpydoc_show_inherited_class_members = False
+numpydoc_class_members_toctree = False
+
+# -- doctest (``sphinx-build -b doctest docs OUT`` runs the ``>>>`` examples) --------
+doctest_global_setup = "import numpy as np"
+
+# -- HTML ----------------------------------------------------------------------------
+html_theme = "alabaster"
+html_title = f"{project} {release}"
+html_theme_options = {
+    "description": "Robust MPC for satellite attitude control",
+    "fixed_sidebar": True,
+    "page_width": "1100px",
+    "sidebar_width": "240px",
+}
+html_sidebars = {"**": ["about.html", "navigation.html", "relations.html", "searchbox.html"]}

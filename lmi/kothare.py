@@ -1,0 +1,219 @@
+"""The Kothare, Balakrishnan & Morari (1996) min-max robust MPC problem, built once, solved per state.
+
+Reference: M. V. Kothare, V. Balakrishnan, M. Morari, "Robust constrained model predictive
+control using linear matrix inequalities", Automatica 32(10), 1361-1379, 1996.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from lmi.backend_clarabel import ClarabelKothare, RawResult
+from lmi.backend_cvxpy import CvxpyKothare
+from lmi.certificate import Certificate, certify
+from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
+from lmi.status import OPTIMAL, UNCERTIFIED
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_vector, check_positive
+
+__all__ = ["KothareProblem", "LMISolution"]
+
+
+@dataclass(frozen=True)
+class LMISolution:
+    """The answer of one solve.
+
+    Attributes
+    ----------
+    status : str
+        ``"optimal"`` (converged and certified) or a failure word (:mod:`lmi.status`).
+    gamma : float
+        The worst-case cost bound ``x' P x`` (NaN when the solver returned nothing).
+    Q, Y : ndarray or None
+        The LMI variables; ``P = gamma Q^-1``.
+    F : ndarray or None
+        The state-feedback gain ``F = Y Q^-1``, applied as ``u = F x``.
+    solve_time : float
+        Time inside the solver (s).
+    iterations : int or None
+    solver_status : str
+        The back-end's own status word.
+    certificate : Certificate or None
+        Recomputed LMI margins.
+    backend : str
+    x : ndarray
+        The state the problem was solved at.
+    """
+
+    status: str
+    gamma: float
+    Q: np.ndarray | None
+    Y: np.ndarray | None
+    F: np.ndarray | None
+    solve_time: float
+    iterations: int | None
+    solver_status: str
+    certificate: Certificate | None
+    backend: str
+    x: np.ndarray = field(repr=False)
+
+    @property
+    def ok(self) -> bool:
+        """``status == "optimal"``."""
+        return self.status == OPTIMAL
+
+    @property
+    def margins(self) -> dict[str, float]:
+        """The certificate's relative margins (empty without a certificate)."""
+        return {} if self.certificate is None else dict(self.certificate.margins)
+
+    @property
+    def P(self) -> np.ndarray | None:
+        """``gamma Q^-1``, the cost matrix of the bound ``x' P x``."""
+        if self.Q is None:
+            return None
+        return self.gamma * np.linalg.inv(self.Q)
+
+
+class KothareProblem:
+    """Min-max robust MPC over a polytope ``Co{[A_j B_j]}``, Kothare et al. (1996).
+
+    At a state ``x`` it minimises ``gamma`` over ``Q > 0``, ``Y`` subject to
+    ``[[1, x'], [x, Q]] >= 0``, one cost LMI per vertex and the input (and output) constraint
+    LMIs; the control law is ``u = F x`` with ``F = Y Q^-1``.
+
+    The problem is solved at ``x / ||x||`` with the bounds divided by ``||x||`` and the answer
+    rescaled (``gamma``, ``Q``, ``Y`` times ``||x||^2``; ``F`` unchanged). This is exact (the
+    LMIs are homogeneous) and keeps states near the origin well conditioned.
+
+    Parameters
+    ----------
+    A : (N, n, n) array_like
+        Vertex state matrices (discrete time).
+    B : (N, n, m) array_like
+        Vertex input matrices.
+    Q : (n, n) array_like
+        State weight ``Q1``, symmetric positive semidefinite.
+    R : (m, m) array_like
+        Input weight, symmetric positive definite.
+    dt : float
+        Sample time, used by the ``"delta"`` formulation (any positive value is exact; the
+        model's own sample time conditions best).
+    input_constraint : {"ellipsoid", "peak", None}
+        ``||u||_2 <= u_max`` (scalar ``u_max``), ``|u_j| <= u_max_j`` (scalar or vector) or none.
+    u_max : float or array_like
+    output_matrix, y_max : array_like, optional
+        Output constraints ``|(C x(k+i))_r| <= y_max_r`` for ``i >= 1`` (Kothare 1996, sec. 3.2).
+    backend : str
+        ``"clarabel"`` (Clarabel's own API, data built once; default) or ``"cvxpy"`` with
+        ``solver`` naming any installed cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
+    solver : str, optional
+        The cvxpy solver for ``backend="cvxpy"`` (default ``"CLARABEL"``).
+    solver_options : dict, optional
+        Solver settings; unknown names raise :class:`InvalidArgumentError`.
+    formulation : {"delta", "standard"}
+        ``"delta"`` rewrites the vertex LMIs with ``(A_j - I)/dt`` (a congruence; same optimum,
+        better conditioned at small ``dt``); ``"standard"`` is eq. (14) as printed.
+    certificate_tol : float
+        A solve is ``"optimal"`` only if every recomputed relative LMI margin is ``>= -tol``.
+
+    Examples
+    --------
+    Kothare (1996), example 1, with the plant at ``alpha = 0.1`` and ``alpha = 10``:
+
+    >>> import numpy as np
+    >>> from lmi import KothareProblem
+    >>> A = [[[1, 0.1], [0, 1 - 0.1 * a]] for a in (0.1, 10.0)]
+    >>> B = [[[0.0], [0.1 * 0.787]]] * 2
+    >>> prob = KothareProblem(A, B, Q=np.diag([1.0, 0.0]), R=[[2e-5]], dt=0.1,
+    ...                       input_constraint="peak", u_max=2.0)
+    >>> sol = prob.solve([0.05, 0.0])
+    >>> sol.status, round(sol.gamma, 5)
+    ('optimal', 0.00972)
+    """
+
+    def __init__(
+        self,
+        A: Any,
+        B: Any,
+        Q: Any,
+        R: Any,
+        *,
+        dt: float = 1.0,
+        input_constraint: InputConstraint = "ellipsoid",
+        u_max: Any = None,
+        output_matrix: Any = None,
+        y_max: Any = None,
+        backend: str = "clarabel",
+        solver: str | None = None,
+        solver_options: dict[str, Any] | None = None,
+        formulation: Formulation = "delta",
+        certificate_tol: float = 1e-7,
+    ) -> None:
+        self.data: KothareData = build_kothare_data(
+            A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
+            output_matrix=output_matrix, y_max=y_max, formulation=formulation,
+        )
+        self.certificate_tol = check_positive(certificate_tol, "certificate_tol")
+        if solver_options is not None and not isinstance(solver_options, dict):
+            raise InvalidArgumentError(
+                "solver_options", "a dict of solver settings", type(solver_options).__name__
+            )
+        if backend == "clarabel":
+            if solver not in (None, "clarabel", "CLARABEL"):
+                raise InvalidArgumentError("solver", "None with backend='clarabel'", repr(solver))
+            self._backend: ClarabelKothare | CvxpyKothare = ClarabelKothare(self.data, solver_options)
+        elif backend == "cvxpy":
+            self._backend = CvxpyKothare(self.data, solver or "CLARABEL", solver_options)
+        else:
+            raise InvalidArgumentError("backend", "'clarabel' or 'cvxpy'", repr(backend))
+
+    @property
+    def backend(self) -> str:
+        """Name of the back-end (``"clarabel"`` or ``"cvxpy:SOLVER"``)."""
+        return self._backend.name
+
+    @property
+    def n_states(self) -> int:
+        return self.data.n
+
+    @property
+    def n_inputs(self) -> int:
+        return self.data.m
+
+    def solve(self, x: Any) -> LMISolution:
+        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised."""
+        x = as_vector(x, "x", self.data.n)
+        scale = float(np.linalg.norm(x))
+        if scale == 0.0:
+            raise InvalidArgumentError(
+                "x", "a non-zero state (the problem is degenerate at the origin)", "x = 0"
+            )
+        raw: RawResult = self._backend.solve(x / scale, self.data.u_max / scale, self.data.y_max / scale)
+        return self._finish(raw, x, scale)
+
+    def _finish(self, raw: RawResult, x: np.ndarray, scale: float) -> LMISolution:
+        if raw.Q is None or raw.Y is None:
+            return LMISolution(
+                raw.status, np.nan, None, None, None, raw.solve_time, raw.iterations,
+                raw.solver_status, None, self.backend, x,
+            )
+        s2 = scale**2
+        q_mat = 0.5 * (raw.Q + raw.Q.T) * s2
+        y_mat = raw.Y * s2
+        gamma = raw.gamma * s2
+        cert = certify(self.data, x, gamma, q_mat, y_mat, tol=self.certificate_tol)
+        try:
+            f_mat = np.linalg.solve(q_mat.T, y_mat.T).T
+        except np.linalg.LinAlgError:
+            f_mat = None
+        status = raw.status
+        if status == OPTIMAL and (not cert.ok or f_mat is None or not np.all(np.isfinite(f_mat))):
+            status = UNCERTIFIED
+        return LMISolution(
+            status, gamma, q_mat, y_mat, f_mat, raw.solve_time, raw.iterations, raw.solver_status,
+            cert, self.backend, x,
+        )

@@ -1,0 +1,120 @@
+"""The documentation builds without warnings, and the examples it shows run and print what it says.
+
+The examples live in ``docs/examples/*.py``; the pages show them with ``literalinclude`` and
+quote their output in the literal block that follows (``It prints::``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import runpy
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+EXAMPLES = sorted((DOCS / "examples").glob("*.py"))
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+
+
+def _pages() -> dict[str, str]:
+    return {page.name: page.read_text(encoding="utf-8") for page in sorted(DOCS.glob("*.rst"))}
+
+
+def _documented_output(example: str) -> str | None:
+    """The literal block that follows ``literalinclude:: examples/<example>``, if any."""
+    for text in _pages().values():
+        lines = text.splitlines()
+        for i, line in enumerate(lines):
+            if line.strip() != f".. literalinclude:: examples/{example}":
+                continue
+            j = i + 1
+            while j < len(lines) and (not lines[j].strip() or lines[j].startswith(" ")):
+                j += 1  # the directive's options and blank lines
+            if j == len(lines) or not lines[j].rstrip().endswith("::"):
+                return None
+            block = []
+            for body in lines[j + 1 :]:
+                if body.strip() and not body.startswith(" "):
+                    break
+                block.append(body.strip())
+            return "\n".join(block).strip()
+    return None
+
+
+def _split(text: str) -> tuple[str, list[float]]:
+    """Text without whitespace and with numbers replaced by ``#``, and the numbers."""
+    numbers = [float(m) for m in _NUMBER.findall(text)]
+    words = re.sub(r"\s+", "", _NUMBER.sub("#", text))
+    return words, numbers
+
+
+def test_docs_build_without_warnings(tmp_path: Path) -> None:
+    pytest.importorskip("sphinx")
+    pytest.importorskip("numpydoc")
+    cmd = [
+        sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
+        "-d", str(tmp_path / "doctrees"), str(DOCS), str(tmp_path / "html"),
+    ]
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600, check=False)
+    assert proc.returncode == 0, f"{' '.join(cmd)}\n{proc.stdout[-4000:]}\n{proc.stderr[-8000:]}"
+    assert (tmp_path / "html" / "index.html").is_file()
+
+
+def test_every_example_is_shown_in_the_docs() -> None:
+    text = "\n".join(_pages().values())
+    assert EXAMPLES, "docs/examples/ holds no example"
+    for example in EXAMPLES:
+        assert f".. literalinclude:: examples/{example.name}" in text, (
+            f"docs/examples/{example.name} is not included by any page"
+        )
+    assert ".. literalinclude:: examples/quickstart.py" in _pages()["quickstart.rst"]
+
+
+@pytest.fixture(scope="module")
+def run_example() -> Any:
+    """Run an example once per test module; return its globals and what it printed."""
+    cache: dict[Path, tuple[dict[str, Any], str]] = {}
+
+    def run(example: Path) -> tuple[dict[str, Any], str]:
+        if example not in cache:
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                namespace = runpy.run_path(str(example), run_name="__main__")
+            cache[example] = (namespace, out.getvalue().strip())
+        return cache[example]
+
+    return run
+
+
+@pytest.mark.parametrize("example", EXAMPLES, ids=lambda p: p.stem)
+def test_example_runs_and_prints_what_the_docs_say(example: Path, run_example: Any) -> None:
+    _, printed = run_example(example)
+    assert printed, f"{example.name} printed nothing"
+    documented = _documented_output(example.name)
+    if documented is None:
+        return
+    got_words, got_numbers = _split(printed)
+    doc_words, doc_numbers = _split(documented)
+    message = f"the output of {example.name} differs from the docs:\n{printed}\n---\n{documented}"
+    assert got_words == doc_words, message
+    assert len(got_numbers) == len(doc_numbers), message
+    # The docs round to 3-4 digits; allow one unit in the last place.
+    np.testing.assert_allclose(got_numbers, doc_numbers, rtol=1e-3, atol=2e-3, err_msg=message)
+
+
+def test_quickstart_regulates_the_attitude(run_example: Any) -> None:
+    namespace, _ = run_example(DOCS / "examples" / "quickstart.py")
+    traj = namespace["traj"]
+    assert namespace["plant"].n_vertices == 2
+    assert traj.plant == "nonlinear"
+    assert np.all(np.abs(traj.attitude_deg[-1]) < 0.1)
+    assert traj.status_counts() == {"optimal": traj.n_steps}
