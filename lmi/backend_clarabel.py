@@ -1,11 +1,13 @@
-"""Direct Clarabel back-end: the conic data built once, only ``b`` changes per state.
+"""Direct Clarabel back-end: the conic data built once, a few entries updated per state.
 
 The Kothare LMIs are written as affine matrices (:mod:`lmi.affine`) in the variables
 ``z = [gamma_s, svec(Q), vec(Y), svec(X), svec(Z)]`` and handed to Clarabel as
 ``A z + s = b``, ``s`` in PSD triangle and non-negative cones, minimising ``gamma_s``. The
-state enters only the constant part of the first LMI and the bounds enter only constants, so
-each solve rebuilds the few entries of ``b`` and calls Clarabel; the matrix ``A`` and the cones
-never change.
+state enters only the constant part of the first LMI (``b``); the input and output bounds enter
+as scalings of the rows of their off-diagonal blocks, ``[[I, Y/u], [Y'/u, Q]] >= 0`` instead of
+``[[u^2 I, Y], [Y', Q]] >= 0`` (a congruence), so a large normalised bound near the origin never
+becomes a huge constant. Each solve rescales those rows of ``A`` and rebuilds ``b``; the
+sparsity pattern and the cones never change.
 
 Formulations (see ``docs/theory.rst``):
 
@@ -30,7 +32,7 @@ import clarabel
 import numpy as np
 from scipy import sparse
 
-from lmi.affine import AffineMatrix, svec_matrix
+from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 from lmi.data import KothareData
 from lmi.status import CLARABEL_STATUS_MAP, SOLVER_ERROR
 from toolkit_common.errors import InvalidArgumentError
@@ -120,43 +122,48 @@ class ClarabelKothare:
             mat = self._vertex_lmi(data.A[j], data.B[j], q, y, nv)
             a_rows, b_rows = self._psd_rows(mat)
             blocks.append((a_rows, b_rows, clarabel.PSDTriangleConeT(mat.shape[0])))
+        # Bounds enter as row scalings of the off-diagonal blocks (see _bounded_block), never
+        # as large constants: [[u^2 I, Y], [Y', Q]] >= 0 is solved as [[I, Y/u], [Y'/u, Q]] >= 0.
+        # Row groups scaled per solve: (first row in the stacked A, rows, bound index, kind).
+        scaled_rows: list[tuple[int, np.ndarray, np.ndarray, str]] = []
+
+        def add_bounded(top: AffineMatrix, off: AffineMatrix, kind: str) -> None:
+            size = top.shape[0]
+            mat = AffineMatrix.bmat([[top, off], [off.T, q]], nv)
+            a_rows, b_rows = self._psd_rows(mat)
+            rows_i, cols_j = svec_indices(size + n)
+            sel = np.flatnonzero((rows_i < size) & (cols_j >= size))
+            start = sum(blk[0].shape[0] for blk in blocks)
+            scaled_rows.append((start, sel, rows_i[sel], kind))
+            blocks.append((a_rows, b_rows, clarabel.PSDTriangleConeT(size + n)))
+
+        def add_unit_diagonal(var: AffineMatrix) -> None:
+            size = var.shape[0]
+            diag_rows = np.array([var.coef[1:, i, i] for i in range(size)])
+            blocks.append((diag_rows, np.ones(size), clarabel.NonnegativeConeT(size)))
+
         # 3. input constraint
-        self._input_index = None
         if data.input_constraint == "ellipsoid":
-            mat = AffineMatrix.bmat([[AffineMatrix.zeros(m, m, nv), y], [y.T, q]], nv)
-            self._input_index = len(blocks)
-            blocks.append((self._psd_rows(mat)[0], None, clarabel.PSDTriangleConeT(m + n)))
+            add_bounded(AffineMatrix.constant(np.eye(m), nv), y, "u")
         elif data.input_constraint == "peak":
             xv = AffineMatrix.symmetric_variable(m, o_x, nv)
-            mat = AffineMatrix.bmat([[xv, y], [y.T, q]], nv)
-            a_rows, b_rows = self._psd_rows(mat)
-            blocks.append((a_rows, b_rows, clarabel.PSDTriangleConeT(m + n)))
-            # u_j^2 - X_jj >= 0
-            diag_rows = np.zeros((m, nv))
-            for i in range(m):
-                diag_rows[i] = xv.coef[1:, i, i]
-            self._input_index = len(blocks)
-            blocks.append((diag_rows, None, clarabel.NonnegativeConeT(m)))
-        # 4. output constraints [[Z, C G_j], [G_j' C', Q]] >= 0, y_r^2 - Z_rr >= 0
-        self._output_index = None
+            add_bounded(xv, y, "u")
+            add_unit_diagonal(xv)  # 1 - X_jj >= 0
+        # 4. output constraints [[Z, D C G_j], [G_j' C' D, Q]] >= 0, 1 - Z_rr >= 0, D = 1/y_max
         if data.C_out is not None:
             zv = AffineMatrix.symmetric_variable(p_out, o_z, nv)
             for j in range(data.n_vertices):
                 g = q.lmul(data.A[j]) + y.lmul(data.B[j])
-                cg = g.lmul(data.C_out)
-                mat = AffineMatrix.bmat([[zv, cg], [cg.T, q]], nv)
-                a_rows, b_rows = self._psd_rows(mat)
-                blocks.append((a_rows, b_rows, clarabel.PSDTriangleConeT(p_out + n)))
-            diag_rows = np.zeros((p_out, nv))
-            for r in range(p_out):
-                diag_rows[r] = zv.coef[1:, r, r]
-            self._output_index = len(blocks)
-            blocks.append((diag_rows, None, clarabel.NonnegativeConeT(p_out)))
+                add_bounded(zv, g.lmul(data.C_out), "y")
+            add_unit_diagonal(zv)
+        self._scaled_rows = scaled_rows
 
         self._offsets = np.cumsum([0] + [blk[0].shape[0] for blk in blocks])
         a_full = np.vstack([blk[0] for blk in blocks])
         a_full[np.abs(a_full) < 1e-300] = 0.0
         self._A = sparse.csc_matrix(a_full)
+        self._A.sort_indices()
+        self._A_data = self._A.data.copy()
         self._b_static = np.concatenate(
             [blk[1] if blk[1] is not None else np.zeros(blk[0].shape[0]) for blk in blocks]
         )
@@ -197,34 +204,36 @@ class ClarabelKothare:
         return -sv[1:].T, sv[0]
 
     # -- solving -----------------------------------------------------------------------
-    def _b_vector(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> np.ndarray:
-        d = self.data
-        n, m = d.n, d.m
+    def _b_vector(self, x: np.ndarray) -> np.ndarray:
+        n = self.data.n
         b = self._b_static.copy()
         const = np.zeros((n + 1, n + 1))
         const[0, 0] = 1.0
         const[0, 1:] = x
         const[1:, 0] = x
         b[self._offsets[0] : self._offsets[1]] = svec_matrix(const)
-        if d.input_constraint == "ellipsoid":
-            i = self._input_index
-            mat = np.zeros((m + n, m + n))
-            mat[:m, :m] = u_max[0] ** 2 * np.eye(m)
-            b[self._offsets[i] : self._offsets[i + 1]] = svec_matrix(mat)
-        elif d.input_constraint == "peak":
-            i = self._input_index
-            b[self._offsets[i] : self._offsets[i + 1]] = u_max**2
-        if self._output_index is not None:
-            i = self._output_index
-            b[self._offsets[i] : self._offsets[i + 1]] = y_max**2
         return b
+
+    def _a_matrix(self, u_max: np.ndarray, y_max: np.ndarray) -> sparse.csc_matrix:
+        """``A`` with the rows of the bounded off-diagonal blocks divided by their bound."""
+        row_scale = np.ones(self._A.shape[0])
+        for start, sel, bound_index, kind in self._scaled_rows:
+            bounds = u_max if kind == "u" else y_max
+            if bounds.size == 1:
+                row_scale[start + sel] = 1.0 / bounds[0]
+            else:
+                row_scale[start + sel] = 1.0 / bounds[bound_index]
+        a_mat = self._A.copy()
+        a_mat.data = self._A_data * row_scale[self._A.indices]
+        return a_mat
 
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         """Solve at the (normalised) state ``x`` with the (normalised) bounds."""
-        b = self._b_vector(x, u_max, y_max)
+        b = self._b_vector(x)
+        a_mat = self._a_matrix(u_max, y_max)
         start = time.perf_counter()
         try:
-            solver = clarabel.DefaultSolver(self._P, self._q, self._A, b, self._cones, self.settings)
+            solver = clarabel.DefaultSolver(self._P, self._q, a_mat, b, self._cones, self.settings)
             sol = solver.solve()
         except BaseException as err:
             if isinstance(err, KeyboardInterrupt):

@@ -89,31 +89,37 @@ class CvxpyKothare:
             mat = cp.bmat([top, second, [cost_q.T, zn_p.T, gs * np.eye(p), np.zeros((p, m))],
                            [cost_u.T, zn_m.T, np.zeros((m, p)), gs * np.eye(m)]])
             cons.append(0.5 * (mat + mat.T) >> 0)
-        self.u2 = None
+        # Bounds as scalings of the off-diagonal blocks (1/u, 1/y_max), as in the Clarabel back-end:
+        # [[I, Y/u], [Y'/u, Q]] >= 0 rather than [[u^2 I, Y], [Y', Q]] >= 0.
+        self.inv_u = None
         if data.input_constraint == "ellipsoid":
-            self.u2 = cp.Parameter(nonneg=True)
-            cons.append(cp.bmat([[self.u2 * np.eye(m), y], [y.T, q]]) >> 0)
+            self.inv_u = cp.Parameter(nonneg=True)
+            yu = self.inv_u * y
+            cons.append(cp.bmat([[np.eye(m), yu], [yu.T, q]]) >> 0)
         elif data.input_constraint == "peak":
-            self.u2 = cp.Parameter(m, nonneg=True)
+            self.inv_u = cp.Parameter(m, nonneg=True)
             xv = cp.Variable((m, m), symmetric=True)
-            cons += [cp.bmat([[xv, y], [y.T, q]]) >> 0, cp.diag(xv) <= self.u2]
-        self.y2 = None
+            yu = cp.multiply(cp.reshape(self.inv_u, (m, 1), order="C"), y)
+            cons += [cp.bmat([[xv, yu], [yu.T, q]]) >> 0, cp.diag(xv) <= 1.0]
+        self.inv_y = None
         if data.C_out is not None:
             p_out = data.C_out.shape[0]
-            self.y2 = cp.Parameter(p_out, nonneg=True)
+            self.inv_y = cp.Parameter(p_out, nonneg=True)
             zv = cp.Variable((p_out, p_out), symmetric=True)
             for j in range(data.n_vertices):
                 cg = data.C_out @ (data.A[j] @ q + data.B[j] @ y)
+                cg = cp.multiply(cp.reshape(self.inv_y, (p_out, 1), order="C"), cg)
                 cons.append(cp.bmat([[zv, cg], [cg.T, q]]) >> 0)
-            cons.append(cp.diag(zv) <= self.y2)
+            cons.append(cp.diag(zv) <= 1.0)
         self.problem = cp.Problem(cp.Minimize(gs), cons)
 
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         self.x.value = x
-        if self.u2 is not None:
-            self.u2.value = float(u_max[0]) ** 2 if self.data.input_constraint == "ellipsoid" else u_max**2
-        if self.y2 is not None:
-            self.y2.value = y_max**2
+        if self.inv_u is not None:
+            ellipsoid = self.data.input_constraint == "ellipsoid"
+            self.inv_u.value = 1.0 / float(u_max[0]) if ellipsoid else 1.0 / u_max
+        if self.inv_y is not None:
+            self.inv_y.value = 1.0 / y_max
         start = time.perf_counter()
         try:
             self.problem.solve(solver=self.solver, **self.options)

@@ -52,6 +52,13 @@ class RMPC:
     hold_radius : float
         Below this norm of ``x - x_ref`` the problem degenerates (``gamma -> 0``); the last
         certified gain is kept without re-solving (its invariant ellipsoid contains the state).
+    resolve_threshold : float
+        ``rho`` in ``(0, 1]``. With ``rho = 1`` (default, Kothare's algorithm) the problem is
+        solved at every step. With ``rho < 1`` the last certified gain is kept while the state
+        stays inside its invariant ellipsoid with ``x' Q^-1 x > rho`` and re-solved once the
+        level has dropped to ``rho`` (or the state has left the ellipsoid, e.g. under a
+        disturbance). Every constraint and stability guarantee of the kept gain holds inside
+        its ellipsoid; the cost is some performance, the gain is far fewer solves.
 
     Attributes
     ----------
@@ -91,6 +98,7 @@ class RMPC:
         certificate_tol: float = 1e-7,
         on_failure: Literal["fallback", "raise"] = "fallback",
         hold_radius: float = 1e-9,
+        resolve_threshold: float = 1.0,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
@@ -104,6 +112,9 @@ class RMPC:
         )
         self.on_failure = check_choice(on_failure, "on_failure", ("fallback", "raise"))
         self.hold_radius = check_positive(hold_radius, "hold_radius", allow_zero=True)
+        self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
+        if self.resolve_threshold > 1.0:
+            raise InvalidArgumentError("resolve_threshold", "a level in (0, 1]", repr(resolve_threshold))
         n = plant.n_states
         self.x_ref = np.zeros(n) if x_ref is None else as_vector(x_ref, "x_ref", n)
         drift = max(float(np.max(np.abs(a @ self.x_ref - self.x_ref))) for a in plant.A)
@@ -157,6 +168,13 @@ class RMPC:
             gain = self._current_gain()
             self.last = StepInfo(status="reused", extra={"solution": None, "reason": "near origin"})
             return gain @ z
+        if self.resolve_threshold < 1.0 and self._q_inv is not None:
+            level = float(z @ self._q_inv @ z)
+            if self.resolve_threshold < level <= 1.0:
+                self.last = StepInfo(
+                    status="reused", extra={"solution": None, "reason": "inside ellipsoid", "level": level}
+                )
+                return self._current_gain() @ z
         sol = self.problem.solve(z)
         usable = sol.status in _USABLE and sol.certificate is not None and sol.certificate.ok
         if usable:
