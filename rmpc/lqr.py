@@ -56,6 +56,14 @@ class LQR:
         n, m = plant.n_states, plant.n_inputs
         self.Q = check_psd(as_matrix(Q, "Q", (n, n)), "Q")
         self.R = check_pd(as_matrix(R, "R", (m, m)), "R")
+        if vertex is not None and (
+            isinstance(vertex, bool)
+            or not isinstance(vertex, int | np.integer)
+            or not -plant.n_vertices <= vertex < plant.n_vertices
+        ):
+            raise InvalidArgumentError(
+                "vertex", f"None or an integer in [0, {plant.n_vertices - 1}]", repr(vertex)
+            )
         a, b = plant.nominal if vertex is None else plant.vertex(vertex)
         try:
             k, s, _ = control.dlqr(a, b, self.Q, self.R)
