@@ -18,6 +18,12 @@ Formulations (see ``docs/theory.rst``):
     ``[[-(H_j + H_j'), sqrt(dt) H_j', Q Q1h', Y' Rh'], [sqrt(dt) H_j, Q, 0, 0],
     [Q1h Q, 0, gamma_s I, 0], [Rh Y, 0, 0, gamma_s I]] >= 0``. Same feasible set, well
     conditioned when ``A_j`` is close to ``I`` (small sample times).
+``"delta_shared"``
+    The delta form with the common ``Q1``/``R`` part lifted into one shared block: a variable
+    ``W`` with ``[[W, Q Q1h', Y' Rh'], [Q1h Q, gamma_s I, 0], [Rh Y, 0, gamma_s I]] >= 0`` and,
+    per vertex, ``[[-(H_j + H_j') - W, sqrt(dt) H_j'], [sqrt(dt) H_j, Q]] >= 0``. By a Schur
+    complement this is the same feasible set in ``(Q, Y, gamma)`` (the best ``W`` is
+    ``(Q Q1 Q + Y' R Y)/(dt gamma)``), and each vertex cone shrinks from ``2n + p + m`` to ``2n``.
 ``"standard"``
     Kothare's eq. (14) as printed, with ``gamma_s = gamma``.
 """
@@ -43,7 +49,10 @@ __all__ = ["ClarabelKothare", "RawResult", "clarabel_settings"]
 #: relative LMI margins >= -1.1e-8 on 20 random states of paper P's satellite with 2 and 8
 #: vertices; 1e-9 and 1e-10 made Clarabel stop with "AlmostSolved" on up to 80 % of the 8-vertex
 #: solves (the delta formulation's conditioning limit), with no gain in the certificate.
+#: Chordal decomposition is off: the LMI cones are dense, and with it on, Clarabel took 51 ms
+#: instead of 30 ms per solve of paper P's 2-vertex problem (and refuses data updates).
 DEFAULT_CLARABEL_OPTIONS: dict[str, Any] = {
+    "chordal_decomposition_enable": False,
     "tol_gap_abs": 1e-8,
     "tol_gap_rel": 1e-8,
     "tol_feas": 1e-8,
@@ -103,21 +112,27 @@ class ClarabelKothare:
         self._n_x = m * (m + 1) // 2 if data.input_constraint == "peak" else 0
         p_out = 0 if data.C_out is None else data.C_out.shape[0]
         self._n_z = p_out * (p_out + 1) // 2
-        nv = 1 + self._n_q + self._n_y + self._n_x + self._n_z
+        self._n_w = self._n_q if data.formulation == "delta_shared" else 0
+        nv = 1 + self._n_q + self._n_y + self._n_x + self._n_z + self._n_w
         self.n_vars = nv
         o_q, o_y = 1, 1 + self._n_q
         o_x, o_z = o_y + self._n_y, o_y + self._n_y + self._n_x
-        self._slices = (o_q, o_y)
+        o_w = o_z + self._n_z
         q = AffineMatrix.symmetric_variable(n, o_q, nv)
         y = AffineMatrix.full_variable(m, n, o_y, nv)
         self._q_affine, self._y_affine = q, y
+        self._w = AffineMatrix.symmetric_variable(n, o_w, nv) if self._n_w else None
 
         blocks: list[tuple[np.ndarray, np.ndarray, Any]] = []  # (A rows, b static, cone)
         # 1. state LMI [[1, x'], [x, Q]]: constant part filled per solve
         state = AffineMatrix.bmat([[AffineMatrix.zeros(1, 1, nv), None], [None, q]], nv)
         self._state_rows = self._psd_rows(state)
         blocks.append((self._state_rows[0], None, clarabel.PSDTriangleConeT(n + 1)))
-        # 2. one cost LMI per vertex
+        # 2. one cost LMI per vertex (plus the shared cost block of "delta_shared")
+        if self._w is not None:
+            mat = self._shared_cost_lmi(q, y, self._w, nv)
+            a_rows, b_rows = self._psd_rows(mat)
+            blocks.append((a_rows, b_rows, clarabel.PSDTriangleConeT(mat.shape[0])))
         for j in range(data.n_vertices):
             mat = self._vertex_lmi(data.A[j], data.B[j], q, y, nv)
             a_rows, b_rows = self._psd_rows(mat)
@@ -192,9 +207,25 @@ class ClarabelKothare:
         dt = d.dt
         h = q.lmul((a - np.eye(n)) / dt) + y.lmul(b / dt)
         sq = np.sqrt(dt)
+        if self._w is not None:
+            return AffineMatrix.bmat([[-(h + h.T) - self._w, h.T * sq], [h * sq, q]], nv)
         return AffineMatrix.bmat(
             [[-(h + h.T), h.T * sq, cost_q, cost_u], [h * sq, q, None, None],
              [cost_q.T, None, gam, None], [cost_u.T, None, None, gam_m]], nv,
+        )
+
+    def _shared_cost_lmi(
+        self, q: AffineMatrix, y: AffineMatrix, w: AffineMatrix, nv: int
+    ) -> AffineMatrix:
+        """``[[W, Q Q1h', Y' Rh'], [Q1h Q, gamma_s I, 0], [Rh Y, 0, gamma_s I]] >= 0``."""
+        d = self.data
+        p, m = d.Q1h.shape[0], d.m
+        gam = AffineMatrix.scalar_variable_times(np.eye(p), 0, nv)
+        gam_m = AffineMatrix.scalar_variable_times(np.eye(m), 0, nv)
+        cost_q = q.rmul(d.Q1h.T)
+        cost_u = y.T.rmul(d.Rh.T)
+        return AffineMatrix.bmat(
+            [[w, cost_q, cost_u], [cost_q.T, gam, None], [cost_u.T, None, gam_m]], nv
         )
 
     @staticmethod
@@ -246,7 +277,7 @@ class ClarabelKothare:
         q_mat = self._q_affine.value(z)
         y_mat = self._y_affine.value(z)
         gamma = float(z[0])
-        if self.data.formulation == "delta":
+        if self.data.formulation != "standard":
             gamma /= self.data.dt
         return RawResult(status, raw, gamma, q_mat, y_mat, int(sol.iterations), elapsed)
 

@@ -77,7 +77,16 @@ class CvxpyKothare:
         cost_q = q @ data.Q1h.T
         cost_u = y.T @ data.Rh.T
         zn_p, zn_m = np.zeros((n, p)), np.zeros((n, m))
-        for j in range(data.n_vertices):
+        if data.formulation == "delta_shared":
+            w = cp.Variable((n, n), symmetric=True)
+            mat = cp.bmat([[w, cost_q, cost_u], [cost_q.T, gs * np.eye(p), np.zeros((p, m))],
+                           [cost_u.T, np.zeros((m, p)), gs * np.eye(m)]])
+            cons.append(0.5 * (mat + mat.T) >> 0)
+            for j in range(data.n_vertices):
+                h = ((data.A[j] - np.eye(n)) / data.dt) @ q + (data.B[j] / data.dt) @ y
+                mat = cp.bmat([[-(h + h.T) - w, np.sqrt(data.dt) * h.T], [np.sqrt(data.dt) * h, q]])
+                cons.append(0.5 * (mat + mat.T) >> 0)
+        for j in range(data.n_vertices if data.formulation != "delta_shared" else 0):
             if data.formulation == "standard":
                 g = data.A[j] @ q + data.B[j] @ y
                 top = [q, g.T, cost_q, cost_u]
@@ -131,7 +140,7 @@ class CvxpyKothare:
         if self.Qv.value is None:
             return RawResult(status, raw, np.nan, None, None, None, elapsed)
         gamma = float(self.gs.value)
-        if self.data.formulation == "delta":
+        if self.data.formulation != "standard":
             gamma /= self.data.dt
         stats = self.problem.solver_stats
         iters = None if stats is None or stats.num_iters is None else int(stats.num_iters)

@@ -20,7 +20,8 @@ from toolkit_common.validation import (
 __all__ = ["InputConstraint", "KothareData", "build_kothare_data", "psd_factor"]
 
 InputConstraint = Literal["ellipsoid", "peak"] | None
-Formulation = Literal["delta", "standard"]
+Formulation = Literal["delta", "delta_shared", "standard"]
+FORMULATIONS: tuple[str, ...] = ("delta", "delta_shared", "standard")
 
 
 def psd_factor(mat: np.ndarray, tol: float = 1e-12) -> np.ndarray:
@@ -49,7 +50,7 @@ class KothareData:
         Output matrix of the output constraints ``|(C x(k+i))_r| <= y_max_r``, ``i >= 1``.
     y_max : ndarray
         Output bounds (empty without output constraints).
-    formulation : {"delta", "standard"}
+    formulation : {"delta", "delta_shared", "standard"}
     """
 
     A: np.ndarray
@@ -99,7 +100,7 @@ def build_kothare_data(
     u_max: Any = None,
     output_matrix: Any = None,
     y_max: Any = None,
-    formulation: Formulation = "delta",
+    formulation: Formulation = "delta_shared",
 ) -> KothareData:
     """Validate the problem data; every error names the argument.
 
@@ -130,7 +131,7 @@ def build_kothare_data(
     r = check_pd(as_matrix(R, "R", (m, m)), "R")
     dt = check_positive(dt, "dt")
     check_choice(input_constraint, "input_constraint", ("ellipsoid", "peak", None))
-    check_choice(formulation, "formulation", ("delta", "standard"))
+    check_choice(formulation, "formulation", FORMULATIONS)
     if input_constraint is None:
         if u_max is not None:
             raise InvalidArgumentError(

@@ -114,9 +114,12 @@ class KothareProblem:
         The cvxpy solver for ``backend="cvxpy"`` (default ``"CLARABEL"``).
     solver_options : dict, optional
         Solver settings; unknown names raise :class:`InvalidArgumentError`.
-    formulation : {"delta", "standard"}
-        ``"delta"`` rewrites the vertex LMIs with ``(A_j - I)/dt`` (a congruence; same optimum,
-        better conditioned at small ``dt``); ``"standard"`` is eq. (14) as printed.
+    formulation : {"delta_shared", "delta", "standard"}
+        Default ``"delta_shared"``. ``"delta"`` rewrites the vertex LMIs with ``(A_j - I)/dt``
+        (a congruence; same optimum, better conditioned at small ``dt``); ``"delta_shared"``
+        also lifts the common ``Q1``/``R`` part into one shared block so each vertex cone
+        shrinks to ``2n``;
+        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backend_clarabel`.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed relative LMI margin is ``>= -tol``.
 
@@ -150,7 +153,7 @@ class KothareProblem:
         backend: str = "clarabel",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
-        formulation: Formulation = "delta",
+        formulation: Formulation = "delta_shared",
         certificate_tol: float = 1e-7,
     ) -> None:
         self.data: KothareData = build_kothare_data(

@@ -94,7 +94,7 @@ class RMPC:
         backend: str = "clarabel",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
-        formulation: Literal["delta", "standard"] = "delta",
+        formulation: Literal["delta", "delta_shared", "standard"] = "delta_shared",
         certificate_tol: float = 1e-7,
         on_failure: Literal["fallback", "raise"] = "fallback",
         hold_radius: float = 1e-9,
