@@ -41,6 +41,7 @@ from scipy import sparse
 from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 from lmi.data import KothareData
 from lmi.status import CLARABEL_STATUS_MAP, SOLVER_ERROR
+from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["ClarabelKothare", "RawResult", "clarabel_settings"]
@@ -106,6 +107,7 @@ class ClarabelKothare:
     def __init__(self, data: KothareData, options: dict[str, Any] | None = None) -> None:
         self.data = data
         self.settings = clarabel_settings(options)
+        self._blas = SingleThreadBlas()
         n, m = data.n, data.m
         self._n_q = n * (n + 1) // 2
         self._n_y = m * n
@@ -264,8 +266,9 @@ class ClarabelKothare:
         a_mat = self._a_matrix(u_max, y_max)
         start = time.perf_counter()
         try:
-            solver = clarabel.DefaultSolver(self._P, self._q, a_mat, b, self._cones, self.settings)
-            sol = solver.solve()
+            with self._blas.limit():
+                solver = clarabel.DefaultSolver(self._P, self._q, a_mat, b, self._cones, self.settings)
+                sol = solver.solve()
         except BaseException as err:
             if isinstance(err, KeyboardInterrupt):
                 raise

@@ -13,6 +13,7 @@ import numpy as np
 
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.backend_cvxpy import CvxpyKothare
+from lmi.backend_ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.status import OPTIMAL, UNCERTIFIED
@@ -168,11 +169,17 @@ class KothareProblem:
         if backend == "clarabel":
             if solver not in (None, "clarabel", "CLARABEL"):
                 raise InvalidArgumentError("solver", "None with backend='clarabel'", repr(solver))
-            self._backend: ClarabelKothare | CvxpyKothare = ClarabelKothare(self.data, solver_options)
+            self._backend: ClarabelKothare | CvxpyKothare | IPMKothare = ClarabelKothare(
+                self.data, solver_options
+            )
+        elif backend == "ipm":
+            if solver is not None:
+                raise InvalidArgumentError("solver", "None with backend='ipm'", repr(solver))
+            self._backend = IPMKothare(self.data, solver_options)
         elif backend == "cvxpy":
             self._backend = CvxpyKothare(self.data, solver or "CLARABEL", solver_options)
         else:
-            raise InvalidArgumentError("backend", "'clarabel' or 'cvxpy'", repr(backend))
+            raise InvalidArgumentError("backend", "'clarabel', 'ipm' or 'cvxpy'", repr(backend))
 
     @property
     def backend(self) -> str:
