@@ -40,7 +40,7 @@ from scipy import sparse
 
 from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 from lmi.data import KothareData
-from lmi.status import CLARABEL_STATUS_MAP, SOLVER_ERROR
+from lmi.status import CLARABEL_STATUS_MAP, INFEASIBLE, SOLVER_ERROR, UNBOUNDED
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
@@ -276,6 +276,8 @@ class ClarabelKothare:
         elapsed = time.perf_counter() - start
         raw = str(sol.status)
         status = CLARABEL_STATUS_MAP.get(raw, SOLVER_ERROR)
+        if status in (INFEASIBLE, UNBOUNDED):  # the last iterate is no answer: return none
+            return RawResult(status, raw, np.nan, None, None, int(sol.iterations), elapsed)
         z = np.asarray(sol.x)
         q_mat = self._q_affine.value(z)
         y_mat = self._y_affine.value(z)
