@@ -11,14 +11,14 @@ sparsity pattern and the cones never change.
 
 Formulations (see ``docs/theory.rst``):
 
-``"delta"`` (default)
+``"delta"``
     The vertex LMI after the congruence ``[[I, -I], [0, I]]`` on its first two block rows and
     the scaling ``diag(1/sqrt(dt), I, sqrt(dt) I, sqrt(dt) I)``; with
     ``H_j = (A_j - I)/dt Q + B_j/dt Y`` and ``gamma_s = dt gamma`` it reads
     ``[[-(H_j + H_j'), sqrt(dt) H_j', Q Q1h', Y' Rh'], [sqrt(dt) H_j, Q, 0, 0],
     [Q1h Q, 0, gamma_s I, 0], [Rh Y, 0, 0, gamma_s I]] >= 0``. Same feasible set, well
     conditioned when ``A_j`` is close to ``I`` (small sample times).
-``"delta_shared"``
+``"delta_shared"`` (default)
     The delta form with the common ``Q1``/``R`` part lifted into one shared block: a variable
     ``W`` with ``[[W, Q Q1h', Y' Rh'], [Q1h Q, gamma_s I, 0], [Rh Y, 0, gamma_s I]] >= 0`` and,
     per vertex, ``[[-(H_j + H_j') - W, sqrt(dt) H_j'], [sqrt(dt) H_j, Q]] >= 0``. By a Schur
