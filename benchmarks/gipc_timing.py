@@ -1,0 +1,158 @@
+"""Per-step time of GIPC with each QP back-end, against the same QP through cvxpy, in one run.
+
+Run as ``python -m benchmarks.gipc_timing [--steps N] [--plant linear|nonlinear] [--json FILE]``.
+
+Each back-end drives its own closed loop of paper P's problem: the satellite from paper P's
+initial attitude, ``Ts = 0.01`` s, GIPC with its defaults (``Np = 400``, ``Nc = 4``,
+``|u| <= 1``, ``|du| <= 0.01``) and experiment E4's 0.5 N m step disturbance from t = 10 s,
+so the loop has a constrained transient, a disturbance and a quiet end. The ``cvxpy`` row
+solves the same QP modelled in cvxpy (parameters, DPP; Clarabel at 1e-10) through the same
+controller. Reported per back-end, over all steps but the first (the first builds the
+solver; its time is ``setup_s``):
+
+- ``step``: wall time of ``GIPC.step`` (vectors, update, solve, checks) - the controller's
+  cost per sample;
+- ``solve``: wall time of the back-end's solve call alone;
+- median, p95 and max of each, the ratio of the median step time to cvxpy's, the status
+  counts, and the largest error of the applied ``du`` against a certified high-accuracy
+  solution of the same QP (:func:`rmpc.qp.reference_solution`) on every
+  ``--check-every``-th step, as a fraction of the ``du`` bound.
+
+The machine (platform, CPU count, load average) and package versions are printed with the
+figures: the timings depend on them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from benchmarks.machine import machine_info, package_versions, percentiles
+from models import PAPER_P_SAMPLE_TIME, RigidSatellite
+from rmpc import GIPC, StepDisturbance, simulate
+from rmpc.qp import reference_solution
+
+__all__ = ["main", "run"]
+
+BACKENDS = ("proxqp", "osqp", "clarabel", "cvxpy")
+DU_MAX = 0.01
+
+
+def _one(backend: str, steps: int, plant: str, check_every: int) -> dict[str, Any]:
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    model = sat.linear_model(x0, PAPER_P_SAMPLE_TIME)
+    ctrl = GIPC(model, backend=backend, du_max=DU_MAX)
+    sim_plant = sat if plant == "nonlinear" else model
+    start = time.perf_counter()
+    traj = simulate(
+        ctrl, sim_plant, x0, n_steps=steps, dt=PAPER_P_SAMPLE_TIME if plant == "nonlinear" else None,
+        disturbance=StepDisturbance([0.5, 0.5, 0.5], 10.0),
+    )
+    wall = time.perf_counter() - start
+    errs = []
+    for k in range(1, traj.n_steps, check_every):
+        res = reference_solution(ctrl.qp_at(traj.x[k], traj.x[k - 1], traj.u_cmd[k - 1]))
+        du = traj.u_cmd[k] - traj.u_cmd[k - 1]
+        errs.append(float(np.abs(du - res.x[:3]).max()) / DU_MAX)
+    step_times = traj.step_time[1:]
+    solve_times = traj.solve_time[1:]
+    return {
+        "backend": backend,
+        "settings": repr(ctrl.backend.settings),
+        "steps": traj.n_steps,
+        "setup_s": float(traj.step_time[0]),
+        "step": percentiles(step_times),
+        "solve": percentiles(solve_times),
+        "status_counts": traj.status_counts(),
+        "fallbacks": int(sum(bool(getattr(i, "fallback", False)) for i in traj.info)),
+        "max_du_err_frac": max(errs) if errs else float("nan"),
+        "checked_steps": len(errs),
+        "final_attitude_err_rad": float(np.abs(traj.x[-1, :3]).max()),
+        "loop_wall_s": wall,
+    }
+
+
+def run(steps: int = 2000, plant: str = "linear", check_every: int = 20,
+        backends: Sequence[str] = BACKENDS) -> dict[str, Any]:
+    """Time every back-end; return ``{"machine", "versions", "controller", "records"}``."""
+    if steps < 2:
+        raise ValueError(f"steps: expected an integer >= 2, but found {steps}")
+    records = [_one(name, steps, plant, check_every) for name in backends]
+    base = next((r for r in records if r["backend"] == "cvxpy"), None)
+    for rec in records:
+        rec["ratio_to_cvxpy"] = (
+            rec["step"]["p50_s"] / base["step"]["p50_s"] if base is not None else float("nan")
+        )
+    return {
+        "problem": "GIPC",
+        "machine": machine_info(),
+        "versions": package_versions(),
+        "controller": {"Np": 400, "Nc": 4, "Qy": 1.0, "R_du": 1.0, "u_max": 1.0, "du_max": DU_MAX,
+                       "plant": plant, "disturbance": "0.5 N m per axis from t = 10 s",
+                       "dt": PAPER_P_SAMPLE_TIME},
+        "records": records,
+    }
+
+
+def _print(report: dict[str, Any]) -> None:
+    m = report["machine"]
+    print(f"GIPC per-step time, paper P's satellite ({report['controller']['plant']} plant, E4 disturbance)")
+    print(f"machine: {m['platform']}, {m['processor']}, cpu_count={m['cpu_count']}, "
+          f"load={m['load_average']}, python {m['python']}")
+    print("versions: " + ", ".join(f"{k} {v}" for k, v in report["versions"].items()))
+    head = (f"{'backend':9s} {'step p50':>9s} {'p95':>8s} {'max':>8s}  {'solve p50':>9s} {'p95':>8s} "
+            f"{'max':>8s}  {'vs cvxpy':>8s}  {'du err/bound':>12s}  statuses")
+    print(head)
+    print("-" * len(head))
+    for r in report["records"]:
+        s, v = r["step"], r["solve"]
+        print(f"{r['backend']:9s} {s['p50_s'] * 1e3:7.3f}ms {s['p95_s'] * 1e3:6.3f}ms "
+              f"{s['max_s'] * 1e3:6.2f}ms  "
+              f"{v['p50_s'] * 1e3:7.3f}ms {v['p95_s'] * 1e3:6.3f}ms {v['max_s'] * 1e3:6.2f}ms  "
+              f"{r['ratio_to_cvxpy']:8.4f}  {r['max_du_err_frac']:12.1e}  {r['status_counts']}")
+    print(f"steps per back-end: {report['records'][0]['steps']} (the first, solver set-up, excluded)")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(
+        prog="python -m benchmarks.gipc_timing", description=(__doc__ or "").split("\n")[0]
+    )
+    parser.add_argument(
+        "--steps", type=int, default=2000, help="closed-loop steps per back-end (default 2000)"
+    )
+    parser.add_argument("--plant", choices=("linear", "nonlinear"), default="linear",
+                        help="plant of the closed loop (the controller's time does not depend on it)")
+    parser.add_argument("--check-every", type=int, default=20,
+                        help="compare the applied du with a high-accuracy solution every N steps")
+    parser.add_argument("--backends", default=",".join(BACKENDS), help="comma-separated back-end names")
+    parser.add_argument("--json", default=None, help="also write the report to this JSON file")
+    args = parser.parse_args(argv)
+    if args.steps < 2 or args.check_every < 1:
+        print("gipc_timing: error: --steps must be >= 2 and --check-every >= 1", file=sys.stderr)
+        return 2
+    names = [b.strip() for b in args.backends.split(",") if b.strip()]
+    unknown = [b for b in names if b not in BACKENDS]
+    if unknown:
+        print(
+            f"gipc_timing: error: unknown back-end(s) {unknown}; choose from {list(BACKENDS)}",
+            file=sys.stderr,
+        )
+        return 2
+    report = run(args.steps, args.plant, args.check_every, names)
+    _print(report)
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump(report, fh, indent=2)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

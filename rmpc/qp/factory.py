@@ -1,0 +1,51 @@
+"""``make_backend(name, **settings)``: a QP back-end by name."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rmpc.qp.base import QPBackend
+from rmpc.qp.clarabel_backend import ClarabelBackend
+from rmpc.qp.cvxpy_backend import CvxpyBackend
+from rmpc.qp.osqp_backend import OSQPBackend
+from rmpc.qp.proxqp_backend import ProxQPBackend
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+
+__all__ = ["BACKENDS", "make_backend"]
+
+#: Name -> back-end class. ``"cvxpy"`` is the reference (slow; for tests and benchmarks).
+BACKENDS: dict[str, type[QPBackend]] = {
+    "osqp": OSQPBackend,
+    "proxqp": ProxQPBackend,
+    "clarabel": ClarabelBackend,
+    "cvxpy": CvxpyBackend,
+}
+
+
+def make_backend(name: str, **settings: Any) -> QPBackend:
+    """Build the back-end called ``name`` with ``settings`` (unknown settings raise).
+
+    Parameters
+    ----------
+    name : {"osqp", "proxqp", "clarabel", "cvxpy"}
+        The back-end.
+    **settings
+        Settings of that back-end (see its settings class).
+
+    Examples
+    --------
+    >>> from rmpc.qp import make_backend
+    >>> make_backend("osqp", eps_abs=1e-7).settings.eps_abs
+    1e-07
+    >>> try:
+    ...     make_backend("proxqp", eps=1e-3)
+    ... except ValueError as err:
+    ...     print(err.argument, "|", err.found)
+    settings 'eps' | the unknown setting 'eps'
+    """
+    if not isinstance(name, str):
+        raise ArgumentTypeError("name", "a back-end name (str)", type(name).__name__)
+    key = name.lower()
+    if key not in BACKENDS:
+        raise InvalidArgumentError("name", f"one of {', '.join(repr(k) for k in BACKENDS)}", repr(name))
+    return BACKENDS[key](**settings)
