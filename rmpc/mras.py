@@ -1,0 +1,435 @@
+"""The MIT rule of model reference adaptive systems (MRAS), in discrete time.
+
+A model reference adaptive system compares the plant output ``y`` with the output ``ym`` of a
+reference model and adjusts a parameter vector ``theta`` so that the error ``e = y - ym``
+becomes small. The MIT rule (Astrom & Wittenmark, *Adaptive Control*, 2nd ed., section 5.2)
+descends the gradient of ``J(theta) = e' e / 2``::
+
+    dtheta/dt = -gamma (de/dtheta)' e                              (plain MIT rule)
+    dtheta/dt = -gamma (de/dtheta)' e / (alpha + |de/dtheta|^2)    (normalised MIT rule)
+
+``de/dtheta`` (the *sensitivity derivative*) is produced by filters driven by measured signals
+(:class:`SensitivityFilter`). The time derivative is integrated by the discrete integrator
+``Ts / (1 - z^-1)`` (forward Euler)::
+
+    theta(k+1) = theta(k) - gamma Ts (de/dtheta)(k)' e(k) [/ (alpha + |de/dtheta|^2)]
+
+The plain rule's speed scales with the square of the signal levels, so a large command or a
+soft loop can make it unstable; the normalised rule divides that scale out and its speed is
+set by ``gamma`` alone (Astrom & Wittenmark, chapter 5).
+
+:func:`example_5_2` reproduces Astrom & Wittenmark's example 5.2 (adaptation of a
+feedforward gain and a feedback gain for a first-order plant), the outside reference of
+SPEC section 4. :class:`rmpc.CRMPC` uses the same two pieces around robust MPC.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_positive, check_real
+
+__all__ = [
+    "EXAMPLE_5_2_GAINS",
+    "Example52Result",
+    "MITRule",
+    "SensitivityFilter",
+    "example_5_2",
+]
+
+#: The gains of example 5.2 at convergence, ``(theta1, theta2) = (bm / b, (am - a) / b)``
+#: for ``u = theta1 uc - theta2 y``; in the form ``u = theta1 uc + k_y y`` (python-control's
+#: ``kx``) the feedback gain is ``k_y = -theta2 = -2``.
+EXAMPLE_5_2_GAINS: tuple[float, float] = (4.0, 2.0)
+
+
+class MITRule:
+    """Gradient (MIT-rule) adaptation of a parameter vector through a discrete integrator.
+
+    Parameters
+    ----------
+    n_params : int
+        Number of adjustable parameters.
+    gain : float
+        Adaptation gain ``gamma`` (>= 0; 0 freezes the parameters). Its unit is that of
+        ``theta`` per second per unit of ``(de/dtheta)' e`` for the plain rule and
+        1/s for the normalised rule.
+    dt : float
+        Sample time ``Ts`` of the integrator ``Ts / (1 - z^-1)`` (s).
+    normalized : bool
+        Divide the gradient by ``alpha + ||de/dtheta||_F^2`` (the normalised MIT rule).
+    alpha : float
+        Regularisation ``alpha > 0`` of the normalised rule; ignored by the plain rule.
+    theta0 : array_like, optional
+        Initial parameters (default zero); :meth:`reset` returns to them.
+    bound : float or array_like, optional
+        Projection: after each update ``|theta_i| <= bound_i`` is enforced by clipping
+        (``None``: no bound).
+
+    Examples
+    --------
+    One parameter, ``e = theta - 3`` (so ``de/dtheta = 1``): the rule drives ``theta`` to 3.
+
+    >>> import numpy as np
+    >>> from rmpc.mras import MITRule
+    >>> rule = MITRule(1, gain=5.0, dt=0.01)
+    >>> for _ in range(2000):
+    ...     theta = rule.update(rule.theta - 3.0, np.ones((1, 1)))
+    >>> round(float(theta[0]), 6)
+    3.0
+    """
+
+    def __init__(
+        self,
+        n_params: int,
+        gain: float,
+        dt: float,
+        *,
+        normalized: bool = False,
+        alpha: float = 1.0,
+        theta0: Any = None,
+        bound: Any = None,
+    ) -> None:
+        if isinstance(n_params, bool) or not isinstance(n_params, int | np.integer) or n_params < 1:
+            raise InvalidArgumentError("n_params", "a positive integer", repr(n_params))
+        self.n_params = int(n_params)
+        self.gain = check_positive(gain, "gain", allow_zero=True)
+        self.dt = check_positive(dt, "dt")
+        if not isinstance(normalized, bool | np.bool_):
+            found = f"{type(normalized).__name__} {normalized!r}"
+            raise ArgumentTypeError("normalized", "True or False", found)
+        self.normalized = bool(normalized)
+        self.alpha = check_positive(alpha, "alpha")
+        n_p = self.n_params
+        self.theta0 = np.zeros(n_p) if theta0 is None else as_vector(theta0, "theta0", n_p)
+        self.bound = _bound(bound, "bound", self.n_params)
+        if self.bound is not None and np.any(np.abs(self.theta0) > self.bound):
+            raise InvalidArgumentError(
+                "theta0", f"|theta0_i| <= bound_i = {self.bound.tolist()}", repr(self.theta0.tolist())
+            )
+        self._theta = self.theta0.copy()
+
+    @property
+    def theta(self) -> np.ndarray:
+        """The current parameters (a copy)."""
+        return self._theta.copy()
+
+    def reset(self) -> None:
+        """Return to ``theta0``."""
+        self._theta = self.theta0.copy()
+
+    def rate(self, error: Any, sensitivity: Any) -> np.ndarray:
+        """``dtheta/dt`` of the (plain or normalised) MIT rule for this error and sensitivity.
+
+        Parameters
+        ----------
+        error : array_like, shape (p,)
+            The model-following error ``e = y - ym``.
+        sensitivity : array_like, shape (p, n_params)
+            ``de/dtheta``, column ``i`` the sensitivity of ``e`` to ``theta_i``.
+        """
+        e = as_vector(error, "error")
+        sens = as_matrix(sensitivity, "sensitivity", (e.shape[0], self.n_params))
+        grad = sens.T @ e
+        if self.normalized:
+            grad = grad / (self.alpha + float(np.sum(sens * sens)))
+        return -self.gain * grad
+
+    def update(self, error: Any, sensitivity: Any) -> np.ndarray:
+        """One step of the integrator, ``theta(k+1) = theta(k) + Ts * rate``; returns ``theta(k+1)``."""
+        self._integrate(self.rate(error, sensitivity))
+        return self._theta.copy()
+
+    def _gradient_step(self, e: np.ndarray, sens: np.ndarray) -> None:
+        """:meth:`update` without the argument checks (hot loops that built valid arrays)."""
+        grad = sens.T @ e
+        if self.normalized:
+            grad = grad / (self.alpha + float(np.sum(sens * sens)))
+        self._integrate(-self.gain * grad)
+
+    def _integrate(self, rate: np.ndarray) -> None:
+        theta = self._theta + self.dt * rate
+        if self.bound is not None:
+            theta = np.clip(theta, -self.bound, self.bound)
+        self._theta = theta
+
+    def __repr__(self) -> str:
+        kind = "normalised" if self.normalized else "plain"
+        return f"MITRule(n_params={self.n_params}, gain={self.gain:g}, dt={self.dt:g}, {kind})"
+
+
+def _bound(value: Any, name: str, size: int) -> np.ndarray | None:
+    """``None`` or positive bounds, one per parameter (a scalar is broadcast)."""
+    if value is None:
+        return None
+    if np.ndim(value) == 0:
+        arr = np.full(size, check_real(value, name))
+    else:
+        arr = as_vector(value, name, size)
+    if np.any(arr <= 0.0):
+        raise InvalidArgumentError(name, "positive bounds (or None)", repr(arr.tolist()))
+    return arr
+
+
+class SensitivityFilter:
+    """A discrete linear filter that produces sensitivity derivatives ``de/dtheta``.
+
+    ``s(k+1) = A s(k) + B v(k)``, output ``w(k) = C s(k) + D v(k)``. The input ``v`` may be a
+    vector ``(r,)`` or a matrix ``(r, columns)`` whose columns are filtered independently (one
+    column per parameter), and ``A`` may be replaced at each step (a time-varying filter, as
+    for a closed loop whose gain changes).
+
+    Parameters
+    ----------
+    a : (n, n) array_like
+    b : (n, r) array_like
+    c : (p, n) array_like, optional
+        Default: the identity (the output is the state).
+    d : (p, r) array_like, optional
+        Default: zero (the filter is strictly proper: the output at ``k`` depends on inputs
+        up to ``k - 1`` only).
+    columns : int, optional
+        Number of columns of ``v`` (``None``: ``v`` is a vector).
+
+    Examples
+    --------
+    ``am / (p + am)`` with ``am = 2`` sampled at 0.01 s (zero-order hold), unit DC gain:
+
+    >>> from rmpc.mras import SensitivityFilter
+    >>> filt = SensitivityFilter.first_order(pole=2.0, dt=0.01)
+    >>> for _ in range(1000):
+    ...     filt.advance([1.0])
+    >>> round(float(filt.output()[0]), 6)
+    1.0
+    """
+
+    def __init__(self, a: Any, b: Any, c: Any = None, d: Any = None, *, columns: int | None = None) -> None:
+        self.a = as_matrix(a, "a")
+        n = self.a.shape[0]
+        self.a = as_matrix(self.a, "a", (n, n))
+        self.b = as_matrix(b, "b", (n, None))
+        r = self.b.shape[1]
+        self.c = np.eye(n) if c is None else as_matrix(c, "c", (None, n))
+        p = self.c.shape[0]
+        self.d = np.zeros((p, r)) if d is None else as_matrix(d, "d", (p, r))
+        if columns is not None and (
+            isinstance(columns, bool) or not isinstance(columns, int | np.integer) or columns < 1
+        ):
+            raise InvalidArgumentError("columns", "None or a positive integer", repr(columns))
+        self.columns = None if columns is None else int(columns)
+        self._shape = (n,) if self.columns is None else (n, self.columns)
+        self._state = np.zeros(self._shape)
+
+    @classmethod
+    def first_order(cls, pole: float, dt: float, gain: float = 1.0) -> SensitivityFilter:
+        """``gain * pole / (p + pole)`` discretised with a zero-order hold at ``dt``."""
+        pole = check_positive(pole, "pole")
+        dt = check_positive(dt, "dt")
+        gain = check_real(gain, "gain")
+        decay = float(np.exp(-pole * dt))
+        return cls([[decay]], [[gain * (1.0 - decay)]])
+
+    @property
+    def state(self) -> np.ndarray:
+        """The filter state ``s(k)`` (a copy)."""
+        return self._state.copy()
+
+    def reset(self) -> None:
+        """Zero the state."""
+        self._state = np.zeros(self._shape)
+
+    def _input(self, v: Any) -> np.ndarray:
+        r = self.b.shape[1]
+        if self.columns is None:
+            return as_vector(v, "v", r)
+        return as_matrix(v, "v", (r, self.columns))
+
+    def output(self, v: Any = None) -> np.ndarray:
+        """``C s(k) + D v(k)`` (``v`` may be left out when ``D = 0``)."""
+        out = self.c @ self._state
+        if v is not None:
+            out = out + self.d @ self._input(v)
+        elif np.any(self.d != 0.0):
+            raise InvalidArgumentError("v", "the input v(k) (the filter has a direct term D)", "None")
+        return out
+
+    def advance(self, v: Any, a: Any = None) -> None:
+        """``s(k+1) = A s(k) + B v(k)``; ``a`` replaces ``A`` for this step only."""
+        n = self.a.shape[0]
+        a_k = self.a if a is None else as_matrix(a, "a", (n, n))
+        self._state = a_k @ self._state + self.b @ self._input(v)
+
+
+@dataclass(frozen=True)
+class Example52Result:
+    """A run of :func:`example_5_2`.
+
+    Attributes
+    ----------
+    t : (N + 1,) ndarray
+        Sample times (s).
+    uc : (N + 1,) ndarray
+        The command (square wave).
+    y, ym : (N + 1,) ndarray
+        Plant and reference-model outputs.
+    u : (N + 1,) ndarray
+        The control ``u = theta1 uc - theta2 y`` (the last entry is computed, not applied).
+    theta : (N + 1, 2) ndarray
+        ``[theta1, theta2]`` at each sample (Astrom & Wittenmark's sign convention).
+    target : tuple of float
+        The ideal gains of the continuous-time loop, ``(bm / b, (am - a) / b)``.
+    target_sampled : tuple of float
+        The gains that match the sampled plant to the sampled model exactly (zero-order
+        hold at ``dt``): ``(bm_d / b_d, (a_d - am_d) / b_d)`` with ``y(k+1) = a_d y(k) +
+        b_d u(k)`` and ``ym(k+1) = am_d ym(k) + bm_d uc(k)``. They differ from ``target`` by
+        ``O(dt)`` (3.980 and 1.980 at ``dt = 0.01``); this is where the sampled loop converges.
+    gamma, dt : float
+        Adaptation gain and sample time.
+    normalized : bool
+        Whether the normalised MIT rule was used.
+    """
+
+    t: np.ndarray
+    uc: np.ndarray
+    y: np.ndarray
+    ym: np.ndarray
+    u: np.ndarray
+    theta: np.ndarray
+    target: tuple[float, float]
+    target_sampled: tuple[float, float]
+    gamma: float
+    dt: float
+    normalized: bool
+
+    def settling_time(self, tol: float, sampled: bool = False) -> float:
+        """The first time after which both gains stay within ``tol`` of the target (inf if never).
+
+        ``sampled=True`` measures against :attr:`target_sampled` instead of :attr:`target`.
+        """
+        target = self.target_sampled if sampled else self.target
+        err = np.max(np.abs(self.theta - np.asarray(target)), axis=1)
+        outside = np.nonzero(err > tol)[0]
+        if outside.size == 0:
+            return float(self.t[0])
+        last = int(outside[-1])
+        return float("inf") if last == err.size - 1 else float(self.t[last + 1])
+
+
+def example_5_2(
+    gamma: float = 1.0,
+    duration: float = 100.0,
+    *,
+    dt: float = 0.01,
+    period: float = 20.0,
+    amplitude: float = 1.0,
+    normalized: bool = False,
+    alpha: float = 0.01,
+    a: float = 1.0,
+    b: float = 0.5,
+    am: float = 2.0,
+    bm: float = 2.0,
+    theta0: Any = (0.0, 0.0),
+) -> Example52Result:
+    """Astrom & Wittenmark's example 5.2: MIT-rule adaptation of a feedforward and a feedback gain.
+
+    Plant ``y' = -a y + b u``, reference model ``ym' = -am ym + bm uc``, controller
+    ``u = theta1 uc - theta2 y`` and ``e = y - ym``. With ``theta`` frozen the closed loop is
+    ``y = b theta1 / (p + a + b theta2) uc``, so::
+
+        de/dtheta1 =  b / (p + a + b theta2) uc   ~  (b / am) * am / (p + am) uc
+        de/dtheta2 = -b / (p + a + b theta2) y    ~ -(b / am) * am / (p + am) y
+
+    where the approximation replaces the unknown closed-loop pole by the model's ``am`` (the
+    book's choice) and the unknown ``b / am`` is absorbed into ``gamma``. The MIT rule is then
+    ``dtheta1/dt = -gamma e (am / (p + am)) uc``, ``dtheta2/dt = gamma e (am / (p + am)) y``,
+    and the gains converge to ``theta1 = bm / b = 4`` and ``theta2 = (am - a) / b = 2``
+    (:data:`EXAMPLE_5_2_GAINS`).
+
+    Discretisation: the plant, the model and the two filters ``am / (p + am)`` are sampled
+    exactly with a zero-order hold at ``dt``; the control is held over each sample; the
+    gains are integrated by :class:`MITRule` (``Ts / (1 - z^-1)``).
+
+    Parameters
+    ----------
+    gamma : float
+        Adaptation gain (the book shows 0.2, 1 and 5).
+    duration : float
+        Simulated time (s).
+    dt : float
+        Sample time (s).
+    period, amplitude : float
+        The command ``uc`` is a square wave of this period (s) and amplitude, ``+amplitude``
+        over the first half period.
+    normalized : bool
+        Use the normalised MIT rule with regularisation ``alpha``.
+    a, b, am, bm : float
+        Plant and model parameters (the book's 1, 0.5, 2, 2).
+    theta0 : array_like
+        Initial gains.
+
+    Returns
+    -------
+    Example52Result
+
+    Examples
+    --------
+    >>> from rmpc.mras import example_5_2
+    >>> run = example_5_2(gamma=5.0, duration=200.0)
+    >>> [round(float(g), 3) for g in run.theta[-1]]
+    [3.98, 1.98]
+    >>> [round(g, 3) for g in run.target], [round(g, 3) for g in run.target_sampled]
+    ([4.0, 2.0], [3.98, 1.98])
+    """
+    gamma = check_positive(gamma, "gamma", allow_zero=True)
+    duration = check_positive(duration, "duration")
+    dt = check_positive(dt, "dt")
+    period = check_positive(period, "period")
+    amplitude = check_real(amplitude, "amplitude")
+    a = check_real(a, "a")
+    b = check_real(b, "b")
+    if b == 0.0:
+        raise InvalidArgumentError("b", "a non-zero input gain", "0.0")
+    am = check_positive(am, "am")
+    bm = check_real(bm, "bm")
+    n_steps = round(duration / dt)
+    if n_steps < 1:
+        raise InvalidArgumentError("duration", f"at least one sample of dt = {dt:g}", repr(duration))
+
+    plant_a = float(np.exp(-a * dt))
+    plant_b = b * dt if a == 0.0 else b * (1.0 - plant_a) / a
+    model_a = float(np.exp(-am * dt))
+    model_b = bm * (1.0 - model_a) / am
+    rule = MITRule(2, gamma, dt, normalized=normalized, alpha=alpha, theta0=theta0)
+    filt_uc = SensitivityFilter.first_order(am, dt)
+    filt_y = SensitivityFilter.first_order(am, dt)
+
+    sens = np.zeros((1, 2))
+    t = np.arange(n_steps + 1) * dt
+    uc = np.where(np.mod(t, period) < 0.5 * period, amplitude, -amplitude)
+    y = np.zeros(n_steps + 1)
+    ym = np.zeros(n_steps + 1)
+    u = np.zeros(n_steps + 1)
+    theta = np.zeros((n_steps + 1, 2))
+    for k in range(n_steps + 1):
+        if k > 0:
+            # The sensitivities of e(k): filtered uc and y up to k - 1, with their signs.
+            sens[0, 0] = filt_uc.c[0, 0] * filt_uc._state[0]
+            sens[0, 1] = -filt_y.c[0, 0] * filt_y._state[0]
+            rule._gradient_step(np.array([y[k] - ym[k]]), sens)
+        theta[k] = rule._theta
+        u[k] = theta[k, 0] * uc[k] - theta[k, 1] * y[k]
+        if k == n_steps:
+            break
+        y[k + 1] = plant_a * y[k] + plant_b * u[k]
+        ym[k + 1] = model_a * ym[k] + model_b * uc[k]
+        filt_uc._state = filt_uc.a @ filt_uc._state + filt_uc.b[:, 0] * uc[k]
+        filt_y._state = filt_y.a @ filt_y._state + filt_y.b[:, 0] * y[k]
+    return Example52Result(
+        t=t, uc=uc, y=y, ym=ym, u=u, theta=theta, target=(bm / b, (am - a) / b),
+        target_sampled=(model_b / plant_b, (plant_a - model_a) / plant_b),
+        gamma=gamma, dt=dt, normalized=bool(normalized),
+    )
