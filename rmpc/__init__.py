@@ -4,16 +4,22 @@ Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Contr
 """
 
 from rmpc.controller import Controller, StepInfo
+from rmpc.crmpc import CRMPC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
+from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
+from rmpc.offline_rmpc import OfflineRMPC
 from rmpc.robust_mpc import RMPC
 from rmpc.simulate import Trajectory, simulate
 
 __all__ = [
+    "CRMPC",
+    "GIPC",
     "LQR",
     "RMPC",
     "ConstantDisturbance",
     "Controller",
+    "OfflineRMPC",
     "SineDisturbance",
     "StepDisturbance",
     "StepInfo",

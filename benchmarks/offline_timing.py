@@ -1,0 +1,138 @@
+"""Per-step lookup time and design time of off-line robust MPC on paper P's satellite.
+
+Run as ``python -m benchmarks.offline_timing [--steps N] [--repeats R] [--out FILE]``. For
+2 and 8 vertices (inertia spread 0.3, ``||u|| <= 1``, Ts = 0.01 s, ``Q1 = diag(1, 1, 1, 0.1,
+0.1, 0.1)``, ``R = I``) it designs :class:`rmpc.OfflineRMPC` from paper P's initial state (15
+ellipsoids along its ray; the design time is the wall time of the construction), runs one closed
+loop of the nominal linear model, and then times ``step(x)`` at the loop's states, ``R`` passes
+over all of them, with and without interpolation. Reported per step: median, p95 and max of the
+wall time of the call, and of the time the controller reports itself (``last.solve_time``), with
+the machine and its load average (the machines are shared and noisy).
+
+``max_rel_err`` compares each returned ``u`` with a direct evaluation (every level
+``x' Q_i^-1 x`` by ``numpy.linalg.solve``, the interpolation weight from its formula).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from benchmarks.machine import machine_info, package_versions, percentiles
+from models import PAPER_P_SAMPLE_TIME, RigidSatellite
+from rmpc import OfflineRMPC, simulate
+
+Q1 = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
+R = np.eye(3)
+U_MAX = 1.0
+LEVEL_TOL = 1e-6
+
+
+def reference_u(ctrl: OfflineRMPC, x: np.ndarray) -> np.ndarray:
+    """``u`` computed the slow, obvious way from the stored table."""
+    assert ctrl.table is not None
+    ells = ctrl.table.ellipsoids
+    levels = np.array([x @ np.linalg.solve(e.Q, x) for e in ells])
+    inside = np.flatnonzero(levels <= 1.0 + LEVEL_TOL)
+    if inside.size == 0:
+        return ells[0].F @ x
+    i = int(inside.max())
+    if i == len(ells) - 1 or not (ctrl.interpolate and ctrl.table.interpolable[i]):
+        return ells[i].F @ x
+    alpha = min((levels[i + 1] - 1.0) / (levels[i + 1] - levels[i]), 1.0)
+    return (alpha * ells[i].F + (1.0 - alpha) * ells[i + 1].F) @ x
+
+
+def time_lookup(ctrl: OfflineRMPC, states: np.ndarray, repeats: int) -> dict[str, Any]:
+    """Wall time of each ``step`` call and the controller's own ``solve_time``."""
+    ctrl.step(states[0])  # the first step of a run (reset by simulate) is not a plain lookup
+    wall, reported, statuses = [], [], {}
+    for _ in range(repeats):
+        for x in states:
+            start = time.perf_counter()
+            ctrl.step(x)
+            wall.append(time.perf_counter() - start)
+            reported.append(ctrl.last.solve_time)
+            statuses[ctrl.last.status] = statuses.get(ctrl.last.status, 0) + 1
+    err = 0.0
+    for x in states:
+        u, ref = ctrl.step(x), reference_u(ctrl, x)
+        err = max(err, float(np.linalg.norm(u - ref) / max(np.linalg.norm(ref), 1e-300)))
+    rep = percentiles(reported)
+    return {**percentiles(wall), "reported_p50_s": rep["p50_s"], "reported_p95_s": rep["p95_s"],
+            "status_counts": statuses, "max_rel_err": err, "calls": len(wall)}
+
+
+def run(steps: int = 1000, repeats: int = 5, n_ellipsoids: int = 15,
+        modes: Sequence[str] = ("scalar", "box")) -> dict[str, Any]:
+    """Run the benchmark and return ``{"machine", "versions", "records"}``."""
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    records = []
+    for mode in modes:
+        poly = sat.polytope(x0, PAPER_P_SAMPLE_TIME, 0.3, mode)
+        start = time.perf_counter()
+        ctrl = OfflineRMPC(poly, Q1, R, u_max=U_MAX, x_design=x0, n_ellipsoids=n_ellipsoids)
+        design_time = time.perf_counter() - start
+        assert ctrl.table is not None
+        states = simulate(ctrl, poly, x0, n_steps=steps).x[:-1]
+        for interpolate in (True, False):
+            ctrl.interpolate = interpolate  # the same table, looked up with or without interpolation
+            rec = time_lookup(ctrl, states, repeats)
+            records.append({
+                "problem": "OfflineRMPC", "formulation": "lookup" + ("+interpolation" if interpolate else ""),
+                "backend": "numpy", "vertices": poly.n_vertices, "n_ellipsoids": ctrl.table.n_ellipsoids,
+                "design_time_s": design_time, "design_solver_time_s":
+                    float(sum(e.solve_time for e in ctrl.table.ellipsoids)), **rec,
+            })
+    return {"machine": machine_info(), "versions": package_versions(), "records": records}
+
+
+def format_table(result: dict[str, Any]) -> str:
+    """A Markdown table of the records, then the machine."""
+    lines = [
+        "| vertices | ellipsoids | lookup | design (s) | p50 (us) | p95 (us) | max (us) "
+        "| reported p50 (us) | statuses | max rel err u |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in result["records"]:
+        lines.append(
+            f"| {r['vertices']} | {r['n_ellipsoids']} | {r['formulation']} | {r['design_time_s']:.2f} | "
+            f"{1e6 * r['p50_s']:.1f} | {1e6 * r['p95_s']:.1f} | {1e6 * r['max_s']:.1f} | "
+            f"{1e6 * r['reported_p50_s']:.1f} | {r['status_counts']} | {r['max_rel_err']:.1e} |"
+        )
+    m = result["machine"]
+    lines.append("")
+    lines.append(
+        f"machine: {m['platform']}, {m['processor']}, {m['cpu_count']} CPUs (os.cpu_count), "
+        f"load average {m['load_average']} (os.getloadavg), Python {m['python']}"
+    )
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=1000, help="closed-loop states to look up")
+    parser.add_argument("--repeats", type=int, default=5, help="passes over the states")
+    parser.add_argument("--n-ellipsoids", type=int, default=15, help="ellipsoids in the table")
+    parser.add_argument("--modes", nargs="+", default=["scalar", "box"], choices=["scalar", "box"],
+                        help="inertia polytopes: scalar (2 vertices), box (8 vertices)")
+    parser.add_argument("--out", help="write the result as JSON to this file")
+    args = parser.parse_args(argv)
+    if args.steps < 1 or args.repeats < 1 or args.n_ellipsoids < 1:
+        parser.error("--steps, --repeats and --n-ellipsoids must be >= 1")
+    result = run(args.steps, args.repeats, args.n_ellipsoids, args.modes)
+    print(format_table(result))
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            json.dump(result, fh, indent=2)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,418 @@
+"""Off-line robust MPC (Wan & Kothare 2003): a sequence of nested invariant ellipsoids and gains.
+
+Reference: Z. Wan, M. V. Kothare, "An efficient off-line formulation of robust model predictive
+control using linear matrix inequalities", Automatica 39(5), 837-846, 2003.
+
+At each design state ``x_i`` (``i = 1, ..., N``) the Kothare (1996) problem is solved with one
+more LMI, the nesting ``Q_{i-1} - Q_i >= 0``, so that the invariant ellipsoids
+``E_i = {x : x' Q_i^-1 x <= 1}`` satisfy ``E_N ⊆ ... ⊆ E_2 ⊆ E_1``. The nesting is an LMI in the
+unknowns of step ``i``, and the previous solution, scaled to the new state, satisfies it, so
+every design state strictly inside the previous ellipsoid gives a feasible problem.
+
+The LMIs are the cvxpy formulation of :mod:`lmi.backend_cvxpy` (same delta form and
+scalings, so the design is well conditioned at ``Ts = 0.01`` s) with the extra constraints
+added; the design is off-line and not time-critical. Every stored ellipsoid is certified by
+:func:`lmi.certify` (the LMIs recomputed in numpy) and by the recomputed nesting margin.
+
+Wan & Kothare's condition (18) for interpolating between neighbours,
+``Q_i^-1 - (A_j + B_j F_{i+1})' Q_i^-1 (A_j + B_j F_{i+1}) > 0`` for every vertex ``j``, is
+checked after the fact (:func:`interpolation_margin`); where it fails, the table records that
+interpolation between those neighbours is off.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from itertools import pairwise
+from typing import Any
+
+import cvxpy as cp
+import numpy as np
+
+from lmi.backend_cvxpy import CvxpyKothare
+from lmi.certificate import Certificate, certify
+from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
+from lmi.status import CVXPY_STATUS_MAP, INACCURATE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_positive
+
+__all__ = [
+    "NestedEllipsoid",
+    "NestedKothareProblem",
+    "OfflineTable",
+    "interpolation_margin",
+    "nesting_margin",
+]
+
+
+def _rel_min_eig(mat: np.ndarray) -> float:
+    sym = 0.5 * (mat + mat.T)
+    lam = np.linalg.eigvalsh(sym)
+    scale = max(float(np.max(np.abs(lam))), np.finfo(float).tiny)
+    return float(lam[0] / scale)
+
+
+def nesting_margin(q_outer: np.ndarray, q_inner: np.ndarray) -> float:
+    """Smallest eigenvalue of ``Q_outer - Q_inner`` divided by ``||Q_outer||_2``.
+
+    ``>= 0`` means ``E_inner ⊆ E_outer``.
+    """
+    lam = np.linalg.eigvalsh(0.5 * ((q_outer - q_inner) + (q_outer - q_inner).T))
+    return float(lam[0] / max(float(np.linalg.norm(q_outer, 2)), np.finfo(float).tiny))
+
+
+def interpolation_margin(data: KothareData, q_outer: np.ndarray, f_inner: np.ndarray) -> float:
+    """Wan & Kothare's condition (18) for the neighbours ``(Q_i, F_{i+1})``, as a relative margin.
+
+    ``Q_i^-1 - M_j' Q_i^-1 M_j > 0`` with ``M_j = A_j + B_j F_{i+1}`` is, after the congruence
+    with ``Q_i`` and division by ``dt``, ``[[-(H_j + H_j'), sqrt(dt) H_j'], [sqrt(dt) H_j, Q_i]] > 0``
+    with ``H_j = (M_j - I) Q_i / dt`` (the delta form of :mod:`lmi.backend_clarabel`, exact for
+    any ``dt`` and well conditioned when ``M_j`` is close to ``I``). Returns the smallest
+    relative eigenvalue over the vertices; the condition holds when it is ``> 0``.
+    """
+    n, dt = data.n, data.dt
+    worst = np.inf
+    for a, b in zip(data.A, data.B, strict=True):
+        h = ((a + b @ f_inner - np.eye(n)) / dt) @ q_outer
+        mat = np.block([[-(h + h.T), np.sqrt(dt) * h.T], [np.sqrt(dt) * h, q_outer]])
+        worst = min(worst, _rel_min_eig(mat))
+    return float(worst)
+
+
+@dataclass(frozen=True)
+class NestedEllipsoid:
+    """One entry of the off-line table: the solution at one design state.
+
+    Attributes
+    ----------
+    status : str
+        ``"optimal"`` (converged, certified and nested) or a failure word (:mod:`lmi.status`).
+    x : ndarray
+        The design state.
+    gamma : float
+        The cost bound at ``x``; ``P = gamma Q^-1``.
+    Q, Y, F : ndarray or None
+        The LMI variables and the gain ``F = Y Q^-1`` (``u = F x``).
+    certificate : Certificate or None
+        The recomputed Kothare LMIs (:func:`lmi.certify`).
+    nesting_margin : float
+        :func:`nesting_margin` of ``(Q_{i-1}, Q_i)``; NaN for the first ellipsoid.
+    solve_time : float
+    solver_status : str
+    """
+
+    status: str
+    x: np.ndarray = field(repr=False)
+    gamma: float
+    Q: np.ndarray | None = field(repr=False)
+    Y: np.ndarray | None = field(repr=False)
+    F: np.ndarray | None = field(repr=False)
+    certificate: Certificate | None = field(repr=False)
+    nesting_margin: float
+    solve_time: float
+    solver_status: str
+
+    @property
+    def ok(self) -> bool:
+        return self.status == OPTIMAL
+
+    @property
+    def P(self) -> np.ndarray | None:
+        """``gamma Q^-1``."""
+        return None if self.Q is None else self.gamma * np.linalg.inv(self.Q)
+
+
+@dataclass(frozen=True)
+class OfflineTable:
+    """The nested sequence ``E_1 ⊇ E_2 ⊇ ... ⊇ E_N`` and what is known about it.
+
+    Attributes
+    ----------
+    ellipsoids : tuple of NestedEllipsoid
+        Certified entries only, outermost first.
+    interpolation_margins : ndarray, shape (N - 1,)
+        :func:`interpolation_margin` of ``(Q_i, F_{i+1})``.
+    interpolable : ndarray of bool, shape (N - 1,)
+        Whether condition (18) holds between ``i`` and ``i + 1`` (margin ``> interpolation_tol``).
+    design_time : float
+        Wall time of the whole design (s).
+    stop_reason : str
+        Why the sequence ends where it does (``"complete"`` when all design states were used).
+    failed_status : str or None
+        The status of the solve that ended the sequence early, if one did.
+    skipped : tuple of (int, float)
+        Design states not used: (position in the given sequence, level ``x' Q_{i-1}^-1 x``).
+    """
+
+    ellipsoids: tuple[NestedEllipsoid, ...]
+    interpolation_margins: np.ndarray
+    interpolable: np.ndarray
+    design_time: float
+    stop_reason: str
+    failed_status: str | None = None
+    skipped: tuple[tuple[int, float], ...] = ()
+
+    @property
+    def n_ellipsoids(self) -> int:
+        return len(self.ellipsoids)
+
+    @property
+    def gammas(self) -> np.ndarray:
+        return np.array([e.gamma for e in self.ellipsoids])
+
+    @property
+    def states(self) -> np.ndarray:
+        """The design states, shape ``(N, n)``."""
+        return np.array([e.x for e in self.ellipsoids])
+
+
+class NestedKothareProblem:
+    """The Kothare LMIs plus the nesting LMIs of Wan & Kothare (2003), built once.
+
+    Parameters
+    ----------
+    A, B, Q, R, dt, input_constraint, u_max, output_matrix, y_max, formulation
+        As :class:`lmi.KothareProblem`.
+    solver : str
+        Any installed cvxpy conic solver (default ``"CLARABEL"``).
+    solver_options : dict, optional
+        Solver settings, validated as in :mod:`lmi.backend_cvxpy`.
+    certificate_tol : float
+        Every recomputed relative margin (Kothare LMIs, nesting) must be ``>= -tol``.
+    interpolation_tol : float
+        Condition (18) is taken to hold when its relative margin is ``> interpolation_tol``.
+
+    Examples
+    --------
+    Kothare (1996), example 1, four nested ellipsoids along the ray of ``x0 = [0.05, 0]``:
+
+    >>> import numpy as np
+    >>> from lmi.offline import NestedKothareProblem
+    >>> A = [[[1, 0.1], [0, 1 - 0.1 * a]] for a in (0.1, 10.0)]
+    >>> B = [[[0.0], [0.1 * 0.787]]] * 2
+    >>> prob = NestedKothareProblem(A, B, Q=np.diag([1.0, 0.0]), R=[[2e-5]], dt=0.1,
+    ...                             input_constraint="peak", u_max=2.0)
+    >>> table = prob.design_ray([0.05, 0.0], n_ellipsoids=4, shrink=0.5)
+    >>> table.n_ellipsoids, round(float(table.gammas[0]), 5)
+    (4, 0.00972)
+    >>> all(e.nesting_margin >= -1e-7 for e in table.ellipsoids[1:])
+    True
+    """
+
+    def __init__(
+        self,
+        A: Any,
+        B: Any,
+        Q: Any,
+        R: Any,
+        *,
+        dt: float = 1.0,
+        input_constraint: InputConstraint = "ellipsoid",
+        u_max: Any = None,
+        output_matrix: Any = None,
+        y_max: Any = None,
+        solver: str = "CLARABEL",
+        solver_options: dict[str, Any] | None = None,
+        formulation: Formulation = "delta_shared",
+        certificate_tol: float = 1e-7,
+        interpolation_tol: float = 1e-9,
+    ) -> None:
+        self.data: KothareData = build_kothare_data(
+            A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
+            output_matrix=output_matrix, y_max=y_max, formulation=formulation,
+        )
+        if solver_options is not None and not isinstance(solver_options, dict):
+            raise InvalidArgumentError(
+                "solver_options", "a dict of solver settings", type(solver_options).__name__
+            )
+        self.certificate_tol = check_positive(certificate_tol, "certificate_tol")
+        self.interpolation_tol = check_positive(interpolation_tol, "interpolation_tol", allow_zero=True)
+        self._base = CvxpyKothare(self.data, solver, solver_options)
+        n = self.data.n
+        base = self._base
+        # gamma_s = dt gamma in the delta formulations (see lmi.backend_clarabel).
+        self._gamma_scale = 1.0 if formulation == "standard" else self.data.dt
+        self._outer = cp.Parameter((n, n), symmetric=True)
+        extra = [self._outer - base.Qv >> 0]
+        self._nested = cp.Problem(cp.Minimize(base.gs), [*base.problem.constraints, *extra])
+
+    @property
+    def backend(self) -> str:
+        return self._base.name
+
+    # -- one design state ----------------------------------------------------------------
+    def solve(self, x: Any, outer: NestedEllipsoid | None = None) -> NestedEllipsoid:
+        """Solve at ``x`` (non-zero), nested inside ``outer`` when given.
+
+        The problem is solved at ``x / ||x||`` with the bounds (and ``Q_outer``) rescaled, as
+        in :class:`lmi.KothareProblem`. Failures come back as a status, never raised.
+        """
+        d = self.data
+        x = as_vector(x, "x", d.n)
+        s = float(np.linalg.norm(x))
+        if s == 0.0:
+            raise InvalidArgumentError("x", "a non-zero design state", "x = 0")
+        if outer is not None and (outer.Q is None or not outer.ok):
+            raise InvalidArgumentError("outer", "a certified NestedEllipsoid", f"status {outer.status!r}")
+        base = self._base
+        base.x.value = x / s
+        if base.inv_u is not None:
+            base.inv_u.value = s / float(d.u_max[0]) if d.input_constraint == "ellipsoid" else s / d.u_max
+        if base.inv_y is not None:
+            base.inv_y.value = s / d.y_max
+        problem = base.problem
+        if outer is not None:
+            assert outer.Q is not None
+            problem = self._nested
+            self._outer.value = 0.5 * (outer.Q + outer.Q.T) / s**2
+        start = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                # cvxpy warns on "optimal_inaccurate"; the status and the certificate record it.
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+                problem.solve(solver=base.solver, **base.options)
+        except cp.error.SolverError as err:
+            return NestedEllipsoid(
+                SOLVER_ERROR, x, np.nan, None, None, None, None, np.nan,
+                time.perf_counter() - start, str(err),
+            )
+        elapsed = time.perf_counter() - start
+        raw = str(problem.status)
+        status = CVXPY_STATUS_MAP.get(raw, SOLVER_ERROR)
+        if base.Qv.value is None or base.gs.value is None:
+            return NestedEllipsoid(status, x, np.nan, None, None, None, None, np.nan, elapsed, raw)
+        q_mat = 0.5 * (base.Qv.value + base.Qv.value.T) * s**2
+        y_mat = np.asarray(base.Yv.value) * s**2
+        gamma = float(base.gs.value) / self._gamma_scale * s**2
+        return self._finish(status, raw, x, gamma, q_mat, y_mat, outer, elapsed)
+
+    def _finish(
+        self, status: str, raw: str, x: np.ndarray, gamma: float, q_mat: np.ndarray,
+        y_mat: np.ndarray, outer: NestedEllipsoid | None, elapsed: float,
+    ) -> NestedEllipsoid:
+        tol = self.certificate_tol
+        cert = certify(self.data, x, gamma, q_mat, y_mat, tol=tol)
+        try:
+            f_mat = np.linalg.solve(q_mat.T, y_mat.T).T
+        except np.linalg.LinAlgError:
+            f_mat = None
+        nest = np.nan
+        if outer is not None:
+            assert outer.Q is not None
+            nest = nesting_margin(outer.Q, q_mat)
+        checks_ok = (
+            cert.ok and f_mat is not None and bool(np.all(np.isfinite(f_mat)))
+            and not nest < -tol
+        )
+        if status in (OPTIMAL, INACCURATE):
+            status = OPTIMAL if checks_ok else UNCERTIFIED
+        return NestedEllipsoid(status, x, gamma, q_mat, y_mat, f_mat, cert, nest, elapsed, raw)
+
+    # -- sequences -------------------------------------------------------------------------
+    def _table(
+        self, entries: list[NestedEllipsoid], start: float, failed: NestedEllipsoid | None = None,
+        reason: str = "complete", skipped: Sequence[tuple[int, float]] = (),
+    ) -> OfflineTable:
+        pairs = list(pairwise(entries))
+        margins = np.array([interpolation_margin(self.data, o.Q, i.F) for o, i in pairs])  # type: ignore[arg-type]
+        if failed is not None:
+            reason = f"design state {len(entries) + len(skipped)}: status {failed.status!r}"
+        return OfflineTable(
+            ellipsoids=tuple(entries), interpolation_margins=margins,
+            interpolable=margins > self.interpolation_tol,
+            design_time=time.perf_counter() - start, stop_reason=reason,
+            failed_status=None if failed is None else failed.status, skipped=tuple(skipped),
+        )
+
+    def design(self, states: Any) -> OfflineTable:
+        """The nested sequence at the given design states (outermost first).
+
+        A state that is not strictly inside the previous ellipsoid (level
+        ``x' Q_{i-1}^-1 x >= 1``, so no nested ellipsoid can contain it) is skipped and listed
+        in ``skipped``; the sequence stops at the first solve that is not certified.
+        """
+        pts = as_matrix(states, "states", (None, self.data.n))
+        if pts.shape[0] == 0:
+            raise InvalidArgumentError("states", "at least one design state", "an empty sequence")
+        norms = np.linalg.norm(pts, axis=1)
+        if np.any(norms == 0.0):
+            raise InvalidArgumentError(
+                "states", "non-zero design states", f"x = 0 at row {int(np.argmin(norms))}"
+            )
+        start = time.perf_counter()
+        entries: list[NestedEllipsoid] = []
+        skipped: list[tuple[int, float]] = []
+        for k, x in enumerate(pts):
+            outer = entries[-1] if entries else None
+            if outer is not None:
+                level = float(x @ np.linalg.solve(outer.Q, x))  # type: ignore[arg-type]
+                if not level < 1.0:
+                    skipped.append((k, level))
+                    continue
+            sol = self.solve(x, outer)
+            if not sol.ok:
+                return self._table(entries, start, sol, skipped=skipped)
+            entries.append(sol)
+        return self._table(entries, start, skipped=skipped)
+
+    def design_ray(self, x0: Any, n_ellipsoids: int, shrink: float = 0.5) -> OfflineTable:
+        """Design states geometrically spaced along the ray of ``x0``: ``x_i = shrink^(i-1) x0``."""
+        x0 = as_vector(x0, "x0", self.data.n)
+        count = _check_count(n_ellipsoids)
+        shrink = _check_shrink(shrink)
+        return self.design(np.array([x0 * shrink**i for i in range(count)]))
+
+    def design_trajectory(
+        self, x0: Any, n_ellipsoids: int, shrink: float = 0.5, *, A: Any = None, B: Any = None,
+        max_steps: int = 100_000,
+    ) -> OfflineTable:
+        """Design states along a closed loop: ``x_{i+1}`` is the first state of the loop under
+        ``F_i`` with ``x' Q_i^-1 x <= shrink^2``.
+
+        The loop runs on the model ``(A, B)`` (default: the mean of the vertices). Since
+        ``E_i`` is invariant under ``F_i``, every such state is strictly inside ``E_i``.
+        """
+        d = self.data
+        x = as_vector(x0, "x0", d.n)
+        count = _check_count(n_ellipsoids)
+        level_next = _check_shrink(shrink) ** 2
+        a_sim = d.A.mean(axis=0) if A is None else as_matrix(A, "A", (d.n, d.n))
+        b_sim = d.B.mean(axis=0) if B is None else as_matrix(B, "B", (d.n, d.m))
+        if not isinstance(max_steps, int | np.integer) or max_steps < 1:
+            raise InvalidArgumentError("max_steps", "a positive integer", repr(max_steps))
+        start = time.perf_counter()
+        if float(np.linalg.norm(x)) == 0.0:
+            raise InvalidArgumentError("x0", "a non-zero design state", "x0 = 0")
+        entries: list[NestedEllipsoid] = []
+        steps = 0
+        while True:
+            sol = self.solve(x, entries[-1] if entries else None)
+            if not sol.ok:
+                return self._table(entries, start, sol)
+            entries.append(sol)
+            if len(entries) == count:
+                return self._table(entries, start)
+            assert sol.Q is not None and sol.F is not None
+            q_inv = np.linalg.inv(sol.Q)
+            closed = a_sim + b_sim @ sol.F
+            while float(x @ q_inv @ x) > level_next:
+                if steps == max_steps:
+                    return self._table(entries, start, reason=f"max_steps={max_steps} reached")
+                x = closed @ x
+                steps += 1
+
+
+def _check_count(n_ellipsoids: Any) -> int:
+    if isinstance(n_ellipsoids, bool) or not isinstance(n_ellipsoids, int | np.integer) or n_ellipsoids < 1:
+        raise InvalidArgumentError("n_ellipsoids", "a positive integer", repr(n_ellipsoids))
+    return int(n_ellipsoids)
+
+
+def _check_shrink(shrink: Any) -> float:
+    value = check_positive(shrink, "shrink")
+    if not value < 1.0:
+        raise InvalidArgumentError("shrink", "a number in (0, 1)", repr(shrink))
+    return value

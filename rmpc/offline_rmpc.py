@@ -1,0 +1,290 @@
+"""Off-line robust MPC (Wan & Kothare 2003): nested invariant ellipsoids looked up on-line.
+
+Reference: Z. Wan, M. V. Kothare, "An efficient off-line formulation of robust model predictive
+control using linear matrix inequalities", Automatica 39(5), 837-846, 2003.
+
+Off-line, :class:`lmi.offline.NestedKothareProblem` computes ellipsoids
+``E_1 ⊇ E_2 ⊇ ... ⊇ E_N`` (``E_i = {x : x' Q_i^-1 x <= 1}``) with gains ``F_i``. On-line, the
+controller finds the smallest ``E_i`` that contains ``x`` and applies ``u = F x`` with
+``F = alpha F_i + (1 - alpha) F_{i+1}``, ``alpha`` solving
+``x' (alpha Q_i^-1 + (1 - alpha) Q_{i+1}^-1) x = 1`` in closed form. See
+``docs/offline_rmpc.rst`` for what is guaranteed.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Literal
+
+import numpy as np
+
+from lmi.offline import NestedKothareProblem, OfflineTable
+from lmi.status import INFEASIBLE, OPTIMAL
+from models import PolytopicModel
+from rmpc.controller import StepInfo
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
+
+__all__ = ["OUTSIDE", "OfflineRMPC"]
+
+#: Status of a step whose state lies outside the largest ellipsoid (``F_1`` applied, no guarantee).
+OUTSIDE = "outside"
+#: A state with ``x' Q_i^-1 x <= 1 + LEVEL_TOL`` counts as inside ``E_i``. Each design state lies on
+#: the boundary of its own ellipsoid (the LMI ``[[1, x'], [x, Q]] >= 0`` is tight at the optimum),
+#: and the solver's accuracy (1e-8) puts it at levels up to ``1 + 9e-8`` (measured on paper P's
+#: satellite). At level ``1 + LEVEL_TOL`` the input bound holds to a factor ``1 + 5e-7``.
+LEVEL_TOL = 1e-6
+_ONE = 1.0 + LEVEL_TOL
+
+
+class OfflineRMPC:
+    """Off-line robust MPC over a polytopic model (Wan & Kothare 2003), the ``step(x)`` protocol.
+
+    Parameters
+    ----------
+    plant : PolytopicModel
+        The polytope ``Co{[A_j B_j]}`` of discrete-time models.
+    Q, R, u_max, input_constraint
+        As :class:`rmpc.RMPC` (``input_constraint="auto"``: ``"ellipsoid"`` when ``u_max`` is
+        given, none otherwise).
+    output_matrix, y_max : array_like, optional
+        Output constraints ``|(C x(k+i))_r| <= y_max_r``, as :class:`rmpc.RMPC`.
+    x_design : array_like, optional
+        One state ``(n,)``: the design states are generated from it along ``path``. Several
+        states ``(k, n)``: used as given, outermost first (states not strictly inside the
+        previous ellipsoid are skipped and listed in ``table.skipped``). ``None`` (default):
+        the table is designed from the first state passed to :meth:`step`, and designed anew
+        whenever a run (after :meth:`reset`) starts outside its largest ellipsoid.
+    n_ellipsoids : int
+        Number of ellipsoids generated along ``path`` (default 15).
+    shrink : float
+        In ``(0, 1)``. ``"ray"``: ``x_{i+1} = shrink x_i``. ``"trajectory"``: ``x_{i+1}`` is
+        the first state of the nominal closed loop under ``F_i`` with
+        ``x' Q_i^-1 x <= shrink^2``. Default 0.5.
+    path : {"ray", "trajectory"}
+        How design states are generated from one state: geometrically spaced along its ray
+        (default) or along the closed loop of the nominal model.
+    interpolate : bool
+        Interpolate between neighbouring gains (default). Between neighbours where Wan &
+        Kothare's condition (18) fails, the outer gain is applied instead (recorded in
+        ``table.interpolable``).
+    solver, solver_options, formulation, certificate_tol
+        Passed to :class:`lmi.offline.NestedKothareProblem`.
+
+    Attributes
+    ----------
+    table : OfflineTable or None
+        The designed sequence (certified entries only).
+    last : StepInfo or None
+        The last step: ``status`` (``"optimal"`` inside ``E_1``, ``"outside"`` beyond it, or the
+        design's failure word when no ellipsoid could be designed), ``solve_time`` (the lookup
+        time, plus the design time on a step that designed the table), ``gamma`` (the stored
+        bound ``gamma_i`` of the ellipsoid in use) and ``extra = {"index": i, "alpha": alpha}``
+        (``i`` counted from 0; ``alpha = 1`` applies ``F_i`` alone).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import RigidSatellite
+    >>> from rmpc import OfflineRMPC
+    >>> sat = RigidSatellite.paper_p()
+    >>> x0 = sat.initial_state()
+    >>> plant = sat.polytope(x0, dt=0.01, spread=0.3, mode="scalar")
+    >>> ctrl = OfflineRMPC(plant, Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]), R=np.eye(3), u_max=1.0,
+    ...                    x_design=x0, n_ellipsoids=4)
+    >>> ctrl.table.n_ellipsoids
+    4
+    >>> u = ctrl.step(x0)
+    >>> ctrl.last.status, ctrl.last.extra["index"], bool(np.linalg.norm(u) <= 1.0)
+    ('optimal', 0, True)
+    """
+
+    def __init__(
+        self,
+        plant: PolytopicModel,
+        Q: Any,
+        R: Any,
+        u_max: Any = None,
+        input_constraint: Literal["ellipsoid", "peak"] | str | None = "auto",
+        *,
+        output_matrix: Any = None,
+        y_max: Any = None,
+        x_design: Any = None,
+        n_ellipsoids: int = 15,
+        shrink: float = 0.5,
+        path: Literal["ray", "trajectory"] = "ray",
+        interpolate: bool = True,
+        solver: str = "CLARABEL",
+        solver_options: dict[str, Any] | None = None,
+        formulation: Literal["delta", "delta_shared", "standard"] = "delta_shared",
+        certificate_tol: float = 1e-7,
+    ) -> None:
+        if not isinstance(plant, PolytopicModel):
+            raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
+        if input_constraint == "auto":
+            input_constraint = None if u_max is None else "ellipsoid"
+        count_ok = isinstance(n_ellipsoids, int | np.integer) and not isinstance(n_ellipsoids, bool)
+        if not count_ok or n_ellipsoids < 1:
+            raise InvalidArgumentError("n_ellipsoids", "a positive integer", repr(n_ellipsoids))
+        if not check_positive(shrink, "shrink") < 1.0:
+            raise InvalidArgumentError("shrink", "a number in (0, 1)", repr(shrink))
+        _check_bool(interpolate, "interpolate")
+        self.path = check_choice(path, "path", ("ray", "trajectory"))
+        self.plant = plant
+        self.problem = NestedKothareProblem(
+            plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
+            output_matrix=output_matrix, y_max=y_max, solver=solver, solver_options=solver_options,
+            formulation=formulation, certificate_tol=certificate_tol,
+        )
+        self.n_ellipsoids = int(n_ellipsoids)
+        self.shrink = float(shrink)
+        self._interpolate = interpolate
+        self.dt = plant.dt
+        self._n, self._m = plant.n_states, plant.n_inputs
+        self.last: StepInfo | None = None
+        self.table: OfflineTable | None = None
+        self._auto = x_design is None
+        self._fresh = True
+        self._count = 0
+        if x_design is not None:
+            self._design(x_design)
+
+    @property
+    def input_constraint(self) -> str | None:
+        return self.problem.data.input_constraint
+
+    @property
+    def interpolate(self) -> bool:
+        """Whether neighbouring gains are interpolated (may be switched on a designed table)."""
+        return self._interpolate
+
+    @interpolate.setter
+    def interpolate(self, value: bool) -> None:
+        self._interpolate = _check_bool(value, "interpolate")
+        if self.table is not None:
+            self._store(self.table)
+
+    # -- off-line ----------------------------------------------------------------------------
+    def design(self, x_design: Any) -> OfflineTable:
+        """Compute (and store) the table from one state (along ``path``) or from ``(k, n)`` states.
+
+        A table designed here is kept until the next call (no automatic redesign).
+        """
+        table = self._design(x_design)
+        self._auto = False
+        return table
+
+    def _design(self, x_design: Any) -> OfflineTable:
+        arr = np.asarray(x_design, dtype=float) if not isinstance(x_design, str) else None
+        if arr is None or arr.ndim not in (1, 2):
+            raise InvalidArgumentError(
+                "x_design", f"one state ({self._n},) or a sequence of states (k, {self._n})", repr(x_design)
+            )
+        if arr.ndim == 2:
+            states = as_matrix(arr, "x_design", (None, self._n))
+            zero = np.flatnonzero(~states.any(axis=1))
+            if states.shape[0] == 0 or zero.size:
+                found = "no states" if states.shape[0] == 0 else f"x = 0 at row {int(zero[0])}"
+                raise InvalidArgumentError("x_design", "one or more non-zero states", found)
+            table = self.problem.design(states)
+        else:
+            x0 = as_vector(arr, "x_design", self._n)
+            if not np.any(x0):
+                raise InvalidArgumentError("x_design", "a non-zero state", "x_design = 0")
+            if self.path == "ray":
+                table = self.problem.design_ray(x0, self.n_ellipsoids, self.shrink)
+            else:
+                a_nom, b_nom = self.plant.nominal
+                table = self.problem.design_trajectory(
+                    x0, self.n_ellipsoids, self.shrink, A=a_nom, B=b_nom
+                )
+        self._store(table)
+        return table
+
+    def _store(self, table: OfflineTable) -> None:
+        """Precompute the lookup: one matrix whose product with ``x`` gives every level and gain."""
+        self.table = table
+        count, n = table.n_ellipsoids, self._n
+        self._count = count
+        if count == 0:
+            return
+        # x' Q_i^-1 x = ||C_i' x||^2 with C_i C_i' = Q_i^-1 (Cholesky).
+        chol = [np.linalg.cholesky(np.linalg.inv(e.Q)).T for e in table.ellipsoids]  # type: ignore[arg-type]
+        gains = [e.F for e in table.ellipsoids]
+        self._lookup = np.ascontiguousarray(np.vstack([*chol, *gains]))  # type: ignore[list-item]
+        self._split = count * n
+        self._gammas = table.gammas.tolist()
+        self._interp = (table.interpolable & self._interpolate).tolist() if count > 1 else []
+
+    def reset(self) -> None:
+        """Forget the last step; the table is kept (see ``x_design`` for when it is redesigned)."""
+        self.last = None
+        self._fresh = True
+
+    # -- on-line -----------------------------------------------------------------------------
+    def step(self, x: Any) -> np.ndarray:
+        """Look up the gain for ``x`` and return ``u = F x``."""
+        start = time.perf_counter()
+        z = np.asarray(x, dtype=float) if not isinstance(x, str) else None
+        if z is None or z.shape != (self._n,) or not np.isfinite(z).all():
+            z = as_vector(x, "x", self._n)  # raises naming the argument, or accepts a column
+        if self._fresh:
+            return self._first_step(z, start)
+        if self._count == 0:
+            return self._no_table(start)
+        y = self._lookup @ z
+        lev = y[: self._split]
+        lev = (lev * lev).reshape(self._count, self._n).sum(axis=1)
+        k = int(lev.searchsorted(_ONE, side="right"))  # how many (nested) ellipsoids hold z
+        m, base = self._m, self._split
+        if k == 0:
+            self.last = StepInfo(status=OUTSIDE, solve_time=time.perf_counter() - start, fallback=True,
+                                 extra={"index": 0, "alpha": 1.0, "level": float(lev[0])})
+            return y[base : base + m]
+        i = k - 1
+        alpha = 1.0
+        u = y[base + i * m : base + k * m]
+        if k < self._count and self._interp[i]:
+            a, b = lev[i], lev[k]
+            alpha = min(float((b - 1.0) / (b - a)), 1.0)
+            u = alpha * u + (1.0 - alpha) * y[base + k * m : base + (k + 1) * m]
+        self.last = StepInfo(status=OPTIMAL, solve_time=time.perf_counter() - start, gamma=self._gammas[i],
+                             extra={"index": i, "alpha": alpha})
+        return u
+
+    def _no_table(self, start: float) -> np.ndarray:
+        """No certified ellipsoid: ``u = 0`` and the design's failure as the status."""
+        table = self.table
+        failure = (table.failed_status if table is not None else None) or INFEASIBLE
+        reason = table.stop_reason if table is not None else "not designed"
+        self.last = StepInfo(status=failure, solve_time=time.perf_counter() - start, fallback=True,
+                             extra={"index": None, "alpha": None, "stop_reason": reason})
+        return np.zeros(self._m)
+
+    def _first_step(self, z: np.ndarray, start: float) -> np.ndarray:
+        """The first step of a run: with ``x_design=None``, design from ``z`` unless the table holds it."""
+        if self._auto and not np.any(z) and self.table is None:
+            # Nothing to design from at the origin; u = 0 is exact there. Design at the next state.
+            self.last = StepInfo(status=OPTIMAL, solve_time=time.perf_counter() - start,
+                                 extra={"index": None, "alpha": None})
+            return np.zeros(self._m)
+        self._fresh = False
+        design_time = 0.0
+        inside = self._count > 0 and float(np.sum((self._lookup[: self._n] @ z) ** 2)) <= _ONE
+        if self._auto and not inside:
+            t0 = time.perf_counter()
+            self._design(z)
+            design_time = time.perf_counter() - t0
+        u = self.step(z)
+        assert self.last is not None
+        self.last = StepInfo(
+            status=self.last.status, solve_time=time.perf_counter() - start, gamma=self.last.gamma,
+            fallback=self.last.fallback, extra={**self.last.extra, "design_time": design_time},
+        )
+        return u
+
+
+def _check_bool(value: Any, name: str) -> bool:
+    if not isinstance(value, bool):
+        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
+    return value
