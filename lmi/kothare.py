@@ -109,8 +109,10 @@ class KothareProblem:
     output_matrix, y_max : array_like, optional
         Output constraints ``|(C x(k+i))_r| <= y_max_r`` for ``i >= 1`` (Kothare 1996, sec. 3.2).
     backend : str
-        ``"clarabel"`` (Clarabel's own API, data built once; default) or ``"cvxpy"`` with
-        ``solver`` naming any installed cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
+        ``"clarabel"`` (Clarabel's own API, data built once; default), ``"ipm"``
+        (experimental: the toolkit's own dense interior-point method :mod:`lmi.ipm` on the same
+        conic data, :mod:`lmi.backend_ipm`) or ``"cvxpy"`` with ``solver`` naming any installed
+        cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
     solver : str, optional
         The cvxpy solver for ``backend="cvxpy"`` (default ``"CLARABEL"``).
     solver_options : dict, optional
