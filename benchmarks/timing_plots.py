@@ -1,0 +1,74 @@
+"""The figure of the timing report: per-step time distributions, one panel per problem.
+
+Box plots on a log axis (the paths span microseconds to seconds): the box is the interquartile
+range, the line the median, the whiskers reach the 5th and 95th percentiles, and the dots beyond
+them are single steps. Drawn with matplotlib's Agg canvas directly, so no global backend is set.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["plot_distributions"]
+
+_PROBLEMS = ("RMPC", "OfflineRMPC", "GIPC")
+
+
+_COLOURS = {1: "#bbbbbb", 2: "#8fb8de", 4: "#f2b880", 8: "#9bd39b"}
+
+
+def _label(rec: dict[str, Any]) -> str:
+    if rec["problem"] == "GIPC":
+        return rec["backend"]
+    return f"{rec['backend']} / {rec['formulation']} / {rec['vertices']}v"
+
+
+def plot_distributions(report: dict[str, Any], samples: dict[str, np.ndarray], path: Path) -> Path:
+    """Write a PNG of the per-step times of every record of ``report`` (``samples`` by record key)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    groups = []
+    for problem in _PROBLEMS:
+        recs = [r for r in report["records"] if r["problem"] == problem]
+        data, labels, colours = [], [], []
+        for rec in recs:
+            key = f"{rec['problem']}|{rec['backend']}|{rec['formulation']}|{rec['vertices']}"
+            times = np.asarray(samples.get(key, []), dtype=float)
+            times = times[np.isfinite(times) & (times > 0)]
+            if times.size:
+                data.append(times)
+                labels.append(_label(rec))
+                colours.append(_COLOURS.get(rec["vertices"], "#dddddd"))
+        if data:
+            groups.append((problem, data, labels, colours))
+    width = max(8.0, 0.55 * max((len(g[1]) for g in groups), default=1) + 2.0)
+    fig = Figure(figsize=(width, 3.6 * max(len(groups), 1)), layout="constrained")
+    FigureCanvasAgg(fig)
+    if not groups:
+        ax = fig.add_subplot()
+        ax.text(0.5, 0.5, "no timing samples", ha="center", va="center")
+        ax.set_axis_off()
+    for i, (problem, data, labels, colours) in enumerate(groups):
+        ax = fig.add_subplot(len(groups), 1, i + 1)
+        boxes = ax.boxplot(data, whis=(5, 95), widths=0.6, patch_artist=True,
+                           flierprops={"markersize": 2, "alpha": 0.5}, medianprops={"color": "black"})
+        for patch, colour in zip(boxes["boxes"], colours, strict=True):
+            patch.set_facecolor(colour)
+        ax.set_xticks(range(1, len(labels) + 1), labels, rotation=40, ha="right", fontsize=7,
+                      rotation_mode="anchor")
+        ax.set_yscale("log")
+        ax.set_ylabel("time per step (s)")
+        note = "colour: vertex count (blue 2, orange 4, green 8)" if problem != "GIPC" else "nominal model"
+        ax.set_title(f"{problem}: per-step time (box: quartiles, whiskers: p5-p95; {note})", fontsize=10)
+        ax.grid(True, which="both", axis="y", alpha=0.3)
+    m = report.get("machine", {})
+    fig.suptitle(
+        f"{m.get('platform', '')}, {m.get('cpu_count', '?')} CPUs, load {m.get('load_average_start')} "
+        f"-> {m.get('load_average_end')}", fontsize=8,
+    )
+    fig.savefig(path, dpi=110)
+    return Path(path)

@@ -1,0 +1,134 @@
+"""``rmpc timing``: a quick run writes timing.json (API keys on every record), timing.md and the
+figure; bad option values raise errors naming the option (the CLI's exit status 2)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+import numpy as np
+import pytest
+
+from benchmarks.timing import VERTEX_COUNTS, add_timing_parser, config_from_args, polytope
+from toolkit_common.errors import InvalidArgumentError
+
+API_KEYS = ("problem", "formulation", "backend", "vertices", "p50_s", "p95_s", "max_s", "status_counts",
+            "max_rel_err")
+
+
+def _parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="rmpc")
+    add_timing_parser(parser.add_subparsers(dest="command", required=True))
+    return parser.parse_args(["timing", *argv])
+
+
+def test_quick_run_writes_the_report(tmp_path, capsys):
+    out = tmp_path / "timing"
+    # 2 RMPC states on the 2-vertex polytope (every path), 5 ellipsoids, 50 GIPC QPs: ~10 s.
+    args = _parse(["--out", str(out), "--quick", "--steps", "2", "--vertices", "2", "--no-progress"])
+    assert args.func(args) == 0
+    assert "rebuild-per-step / fast path" in capsys.readouterr().out
+
+    report = json.loads((out / "timing.json").read_text())
+    assert {"machine", "versions", "records"} <= set(report)
+    assert report["versions"]["clarabel"] != "not installed"
+    assert report["machine"]["cpu_count"] >= 1
+    assert len(report["machine"]["load_average_start"]) == 3
+    records = report["records"]
+    for rec in records:
+        missing = [k for k in API_KEYS if k not in rec]
+        assert not missing, (missing, rec)
+        assert rec["problem"] in ("RMPC", "OfflineRMPC", "GIPC")
+        assert 0 < rec["p50_s"] <= rec["p95_s"] <= rec["max_s"]
+        assert sum(rec["status_counts"].values()) == rec["steps"] > 0
+        assert rec["max_rel_err"] is None or rec["max_rel_err"] >= 0.0
+    seen = {(r["problem"], r["backend"], r["formulation"]) for r in records}
+    rmpc_paths = [("clarabel", "delta_shared"), ("clarabel", "delta"), ("clarabel", "standard"),
+                  ("ipm", "delta_shared"), ("cvxpy:CLARABEL", "delta"), ("cvxpy-rebuild:CLARABEL", "delta"),
+                  ("cvxpy:SCS", "delta")]
+    for backend, formulation in rmpc_paths:
+        assert ("RMPC", backend, formulation) in seen
+    assert {r["backend"] for r in records if r["problem"] == "GIPC"} == {
+        "proxqp", "osqp", "clarabel", "cvxpy:CLARABEL"}
+    assert {r["formulation"] for r in records if r["problem"] == "OfflineRMPC"} == {
+        "lookup", "lookup+interpolation"}
+    assert {r["vertices"] for r in records if r["problem"] != "GIPC"} == {2}
+
+    # Accuracy: the default path and the QP back-ends agree with their high-accuracy references.
+    fast = next(r for r in records if r["problem"] == "RMPC" and r["backend"] == "clarabel"
+                and r["formulation"] == "delta_shared")
+    assert fast["status_counts"].get("optimal", 0) >= 1
+    assert fast["max_rel_err"] < 1e-6 and fast["min_margin"] > -1e-7
+    for rec in records:
+        if rec["problem"] == "GIPC":
+            assert rec["status_counts"] == {"optimal": rec["steps"]}
+            assert rec["max_rel_err"] < 1e-6
+        if rec["problem"] == "OfflineRMPC":
+            assert rec["max_rel_err"] < 1e-5 and rec["design_time_s"] > 0
+    (ratio,) = report["rebuild_over_fast"]
+    assert ratio["vertices"] == 2 and ratio["rebuild_over_fast"] > 0
+    assert math.isfinite(ratio["rebuild_p50_s"])
+
+    md = (out / "timing.md").read_text()
+    for text in ("## Machine", "load average", "| cvxpy |", "## RMPC", "rebuild / fast", "## OfflineRMPC",
+                 "## GIPC", "timing.png"):
+        assert text in md, text
+    png = (out / "timing.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    samples = np.load(out / "timing_samples.npz")
+    assert len(samples.files) == len(records)
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["--steps", "0"], "--steps"),
+        (["--steps", "many"], "--steps"),
+        (["--vertices", "3"], "--vertices"),
+        (["--vertices", "two"], "--vertices"),
+        (["--problems", "LQR"], "--problems"),
+        (["--rebuild-steps", "0"], "--rebuild-steps"),
+        (["--scs-steps", "-1"], "--scs-steps"),
+    ],
+)
+def test_bad_values_name_the_option(tmp_path, argv, option):
+    args = _parse(["--out", str(tmp_path / "t"), *argv])
+    with pytest.raises(InvalidArgumentError) as err:
+        args.func(args)
+    assert err.value.argument == option
+    assert option in str(err.value)
+    assert not (tmp_path / "t").exists()  # nothing measured, nothing written
+
+
+def test_out_must_not_be_a_file(tmp_path):
+    target = tmp_path / "a_file"
+    target.write_text("x")
+    args = _parse(["--out", str(target), "--quick"])
+    with pytest.raises(InvalidArgumentError) as err:
+        args.func(args)
+    assert err.value.argument == "--out"
+
+
+def test_options_and_defaults(tmp_path):
+    cfg = config_from_args(_parse(["--out", str(tmp_path)]))
+    assert cfg.vertices == VERTEX_COUNTS and cfg.problems == ("RMPC", "OfflineRMPC", "GIPC")
+    assert cfg.steps == 40 and not cfg.quick
+    cfg = config_from_args(_parse(["--out", str(tmp_path), "--quick", "--vertices", "8", "2", "8",
+                                   "--problems", "gipc", "RMPC"]))
+    assert cfg.vertices == (2, 8) and cfg.problems == ("RMPC", "GIPC") and cfg.steps == 3
+    with pytest.raises(SystemExit):  # --out is required (argparse: exit status 2)
+        _parse([])
+
+
+@pytest.mark.parametrize("count", VERTEX_COUNTS)
+def test_polytopes_hold_the_nominal_plant(count):
+    poly = polytope(count)
+    assert poly.n_vertices == count
+    # The nominal B (inertia J0) is a convex combination of the vertices' B: the corners in 1/J
+    # average to 1/J0 only approximately, so check containment through the rate rows' diagonal.
+    b_rates = np.array([np.diag(poly.B[j][3:]) for j in range(count)])
+    nominal = np.diag(poly.nominal[1][3:])
+    assert np.all(b_rates.min(axis=0) <= nominal) and np.all(nominal <= b_rates.max(axis=0))
+    if count == 4:  # Ixx = Iyy scaled together
+        assert np.allclose(b_rates[:, 0], b_rates[:, 1])
