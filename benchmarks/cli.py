@@ -22,21 +22,185 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     plant = sat.linear_model(x0, PAPER_P_SAMPLE_TIME)
     q = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
     ctrl = LQR(plant, Q=q, R=np.eye(3))
-    traj = simulate(
-        ctrl, sat, x0, duration=args.duration, dt=PAPER_P_SAMPLE_TIME, limiter=TorqueLimiter(1.0)
-    )
+    traj = simulate(ctrl, sat, x0, duration=args.duration, dt=PAPER_P_SAMPLE_TIME, limiter=TorqueLimiter(1.0))
     err = np.abs(traj.x[-1, :3])
     print("LQR on the nonlinear satellite of paper P (limiter +-1 N m)")
     print(f"  initial attitude (deg): {np.round(np.degrees(x0[:3]), 3).tolist()}")
-    print(f"  final attitude after {args.duration:g} s (deg): "
-          f"{np.round(np.degrees(traj.x[-1, :3]), 5).tolist()}")
+    print(
+        f"  final attitude after {args.duration:g} s (deg): "
+        f"{np.round(np.degrees(traj.x[-1, :3]), 5).tolist()}"
+    )
     print(f"  max |u| applied (N m): {np.abs(traj.u_applied).max():.4f}")
     print(f"  sum |e(k)| per axis (rad): {np.round(np.abs(traj.x[:, :3]).sum(axis=0), 3).tolist()}")
     return 0 if np.all(err < 1e-2) else 1
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``rmpc`` command."""
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, found {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, found {text!r}")
+    return value
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, found {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a number > 0, found {text!r}")
+    return value
+
+
+def _experiments(text: str) -> list[str]:
+    return [part.strip() for part in text.split(",") if part.strip()]
+
+
+def _cmd_bench_paper(args: argparse.Namespace) -> int:
+    from benchmarks.defaults import SHORT_DURATION_SCALE
+    from benchmarks.paper import run_paper
+
+    scale = SHORT_DURATION_SCALE if args.short else args.duration_scale
+    outcome = run_paper(
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        duration_scale=scale,
+        experiments=args.experiments,
+        progress=None if not args.no_progress else False,
+    )
+    ex = outcome.execution
+    done, failed = len(outcome.records), len(outcome.failures)
+    print(
+        f"rmpc bench paper: {done} cases done, {failed} failed in {outcome.wall_time_s:.1f} s; "
+        f"results in {args.out}/results.md"
+    )
+    for failure in outcome.failures:
+        print(f"  failed: {failure['key']}: {failure['error']}", file=sys.stderr)
+    if ex is not None and ex.interrupted:
+        print("rmpc: interrupted; the files hold the cases that finished", file=sys.stderr)
+        return 130
+    return 1 if failed or (ex is not None and ex.unfinished) else 0
+
+
+def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
+    from benchmarks.sweep import run_sweep
+
+    outcome = run_sweep(
+        args.config,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        retry_errors=args.retry_errors,
+        progress=None if not args.no_progress else False,
+        argv=argv,
+    )
+    ex = outcome.execution
+    print(
+        f"rmpc bench sweep {outcome.name}: {outcome.total} cases, {outcome.skipped} finished before, "
+        f"{outcome.ran} run now ({outcome.failed} failed) in {outcome.wall_time_s:.1f} s; "
+        f"results in {args.out}/results.md"
+    )
+    if ex is not None and ex.interrupted:
+        print(
+            f"rmpc: interrupted; {len(ex.unfinished)} cases not run; re-run the same command to resume",
+            file=sys.stderr,
+        )
+        return 130
+    if ex is not None and ex.unfinished:
+        print(
+            f"rmpc: {ex.lost_reason}; {len(ex.unfinished)} cases not run; re-run the same command to resume",
+            file=sys.stderr,
+        )
+        return 1
+    if outcome.stored_errors:
+        print(
+            f"rmpc: {outcome.stored_errors} cases failed (listed in {args.out}/results.md and errors.json)",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+def _add_bench(sub: argparse._SubParsersAction) -> None:
+    bench = sub.add_parser(
+        "bench",
+        help="benchmark suites and sweeps",
+        description="Run the benchmark suite of paper P or a sweep of scenarios.",
+    )
+    bsub = bench.add_subparsers(dest="bench_command", required=True, metavar="{paper,sweep}")
+    workers_help = "worker processes on this machine (default: one per CPU; 0: run in this process)"
+    paper = bsub.add_parser(
+        "paper",
+        help="experiments E1-E6 of paper P",
+        description="Run E1-E6 of paper P (RMPC, GIPC, CRMPC; linear and nonlinear satellite) and write "
+        "results.json, results.md (tables and every setting chosen), results.csv, results.tex, "
+        "results_table.json, run.json, figures/*.png and traces/*.npz into DIR. Exit status: 0 all done, "
+        "1 some cases failed, 2 bad input, 130 interrupted.",
+    )
+    paper.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    paper.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
+    paper.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run on a Dask scheduler instead")
+    length = paper.add_mutually_exclusive_group()
+    length.add_argument(
+        "--duration-scale",
+        type=_positive,
+        default=1.0,
+        metavar="F",
+        help="multiply every duration and the disturbance time by F (default 1)",
+    )
+    length.add_argument(
+        "--short",
+        action="store_true",
+        help="short runs (duration scale 0.075: 2.25 s instead of 30 s) to check the set-up",
+    )
+    paper.add_argument(
+        "--experiments",
+        type=_experiments,
+        default=None,
+        metavar="E1,E2,...",
+        help="run only these experiments",
+    )
+    paper.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    paper.set_defaults(func=_cmd_bench_paper)
+
+    sweep = bsub.add_parser(
+        "sweep",
+        help="a sweep of scenarios from a TOML file (resumable)",
+        description="Run the cases of a sweep file (see benchmarks/sweeps/) and store each one in "
+        "DIR/sweep.sqlite as it finishes; re-running skips the stored cases. Writes results.json, "
+        "results.md, results.csv, results.tex, results_table.json and errors.json from the store. "
+        "Exit status: 0 all done, 1 some cases failed or did not run, 2 bad input, 130 interrupted. "
+        "With --scheduler the Dask workers need this toolkit installed.",
+    )
+    sweep.add_argument(
+        "--config",
+        required=True,
+        metavar="FILE",
+        help="the sweep TOML file, or the name of a shipped one (smoke, uncertainty, ...)",
+    )
+    sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (holds the store)")
+    sweep.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
+    sweep.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="a Dask scheduler (tcp://host:port) to run the cases on instead of local workers",
+    )
+    sweep.add_argument("--retry-errors", action="store_true", help="run again the cases stored with an error")
+    sweep.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    sweep.set_defaults(func=_cmd_bench_sweep)
+
+
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``rmpc`` command.
+
+    ``argv`` (the arguments to be parsed) lets the parser skip importing the heavy timing module
+    unless the command is ``timing``.
+    """
     parser = argparse.ArgumentParser(
         prog="rmpc", description="Robust MPC for satellite attitude control: runs and benchmarks."
     )
@@ -44,18 +208,45 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="a closed-loop LQR run on the nonlinear satellite")
     demo.add_argument("--duration", type=float, default=30.0, help="simulated time in s")
     demo.set_defaults(func=_cmd_demo)
+    _add_bench(sub)
+    command = next((a for a in (argv or []) if not a.startswith("-")), None)
+    if argv is None or command == "timing":
+        _add_timing(sub)
+    else:  # listed in `rmpc --help` without importing the solvers it times
+        sub.add_parser("timing", help="the solver timing report (timing.json, timing.md, timing.png)")
     return parser
 
 
+def _add_timing(sub: argparse._SubParsersAction) -> None:
+    """``rmpc timing --out DIR`` (the solver timing report of API.md), owned by :mod:`benchmarks.timing`."""
+    try:
+        from benchmarks.timing import add_timing_parser
+    except ModuleNotFoundError as err:
+        if err.name != "benchmarks.timing":
+            raise
+        return  # a checkout without the timing report: the other commands still work
+    add_timing_parser(sub)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit status (2 on bad usage or bad input)."""
-    parser = build_parser()
+    """Entry point; returns the exit status (2 on bad usage or bad input, 130 on interrupt)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:
+        if args.func is _cmd_bench_sweep:
+            return int(_cmd_bench_sweep(args, argv))
         return int(args.func(args))
     except ToolkitError as err:
-        print(f"rmpc: error: {err}", file=sys.stderr)
+        print(f"rmpc: error: {err}".replace("\n", " "), file=sys.stderr)
         return 2
+    except OSError as err:
+        where = err.filename if err.filename else "output"
+        print(f"rmpc: error: {where}: {err.strerror or err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("rmpc: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,232 @@
+"""The controller registry of the benchmarks: names to factories, and their settings.
+
+Each factory takes the controller's polytope, the scenario and the effective settings (the
+defaults of :data:`benchmarks.defaults.CONTROLLER_DEFAULTS` updated by the scenario's
+``settings``) and returns the controller. How saturation is handled:
+
+- ``"constraint"``: the controller's own constraint (RMPC and OfflineRMPC: the input
+  ellipsoid ``||u||_2 <= u_max`` or, with ``input_constraint = "peak"``, ``|u_j| <= u_max``;
+  GIPC: ``|u| <= u_max`` and ``|du| <= du_max``; CRMPC: the inner RMPC's bound and a limiter,
+  since its adaptive term can exceed it). LQR has no constraint and refuses this mode.
+- ``"limiter"``: no constraint in the controller and a per-axis clip at ``u_max`` in the loop.
+- ``"none"``: neither.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from benchmarks.defaults import CONTROLLER_DEFAULTS, SETTING_CHOICES
+from toolkit_common.errors import ConfigError
+
+__all__ = ["CONTROLLERS", "BuiltController", "build_controller", "check_setting", "effective_settings"]
+
+
+@dataclass(frozen=True)
+class BuiltController:
+    """A controller ready for :func:`rmpc.simulate` and whether it needs a limiter in the loop."""
+
+    controller: Any
+    needs_limiter: bool
+
+
+def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    return np.diag(settings["Q_diag"]), np.diag(settings["R_diag"])
+
+
+def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc.robust_mpc import RMPC
+
+    q, r = _weights(s)
+    constrained = scenario.saturation == "constraint"
+    ctrl = RMPC(
+        poly,
+        q,
+        r,
+        u_max=scenario.u_max if constrained else None,
+        input_constraint=s["input_constraint"] if constrained else None,
+        resolve_threshold=s["resolve_threshold"],
+        hold_radius=s["hold_radius"],
+        backend=s["backend"],
+        formulation=s["formulation"],
+    )
+    return BuiltController(ctrl, scenario.saturation == "limiter")
+
+
+def _crmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc.crmpc import CRMPC
+
+    q, r = _weights(s)
+    constrained = scenario.saturation == "constraint"
+    ctrl = CRMPC(
+        poly,
+        q,
+        r,
+        u_max=scenario.u_max if constrained else None,
+        input_constraint=s["input_constraint"] if constrained else None,
+        adaptation_gain=s["adaptation_gain"],
+        normalized=s["normalized"],
+        alpha=s["alpha"],
+        rmpc_options={"resolve_threshold": s["resolve_threshold"]},
+    )
+    return BuiltController(ctrl, scenario.saturation != "none")
+
+
+def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc.gipc import GIPC
+
+    constrained = scenario.saturation == "constraint"
+    ctrl = GIPC(
+        poly,
+        Np=s["Np"],
+        Nc=s["Nc"],
+        Qy=s["Qy"],
+        R_du=s["R_du"],
+        u_max=scenario.u_max if constrained else None,
+        du_max=s["du_max"] if constrained else None,
+        backend=s["backend"],
+    )
+    return BuiltController(ctrl, scenario.saturation == "limiter")
+
+
+def _offline(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc.offline_rmpc import OfflineRMPC
+
+    q, r = _weights(s)
+    constrained = scenario.saturation == "constraint"
+    ctrl = OfflineRMPC(
+        poly,
+        q,
+        r,
+        u_max=scenario.u_max if constrained else None,
+        input_constraint=s["input_constraint"] if constrained else None,
+        n_ellipsoids=s["n_ellipsoids"],
+        shrink=s["shrink"],
+        interpolate=s["interpolate"],
+    )
+    return BuiltController(ctrl, scenario.saturation == "limiter")
+
+
+def _lqr(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc.lqr import LQR
+
+    q, r = _weights(s)
+    return BuiltController(LQR(poly, q, r), scenario.saturation == "limiter")
+
+
+#: Controller name -> factory ``(polytope, scenario, settings) -> BuiltController``.
+CONTROLLERS: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltController]] = {
+    "RMPC": _rmpc,
+    "GIPC": _gipc,
+    "CRMPC": _crmpc,
+    "OfflineRMPC": _offline,
+    "LQR": _lqr,
+}
+
+#: Settings that may be 0 (0 turns the adaptation off; keeps re-solving down to the origin).
+_ZERO_ALLOWED = frozenset({"adaptation_gain", "hold_radius"})
+
+#: Controllers that can enforce the torque limit themselves (``saturation = "constraint"``).
+CONSTRAINED = ("RMPC", "GIPC", "CRMPC", "OfflineRMPC")
+
+
+def _check_value(default: Any, value: Any, where: str) -> Any:
+    """Check one setting against the type of its default; return it normalised."""
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(where, "true or false", repr(value))
+        return value
+    if isinstance(default, int):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ConfigError(where, "a positive integer", repr(value))
+        return value
+    if isinstance(default, float):
+        zero_ok = where.rsplit(".", 1)[-1] in _ZERO_ALLOWED
+        number = not isinstance(value, bool) and isinstance(value, int | float) and np.isfinite(value)
+        if not number or value < 0 or (value == 0 and not zero_ok):
+            raise ConfigError(where, "a number >= 0" if zero_ok else "a number > 0", repr(value))
+        return float(value)
+    if isinstance(default, tuple):
+        ok = (
+            isinstance(value, list | tuple)
+            and len(value) == len(default)
+            and all(
+                isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) and v >= 0
+                for v in value
+            )
+        )
+        if not ok:
+            raise ConfigError(where, f"a list of {len(default)} numbers >= 0", repr(value))
+        return tuple(float(v) for v in value)
+    choices = SETTING_CHOICES.get(where.rsplit(".", 1)[-1])
+    if not isinstance(value, str) or (choices is not None and value not in choices):
+        expected = "a string" if choices is None else "one of " + ", ".join(repr(c) for c in choices)
+        raise ConfigError(where, expected, repr(value))
+    return value
+
+
+def check_setting(key: str, value: Any, where: str) -> Any:
+    """Check one setting's value against the controller(s) that have it; return it normalised.
+
+    Raises
+    ------
+    ConfigError
+        When no controller has a setting of that name, or the value is of the wrong kind.
+    """
+    owners = [defaults for defaults in CONTROLLER_DEFAULTS.values() if key in defaults]
+    if not owners:
+        names = sorted({k for d in CONTROLLER_DEFAULTS.values() for k in d})
+        raise ConfigError(where, f"a controller setting ({', '.join(names)})", "an unknown name")
+    return _check_value(owners[0][key], value, where)
+
+
+def effective_settings(
+    controller: str, overrides: Mapping[str, Any], where: str = "settings", lenient: bool = False
+) -> dict[str, Any]:
+    """The controller's defaults updated by ``overrides``, each checked; unknown names raise.
+
+    Parameters
+    ----------
+    controller : str
+        A name of :data:`CONTROLLERS`.
+    overrides : mapping
+        Setting names to values (a scenario's ``settings``).
+    where : str
+        Dotted prefix of the settings for error messages.
+    lenient : bool
+        Drop (instead of refusing) a setting of another controller of the registry, so one
+        settings table can serve a sweep over several controllers. A name no controller has
+        is an error either way.
+
+    Raises
+    ------
+    ConfigError
+        On an unknown setting name or a value of the wrong kind, naming ``where.<name>``.
+    """
+    defaults = CONTROLLER_DEFAULTS[controller]
+    out = dict(defaults)
+    for key, value in overrides.items():
+        if key not in defaults:
+            if lenient and any(key in other for other in CONTROLLER_DEFAULTS.values()):
+                continue
+            raise ConfigError(
+                f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
+            )
+        out[key] = _check_value(defaults[key], value, f"{where}.{key}")
+    if controller in ("RMPC", "CRMPC") and out["resolve_threshold"] > 1.0:
+        raise ConfigError(f"{where}.resolve_threshold", "a level in (0, 1]", repr(out["resolve_threshold"]))
+    if controller == "OfflineRMPC" and out["shrink"] >= 1.0:
+        raise ConfigError(f"{where}.shrink", "a number in (0, 1)", repr(out["shrink"]))
+    if controller == "GIPC" and out["Nc"] > out["Np"]:
+        raise ConfigError(f"{where}.Nc", f"an integer <= Np = {out['Np']}", repr(out["Nc"]))
+    return out
+
+
+def build_controller(poly: Any, scenario: Any) -> BuiltController:
+    """Build the scenario's controller on ``poly`` with its effective settings."""
+    settings = effective_settings(scenario.controller, scenario.settings)
+    return CONTROLLERS[scenario.controller](poly, scenario, settings)

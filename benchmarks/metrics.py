@@ -1,0 +1,210 @@
+"""Metrics of one closed-loop run: attitude error, torque use, saturation, solver effort.
+
+The attitude error is the attitude itself (every experiment regulates it to zero), per axis
+``roll, pitch, yaw`` = ``phi, theta, psi`` in rad. Definitions (``e_k = e(t_k)``,
+``k = 0 .. N`` the recorded samples):
+
+- ``sum_abs_err``: ``sum_k |e_k|`` over all ``N + 1`` samples (paper P's table metric).
+- ``final_abs_err``: ``|e_N|``.
+- ``iae`` and ``ise``: ``int |e| dt`` and ``int e^2 dt`` by the trapezoidal rule over the
+  samples (exact for a piecewise-linear signal).
+- ``settling_time``: the first sample time after which ``|e|`` stays within a band of 2 %
+  of ``|e_0|`` (of ``max |e|`` when ``e_0 = 0``) until the end of the run; ``None`` when the
+  last sample is outside the band (not settled within the run).
+- ``overshoot``: how far ``e`` crosses zero to the side opposite to ``e_0``, in % of
+  ``|e_0|``; ``None`` when ``e_0 = 0``.
+
+Torques (N m, per axis limit ``u_max``): ``max_abs_u`` (largest applied component),
+``max_abs_u_cmd`` (largest commanded), ``saturated_fraction`` (share of steps whose command
+reaches the limit on some axis), ``constraint_violation`` (largest excess of an applied
+component over ``u_max``, 0 if none) and ``violation_steps``. Solver effort: the
+controller-reported ``solve_time_p50/p95/max`` over all steps (a step that keeps its gain
+costs 0), the same over the steps that solved (``solve_time_solves_*``), the wall time of
+``step`` (``step_time_*``), ``n_solves``, ``fallback_count``, ``failure_count`` and
+``status_counts``. ``gamma``: first, last, smallest and largest cost bound, their count, and
+the series gamma(k) at the steps that solved (``t``, ``values``; at most 200 points, evenly
+thinned).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "AXES",
+    "FAILURE_FREE_STATUSES",
+    "compute_metrics",
+    "iae",
+    "ise",
+    "overshoot",
+    "settling_time",
+]
+
+#: Names of the attitude axes, in state order.
+AXES: tuple[str, str, str] = ("roll", "pitch", "yaw")
+#: Largest number of (t, gamma) points kept in ``metrics["gamma"]`` (evenly thinned).
+GAMMA_POINTS = 200
+#: Step statuses that are not failures: solved, solved less accurately, or a kept gain.
+FAILURE_FREE_STATUSES: frozenset[str] = frozenset({"optimal", "inaccurate", "reused"})
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    if y.size < 2:
+        return 0.0
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def iae(t: Any, e: Any) -> float:
+    """Integral of ``|e|`` over ``t`` (trapezoidal rule).
+
+    Examples
+    --------
+    >>> iae([0.0, 1.0, 2.0], [1.0, -1.0, 0.0])
+    1.5
+    """
+    return _trapezoid(np.abs(np.asarray(e, dtype=float)), np.asarray(t, dtype=float))
+
+
+def ise(t: Any, e: Any) -> float:
+    """Integral of ``e^2`` over ``t`` (trapezoidal rule on the squared samples).
+
+    Examples
+    --------
+    >>> ise([0.0, 1.0, 2.0], [1.0, -1.0, 0.0])
+    1.5
+    """
+    e = np.asarray(e, dtype=float)
+    return _trapezoid(e * e, np.asarray(t, dtype=float))
+
+
+def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
+    """First time after which ``|e|`` stays within ``band * |e(0)|`` (``None`` if never).
+
+    The reference is ``|e(0)|``, or ``max |e|`` when ``e(0) = 0``; a signal that is zero
+    throughout settles at ``t[0]``.
+
+    Examples
+    --------
+    >>> settling_time([0.0, 1.0, 2.0, 3.0], [1.0, 0.5, 0.01, 0.0])
+    2.0
+    >>> settling_time([0.0, 1.0], [1.0, 0.5]) is None
+    True
+    """
+    t = np.asarray(t, dtype=float)
+    mag = np.abs(np.asarray(e, dtype=float))
+    ref = mag[0] if mag[0] > 0 else float(np.max(mag))
+    if ref == 0.0:
+        return float(t[0])
+    outside = np.flatnonzero(mag > band * ref)
+    if outside.size == 0:
+        return float(t[0])
+    last = int(outside[-1])
+    if last == mag.size - 1:
+        return None
+    return float(t[last + 1])
+
+
+def overshoot(e: Any) -> float | None:
+    """Largest excursion past zero, opposite to ``e(0)``, in % of ``|e(0)|`` (``None`` if ``e(0) = 0``).
+
+    Examples
+    --------
+    >>> overshoot([2.0, 0.5, -0.2, 0.0])
+    10.0
+    >>> overshoot([2.0, 1.0, 0.0])
+    0.0
+    """
+    e = np.asarray(e, dtype=float)
+    if e[0] == 0.0:
+        return None
+    beyond = float(np.max(-np.sign(e[0]) * e))
+    return 100.0 * max(0.0, beyond) / abs(float(e[0]))
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+def _pcts(values: np.ndarray, prefix: str) -> dict[str, float | None]:
+    if values.size == 0:
+        return {f"{prefix}_p50": None, f"{prefix}_p95": None, f"{prefix}_max": None}
+    return {
+        f"{prefix}_p50": float(np.percentile(values, 50)),
+        f"{prefix}_p95": float(np.percentile(values, 95)),
+        f"{prefix}_max": float(np.max(values)),
+    }
+
+
+def _per_axis(values: list[Any]) -> dict[str, Any]:
+    return dict(zip(AXES, values, strict=True))
+
+
+def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, Any]:
+    """All metrics of a :class:`rmpc.Trajectory` (see the module notes for definitions).
+
+    Parameters
+    ----------
+    traj : rmpc.Trajectory
+        The run; ``x[:, :3]`` is the attitude error.
+    u_max : float
+        Per-axis torque limit (N m) that saturation and violation are measured against.
+    band : float
+        Settling band as a fraction of the initial error (default 2 %).
+
+    Returns
+    -------
+    dict
+        JSON-ready values; ``None`` where a value does not exist.
+    """
+    t = np.asarray(traj.t, dtype=float)
+    err = np.asarray(traj.x, dtype=float)[:, :3]
+    u_app = np.abs(np.asarray(traj.u_applied, dtype=float))
+    u_cmd = np.abs(np.asarray(traj.u_cmd, dtype=float))
+    status = list(traj.status)
+    solve = np.asarray(traj.solve_time, dtype=float)
+    solved = np.array([s != "reused" for s in status], dtype=bool)
+    excess = np.max(u_app, axis=1) - u_max if u_app.size else np.zeros(0)
+    gamma_all = np.asarray(traj.gamma, dtype=float)
+    solved_at = np.flatnonzero(np.isfinite(gamma_all))
+    gamma = gamma_all[solved_at]
+    picks = np.linspace(0, solved_at.size - 1, min(solved_at.size, GAMMA_POINTS)).astype(int)
+    keep = solved_at[np.unique(picks)]
+    fallbacks = sum(bool(getattr(info, "fallback", False)) for info in traj.info)
+    counts: dict[str, int] = {}
+    for s in status:
+        counts[s] = counts.get(s, 0) + 1
+    metrics: dict[str, Any] = {
+        "sum_abs_err": _per_axis([float(v) for v in np.sum(np.abs(err), axis=0)]),
+        "final_abs_err": _per_axis([float(v) for v in np.abs(err[-1])]),
+        "iae": _per_axis([iae(t, err[:, i]) for i in range(3)]),
+        "ise": _per_axis([ise(t, err[:, i]) for i in range(3)]),
+        "settling_time": _per_axis([settling_time(t, err[:, i], band) for i in range(3)]),
+        "overshoot": _per_axis([overshoot(err[:, i]) for i in range(3)]),
+        "max_abs_u": float(np.max(u_app)) if u_app.size else 0.0,
+        "max_abs_u_cmd": float(np.max(u_cmd)) if u_cmd.size else 0.0,
+        "saturated_fraction": float(np.mean(np.any(u_cmd >= u_max * (1.0 - 1e-6), axis=1)))
+        if u_cmd.size
+        else 0.0,
+        "constraint_violation": float(max(0.0, np.max(excess))) if excess.size else 0.0,
+        "violation_steps": int(np.sum(excess > 1e-9)),
+        **_pcts(solve, "solve_time"),
+        **_pcts(solve[solved], "solve_time_solves"),
+        **_pcts(np.asarray(traj.step_time, dtype=float), "step_time"),
+        "n_steps": len(status),
+        "n_solves": int(np.sum(solved)),
+        "fallback_count": int(fallbacks),
+        "failure_count": int(sum(1 for s in status if s not in FAILURE_FREE_STATUSES)),
+        "status_counts": counts,
+        "gamma": {
+            "first": _finite_or_none(gamma[0]) if gamma.size else None,
+            "last": _finite_or_none(gamma[-1]) if gamma.size else None,
+            "min": float(np.min(gamma)) if gamma.size else None,
+            "max": float(np.max(gamma)) if gamma.size else None,
+            "count": int(gamma.size),
+            "t": [float(t[k]) for k in keep],
+            "values": [float(gamma_all[k]) for k in keep],
+        },
+    }
+    return metrics

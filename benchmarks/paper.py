@@ -1,0 +1,342 @@
+"""The benchmark suite "paper": experiments E1-E6 of paper P (SPEC section 3).
+
+All experiments regulate paper P's satellite to zero attitude from its initial attitude.
+
+====  =====================================================================  ================
+E1    no input constraint, linear model: RMPC vs GIPC                        linear
+E2    saturation by a limiter vs the controller's constraint                 linear
+E3    E2 on the nonlinear satellite (figure: overlaid on E2)                 nonlinear
+E4    0.5 N m step disturbance from t = 10 s: RMPC, GIPC, CRMPC              nonlinear
+E5    E4 with +-70 % inertia uncertainty (true inertia 1.7 x nominal)        nonlinear
+E6    initial attitude x 1.3: RMPC and GIPC                                  linear, nonlinear
+====  =====================================================================  ================
+
+:func:`paper_cases` lists the cases (settings from :mod:`benchmarks.defaults`);
+:func:`run_paper` runs them in parallel and writes ``results.json``, ``results.md``,
+``results.csv``, ``results.tex``, ``results_table.json``, ``run.json``, the figures
+(``figures/*.png``) and the trajectories (``traces/*.npz``).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks import defaults
+from benchmarks.execute import ExecOutcome, Task, execute
+from benchmarks.executors import make_executor
+from benchmarks.machine import machine_info, package_versions
+from benchmarks.progress import CaseProgress
+from benchmarks.report import metric_table, to_markdown, write_tables
+from benchmarks.scenario import Scenario
+from models import PAPER_P_INERTIA
+from toolkit_common.errors import ConfigError
+
+__all__ = ["EXPERIMENTS", "PaperCase", "PaperOutcome", "paper_cases", "run_paper"]
+
+#: Experiment name -> what it shows.
+EXPERIMENTS: dict[str, str] = {
+    "E1": "No input constraint, linear model: RMPC vs GIPC step responses and torques.",
+    "E2": "Saturation handled two ways on the linear model: a limiter clipping the controller output to "
+    "+-u_max, versus the constraint inside the controller (RMPC ||u||_2 <= u_max; GIPC |u| <= u_max, "
+    "|du| <= du_max). Paper P's metric: sum_k |e(k)| per axis.",
+    "E3": "E2 on the nonlinear satellite; the figure overlays the linear responses of E2 (dashed).",
+    "E4": "Input disturbance: a step torque from t = 10 s on the nonlinear satellite: RMPC, GIPC, CRMPC.",
+    "E5": "Inertia uncertainty raised to +-70 % (true inertia at the heavy corner) with the E4 disturbance.",
+    "E6": "Initial attitude raised by 30 %: linear vs nonlinear satellite, RMPC and GIPC.",
+}
+
+
+@dataclass(frozen=True)
+class PaperCase:
+    """One run of the suite: the experiment it belongs to and its scenario."""
+
+    experiment: str
+    scenario: Scenario
+
+    @property
+    def key(self) -> str:
+        sc = self.scenario
+        return f"{self.experiment}_{sc.controller}_{sc.plant}_{sc.saturation}"
+
+
+def paper_cases(duration_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[PaperCase]:
+    """The cases of E1-E6, durations (and the disturbance time) multiplied by ``duration_scale``.
+
+    Examples
+    --------
+    >>> cases = paper_cases()
+    >>> len(cases), sorted({c.experiment for c in cases})
+    (20, ['E1', 'E2', 'E3', 'E4', 'E5', 'E6'])
+    """
+    if not duration_scale > 0:
+        raise ConfigError("--duration-scale", "a number > 0", repr(duration_scale))
+    chosen = list(EXPERIMENTS) if experiments is None else list(experiments)
+    for name in chosen:
+        if name not in EXPERIMENTS:
+            raise ConfigError("--experiments", "names among " + ", ".join(EXPERIMENTS), repr(name))
+    base = {
+        "duration": defaults.DURATION * duration_scale,
+        "disturbance_start": defaults.DISTURBANCE_START * duration_scale,
+    }
+    disturbed = {
+        **base,
+        "plant": "nonlinear",
+        "saturation": "constraint",
+        "disturbance": defaults.DISTURBANCE_MAGNITUDE,
+        "disturbance_axes": list(defaults.DISTURBANCE_AXES),
+    }
+    heavy = [defaults.E5_TRUE_INERTIA_FACTOR * j for j in PAPER_P_INERTIA]
+    spec: list[tuple[str, dict[str, Any]]] = []
+    for ctrl in ("RMPC", "GIPC"):
+        spec.append(("E1", {**base, "controller": ctrl, "plant": "linear", "saturation": "none"}))
+    for exp, plant in (("E2", "linear"), ("E3", "nonlinear")):
+        for sat in ("limiter", "constraint"):
+            for ctrl in ("RMPC", "GIPC"):
+                spec.append((exp, {**base, "controller": ctrl, "plant": plant, "saturation": sat}))
+    for ctrl in ("RMPC", "GIPC", "CRMPC"):
+        spec.append(("E4", {**disturbed, "controller": ctrl}))
+    for ctrl in ("RMPC", "GIPC", "CRMPC"):
+        spec.append(
+            ("E5", {**disturbed, "controller": ctrl, "spread": defaults.E5_SPREAD, "true_inertia": heavy})
+        )
+    for plant in ("linear", "nonlinear"):
+        for ctrl in ("RMPC", "GIPC"):
+            spec.append(
+                (
+                    "E6",
+                    {
+                        **base,
+                        "controller": ctrl,
+                        "plant": plant,
+                        "saturation": "constraint",
+                        "ic_scale": defaults.E6_IC_SCALE,
+                    },
+                )
+            )
+    return [PaperCase(exp, Scenario.from_dict(d)) for exp, d in spec if exp in chosen]
+
+
+def _cost(case: PaperCase) -> float:
+    """A rough relative cost, to start the long cases first (the LMI solves dominate)."""
+    sc = case.scenario
+    weight = {"RMPC": 3.0, "CRMPC": 3.0, "OfflineRMPC": 1.0}.get(sc.controller, 0.5)
+    if sc.disturbance and sc.controller == "RMPC":
+        weight *= 4.0
+    return weight * sc.duration
+
+
+@dataclass
+class PaperOutcome:
+    """What :func:`run_paper` did: records, failures, files, wall time, interruption."""
+
+    records: list[dict[str, Any]] = field(default_factory=list)
+    failures: list[dict[str, Any]] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+    wall_time_s: float = 0.0
+    execution: ExecOutcome | None = None
+
+
+def run_paper(
+    out: str | Path,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    duration_scale: float = 1.0,
+    experiments: Sequence[str] | None = None,
+    progress: bool | None = None,
+) -> PaperOutcome:
+    """Run E1-E6 and write every output file into ``out`` (created if needed).
+
+    Parameters
+    ----------
+    out : str or Path
+        Output directory.
+    workers : int, optional
+        Worker processes (default: one per CPU; 0 runs in-process).
+    scheduler : str, optional
+        A Dask scheduler address instead of local workers.
+    duration_scale : float
+        Factor on every duration and on the disturbance time (``--short`` uses 0.075).
+    experiments : sequence of str, optional
+        A subset of ``E1`` .. ``E6``.
+    progress : bool, optional
+        Force the progress bar on or off (default: on when stderr is a terminal).
+    """
+    cases = paper_cases(duration_scale, experiments)
+    executor = make_executor(workers, scheduler)  # a bad --scheduler fails before anything is written
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        executor.close()
+        raise
+    start = time.perf_counter()
+    results: dict[str, dict[str, Any]] = {}
+    ordered = sorted(cases, key=_cost, reverse=True)
+    tasks = [
+        Task(c.key, {"scenario": c.scenario.to_dict(), "experiment": c.experiment, "trace": True})
+        for c in ordered
+    ]
+    with CaseProgress(len(tasks), "rmpc bench paper", progress) as bar:
+
+        def on_result(task: Task, result: dict[str, Any]) -> None:
+            results[task.key] = result
+            bar.advance(task.key, ok=bool(result.get("ok")))
+
+        execution = execute(tasks, executor, on_result)
+    outcome = PaperOutcome(wall_time_s=time.perf_counter() - start, execution=execution)
+    runs = []
+    for case in cases:
+        res = results.get(case.key)
+        if res is None:
+            continue
+        if res["ok"]:
+            outcome.records.append(res["record"])
+            runs.append((case, res["record"], res["trace"]))
+        else:
+            outcome.failures.append(
+                {
+                    "experiment": case.experiment,
+                    "key": case.key,
+                    "error": res["error"],
+                    "traceback": res.get("traceback", ""),
+                    "scenario": case.scenario.to_dict(),
+                }
+            )
+    outcome.files = _write(
+        out, cases, runs, outcome, workers, scheduler, duration_scale, executor.description
+    )
+    return outcome
+
+
+def _write(
+    out: Path,
+    cases: list[PaperCase],
+    runs: list[tuple[PaperCase, dict, dict]],
+    outcome: PaperOutcome,
+    workers: int | None,
+    scheduler: str | None,
+    duration_scale: float,
+    where: str,
+) -> list[Path]:
+    from benchmarks.plots import plot_gamma, plot_responses
+
+    files: list[Path] = []
+    (out / "figures").mkdir(exist_ok=True)
+    (out / "traces").mkdir(exist_ok=True)
+    for case, _, trace in runs:
+        path = out / "traces" / f"{case.key}.npz"
+        np.savez_compressed(path, **trace)
+        files.append(path)
+    groups: dict[str, list[tuple[dict, dict]]] = {}
+    for case, rec, trace in runs:
+        groups.setdefault(case.experiment, []).append((rec, trace))
+    figures: dict[str, list[Path]] = {}
+    for exp, items in groups.items():
+        path = plot_responses(
+            items, out / "figures" / f"{exp}.png", f"{exp}: {EXPERIMENTS[exp]}"[:110], defaults.U_MAX
+        )
+        figures.setdefault(exp, []).append(path)
+    if "E2" in groups and "E3" in groups:
+        path = plot_responses(
+            groups["E2"] + groups["E3"],
+            out / "figures" / "E3_linear_vs_nonlinear.png",
+            "E2 (linear, dashed) vs E3 (nonlinear, solid)",
+            defaults.U_MAX,
+        )
+        figures.setdefault("E3", []).append(path)
+    gamma = plot_gamma(groups, out / "figures" / "gamma.png")
+    files += [p for ps in figures.values() for p in ps] + ([gamma] if gamma else [])
+
+    records = outcome.records
+    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    header, rows = metric_table(records)
+    files += write_tables(out, header, rows, "Benchmark suite paper: E1-E6")
+    run_info = {
+        "command": "rmpc bench paper",
+        "wall_time_s": outcome.wall_time_s,
+        "executor": where,
+        "workers": workers,
+        "scheduler": scheduler,
+        "duration_scale": duration_scale,
+        "cases": len(cases),
+        "done": len(records),
+        "failed": len(outcome.failures),
+        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
+        "machine": machine_info(),
+        "versions": package_versions(),
+        "failures": outcome.failures,
+    }
+    (out / "run.json").write_text(json.dumps(run_info, indent=1) + "\n", encoding="utf-8")
+    md = _markdown(records, outcome, figures, gamma, run_info, out)
+    (out / "results.md").write_text(md, encoding="utf-8")
+    files += [out / n for n in ("results.json", "run.json", "results.md")]
+    return files
+
+
+def _markdown(
+    records: list[dict],
+    outcome: PaperOutcome,
+    figures: dict[str, list[Path]],
+    gamma: Path | None,
+    info: dict[str, Any],
+    out: Path,
+) -> str:
+    from benchmarks.defaults import rationale, settings_rows
+
+    lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", ""]
+    m = info["machine"]
+    lines += [
+        f"Wall time {info['wall_time_s']:.1f} s on {info['executor']}; "
+        f"duration scale {info['duration_scale']:g}; "
+        f"{info['done']} of {info['cases']} cases done, {info['failed']} failed"
+        + (" (interrupted)" if info["interrupted"] else "")
+        + ".",
+        f"Machine: {m['platform']}, {m['cpu_count']} CPUs, load average {m['load_average']} at the end; "
+        "package versions in `run.json`.",
+        "",
+        "Errors are the attitude angles (rad); `sum|e|` is paper P's `sum_k |e(k)|` over all samples; "
+        "settling and overshoot are the worst axis (`-`: not settled within the run); `per-solve` times are "
+        "the optimiser time of the steps that solved (RMPC keeps its gain inside its invariant ellipsoid and "
+        "re-solves when the level drops to `resolve_threshold`), `step p95` the wall time of a controller "
+        "step over all steps; results.json also has the per-step `solve_time_p50/p95/max` over all steps.",
+        "",
+    ]
+    for exp, text in EXPERIMENTS.items():
+        recs = [r for r in records if r["experiment"] == exp]
+        if not recs and exp not in figures:
+            continue
+        lines += [f"## {exp}", "", text, ""]
+        header, rows = metric_table(recs, lead=("controller", "plant", "saturation"))
+        lines += [to_markdown(header, rows), ""]
+        for path in figures.get(exp, []):
+            lines += [f"![{path.stem}]({path.relative_to(out).as_posix()})", ""]
+    if gamma is not None:
+        lines += [
+            "## gamma(k)",
+            "",
+            "The robust MPC's cost bound at the steps that solved (log axis).",
+            "",
+            f"![gamma]({gamma.relative_to(out).as_posix()})",
+            "",
+        ]
+    if outcome.failures:
+        lines += ["## Failed cases", ""]
+        lines += [f"- {f['key']}: {f['error']}" for f in outcome.failures]
+        lines.append("")
+    lines += [
+        "## Settings",
+        "",
+        "Every value paper P leaves out is the toolkit's choice "
+        "(`benchmarks/defaults.py`; each is a scenario field or controller setting).",
+        "",
+    ]
+    lines += [to_markdown(["setting", "value", "source"], [list(r) for r in settings_rows()]), ""]
+    lines += ["Why these values:", "", rationale(), ""]
+    return "\n".join(lines)

@@ -1,0 +1,141 @@
+"""Figures in the style of paper P: attitude in degrees, torques with the limit lines, gamma(k).
+
+Matplotlib's object API with the Agg renderer (no pyplot, no global state, no display): each
+function builds a :class:`matplotlib.figure.Figure` and writes a PNG. Within a figure the
+colour tells the controller and saturation handling apart, the line style the plant
+(solid: nonlinear, dashed: linear), so linear and nonlinear runs overlay directly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+__all__ = ["plot_gamma", "plot_responses"]
+
+_AXIS_LABELS = ("roll $\\phi$", "pitch $\\theta$", "yaw $\\psi$")
+_TORQUE_LABELS = ("$M_x$", "$M_y$", "$M_z$")
+_COLORS = (
+    "tab:blue",
+    "tab:orange",
+    "tab:green",
+    "tab:red",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:gray",
+)
+_STYLES = {"nonlinear": "-", "linear": "--"}
+
+Run = tuple[Mapping[str, Any], Mapping[str, np.ndarray]]
+
+
+def _key(rec: Mapping[str, Any]) -> str:
+    return f"{rec['controller']} {rec['saturation']}"
+
+
+def _colors(runs: Sequence[Run]) -> dict[str, str]:
+    keys: list[str] = []
+    for rec, _ in runs:
+        if _key(rec) not in keys:
+            keys.append(_key(rec))
+    return {k: _COLORS[i % len(_COLORS)] for i, k in enumerate(keys)}
+
+
+def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: float) -> Path:
+    """Attitude (deg) and applied torque per axis for several runs, with the +-``u_max`` lines.
+
+    Parameters
+    ----------
+    runs : sequence of (record, trace)
+        ``trace`` has ``t``, ``x`` and ``u_applied`` (see :func:`benchmarks.runner.simulate_scenario`).
+    path : str or Path
+        Output PNG.
+    title : str
+        Figure title.
+    u_max : float
+        Torque limit drawn as dotted lines (N m).
+    """
+    fig = Figure(figsize=(11, 8), layout="constrained")
+    axes = fig.subplots(3, 2, sharex=True)
+    colors = _colors(runs)
+    for rec, tr in runs:
+        t = np.asarray(tr["t"])
+        style = dict(
+            color=colors[_key(rec)],
+            linestyle=_STYLES.get(rec["plant"], "-"),
+            linewidth=1.2,
+            label=f"{_key(rec)} ({rec['plant']})",
+        )
+        for i in range(3):
+            axes[i, 0].plot(t, np.degrees(np.asarray(tr["x"])[:, i]), **style)
+            axes[i, 1].plot(t[:-1], np.asarray(tr["u_applied"])[:, i], drawstyle="steps-post", **style)
+        d_start = rec.get("settings", {}).get("disturbance_start")
+        if rec.get("settings", {}).get("disturbance") and d_start is not None and d_start < t[-1]:
+            for ax in axes.ravel():
+                ax.axvline(d_start, color="0.6", linewidth=0.8, linestyle=":")
+    for i in range(3):
+        axes[i, 0].set_ylabel(f"{_AXIS_LABELS[i]} (deg)")
+        axes[i, 1].set_ylabel(f"{_TORQUE_LABELS[i]} (N m)")
+        for sign in (1.0, -1.0):
+            axes[i, 1].axhline(sign * u_max, color="k", linewidth=0.8, linestyle=":")
+        for ax in axes[i]:
+            ax.grid(True, alpha=0.3)
+    axes[-1, 0].set_xlabel("time (s)")
+    axes[-1, 1].set_xlabel("time (s)")
+    axes[0, 0].set_title("attitude")
+    axes[0, 1].set_title(f"applied torque (limit +-{u_max:g} N m dotted)")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)), fontsize="small")
+    fig.suptitle(title)
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def plot_gamma(groups: Mapping[str, Sequence[Run]], path: str | Path) -> Path | None:
+    """The cost bound gamma(k) on a log axis, one panel per experiment (steps that solved only).
+
+    Returns ``None`` (and writes nothing) when no run has a gamma.
+    """
+    panels = {
+        name: [(rec, tr) for rec, tr in runs if np.any(np.isfinite(np.asarray(tr["gamma"])))]
+        for name, runs in groups.items()
+    }
+    panels = {name: runs for name, runs in panels.items() if runs}
+    if not panels:
+        return None
+    cols = min(3, len(panels))
+    rows = (len(panels) + cols - 1) // cols
+    fig = Figure(figsize=(4.2 * cols, 3.3 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    for ax, (name, runs) in zip(axes, panels.items(), strict=False):
+        colors = _colors(runs)
+        for rec, tr in runs:
+            t = np.asarray(tr["t"])[:-1]
+            g = np.asarray(tr["gamma"])
+            ok = np.isfinite(g) & (g > 0)
+            ax.semilogy(
+                t[ok],
+                g[ok],
+                drawstyle="steps-post",
+                color=colors[_key(rec)],
+                linestyle=_STYLES.get(rec["plant"], "-"),
+                label=f"{_key(rec)} ({rec['plant']})",
+            )
+        ax.set_title(name)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("gamma(k)")
+        ax.grid(True, which="major", alpha=0.3)
+        ax.legend(fontsize="x-small")
+    for ax in axes[len(panels) :]:
+        ax.set_visible(False)
+    fig.suptitle("cost bound gamma(k) of the robust MPC (at the steps that solved)")
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    return path

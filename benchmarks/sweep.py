@@ -1,0 +1,481 @@
+"""Sweeps: a TOML file expanded into scenarios, run in parallel, resumable through a store.
+
+A sweep file has up to five top-level entries, all optional::
+
+    name = "smoke"                      # used in reports
+    description = "what it is for"
+
+    [base]                              # scenario fields (benchmarks.scenario.Scenario)
+    controller = "GIPC"
+    duration = 2.0
+    [base.settings]                     # controller settings (benchmarks.defaults)
+    Np = 200
+
+    [grid]                              # the product of these lists, over any field
+    plant = ["linear", "nonlinear"]
+    saturation = ["limiter", "constraint"]
+    settings.R_du = [0.1, 1.0]          # a controller setting
+
+    [montecarlo]                        # seeded draws of the true inertia in the polytope box
+    n = 10
+    seed = 1
+
+Each grid point is repeated for the ``n`` draws: the true principal inertias are
+``J0_i (1 + spread u_i)`` with ``u`` uniform in ``[-1, 1]^3`` (one common ``u`` in
+``"scalar"`` mode), from ``numpy.random.default_rng(seed)``; every grid point gets the same
+draws. Cases are keyed by :attr:`Scenario.case_id`, so re-running a sweep skips the cases its
+store already holds and a grid that repeats a case runs it once. A ``settings`` table may hold
+settings of several controllers (each case takes those of its own controller); grid
+combinations a controller cannot run (LQR with ``saturation = "constraint"``) are left out and
+listed in ``results.md``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import shlex
+import sys
+import time
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.controllers import check_setting
+from benchmarks.defaults import CONTROLLER_DEFAULTS
+from benchmarks.execute import ExecOutcome, Task, execute
+from benchmarks.executors import make_executor
+from benchmarks.machine import machine_info, package_versions
+from benchmarks.progress import CaseProgress
+from benchmarks.report import metric_table, to_markdown, varying_fields, write_tables
+from benchmarks.scenario import Scenario, unsupported
+from benchmarks.store import STORE_NAME, CaseStore
+from models import PAPER_P_INERTIA
+from toolkit_common.errors import ConfigError
+
+__all__ = [
+    "SHIPPED",
+    "SweepOutcome",
+    "SweepSpec",
+    "expand",
+    "left_out",
+    "load_sweep",
+    "parse_sweep",
+    "resolve_config",
+    "run_sweep",
+]
+
+_TOP_LEVEL = ("name", "description", "base", "grid", "montecarlo")
+_MONTECARLO = ("n", "seed")
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep file: base scenario fields, grid lists (dotted field names), draws."""
+
+    name: str
+    description: str
+    base: dict[str, Any]
+    grid: dict[str, list[Any]]
+    montecarlo: dict[str, int] | None
+
+
+#: The example sweeps shipped with the package.
+SHIPPED = Path(__file__).resolve().parent / "sweeps"
+
+
+def resolve_config(path: str | Path) -> Path:
+    """``path`` itself, or a shipped sweep when ``path`` is a bare name such as ``smoke``."""
+    path = Path(path)
+    if not path.is_file() and path.parent == Path(".") and (SHIPPED / f"{path.stem}.toml").is_file():
+        return SHIPPED / f"{path.stem}.toml"
+    return path
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and validate a sweep file (:class:`ConfigError` naming the field on any problem).
+
+    ``path`` may also name a shipped sweep (``"smoke"``, see :func:`resolve_config`).
+    """
+    path = resolve_config(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise ConfigError("--config", "a readable TOML file", f"{str(path)!r} ({err.strerror})") from None
+    except UnicodeDecodeError:
+        raise ConfigError("--config", "a UTF-8 TOML file", f"{str(path)!r} (not UTF-8)") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(str(path), "valid TOML", str(err).replace("\n", " ")) from None
+    return parse_sweep(data, default_name=path.stem)
+
+
+def _flatten_grid(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            out.update(_flatten_grid(value, f"{name}."))
+        else:
+            out[name] = value
+    return out
+
+
+def _with(base: Mapping[str, Any], field_name: str, value: Any) -> dict[str, Any]:
+    """``base`` with one (possibly ``settings.<name>``) field replaced."""
+    out = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in base.items()}
+    if field_name.startswith("settings."):
+        out.setdefault("settings", {})[field_name.split(".", 1)[1]] = value
+    else:
+        out[field_name] = value
+    return out
+
+
+def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSpec:
+    """Validate the parsed TOML of a sweep (see the module notes for the format).
+
+    Examples
+    --------
+    >>> spec = parse_sweep({"base": {"controller": "GIPC"}, "grid": {"u_max": [0.5, 1.0]},
+    ...                     "montecarlo": {"n": 3, "seed": 1}})
+    >>> len(expand(spec))
+    6
+    """
+    for key in data:
+        if key not in _TOP_LEVEL:
+            raise ConfigError(str(key), "a sweep table (" + ", ".join(_TOP_LEVEL) + ")", "an unknown field")
+    name = data.get("name", default_name)
+    description = data.get("description", "")
+    if not isinstance(name, str) or not name:
+        raise ConfigError("name", "a non-empty string", repr(name))
+    if not isinstance(description, str):
+        raise ConfigError("description", "a string", repr(description))
+    base = data.get("base", {})
+    if not isinstance(base, Mapping):
+        raise ConfigError("base", "a table of scenario fields", repr(base))
+    for key, value in base.items():
+        if key != "settings":
+            Scenario.check_field(str(key), value, f"base.{key}")
+        elif not isinstance(value, Mapping):
+            raise ConfigError("base.settings", "a table of controller settings", repr(value))
+        else:
+            for name_, setting in value.items():
+                check_setting(str(name_), setting, f"base.settings.{name_}")
+    grid_table = data.get("grid", {})
+    if not isinstance(grid_table, Mapping):
+        raise ConfigError("grid", "a table of field = [values]", repr(grid_table))
+    grid = _flatten_grid(grid_table)
+    known = Scenario.field_names()
+    for key, values in grid.items():
+        top = key.split(".", 1)[0]
+        if top not in known or (top == "settings") != (key != top):
+            raise ConfigError(f"grid.{key}", "a scenario field or settings.<name>", "an unknown field")
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"grid.{key}", "a non-empty list of values", repr(values))
+        for value in values:
+            if top == "settings":
+                check_setting(key.split(".", 1)[1], value, f"grid.{key}")
+            else:
+                Scenario.check_field(key, value, f"grid.{key}")
+    mc = data.get("montecarlo")
+    if mc is not None:
+        mc = _check_montecarlo(mc, base, grid)
+    spec = SweepSpec(name=name, description=description, base=dict(base), grid=grid, montecarlo=mc)
+    _check_settings_used(spec)
+    _grid_points(spec)  # the combinations: raises on one that is impossible
+    return spec
+
+
+def _check_settings_used(spec: SweepSpec) -> None:
+    """Every setting given must belong to a controller the sweep runs (else it is a mistake)."""
+    controllers = set(spec.grid.get("controller", [spec.base.get("controller", Scenario.controller)]))
+    given = [(f"base.settings.{k}", k) for k in spec.base.get("settings", {})]
+    given += [(f"grid.{k}", k.split(".", 1)[1]) for k in spec.grid if k.startswith("settings.")]
+    for where, key in given:
+        if not any(key in CONTROLLER_DEFAULTS[c] for c in controllers):
+            owners = [c for c, d in CONTROLLER_DEFAULTS.items() if key in d]
+            raise ConfigError(
+                where,
+                f"a setting of a controller the sweep runs ({', '.join(sorted(controllers))})",
+                f"a setting of {', '.join(owners)} only",
+            )
+
+
+def _check_montecarlo(mc: Any, base: Mapping[str, Any], grid: Mapping[str, Any]) -> dict[str, int]:
+    if not isinstance(mc, Mapping):
+        raise ConfigError("montecarlo", "a table with n and seed", repr(mc))
+    for key in mc:
+        if key not in _MONTECARLO:
+            raise ConfigError(f"montecarlo.{key}", "n or seed", "an unknown field")
+    n, seed = mc.get("n"), mc.get("seed", 0)
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ConfigError("montecarlo.n", "a positive integer number of draws", repr(n))
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ConfigError("montecarlo.seed", "an integer >= 0", repr(seed))
+    if "true_inertia" in base or "true_inertia" in grid:
+        raise ConfigError(
+            "montecarlo", "no true_inertia in [base] or [grid] (the draws set it)", "true_inertia given"
+        )
+    return {"n": n, "seed": seed}
+
+
+def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:
+    """The scenarios of the grid (before the draws) and the combinations left out.
+
+    A combination a controller cannot run (LQR with ``saturation = "constraint"``) is left out
+    and listed; if that leaves nothing, or a combination is impossible otherwise, it raises
+    :class:`ConfigError` naming the field (``grid.<field>`` when the grid sets it).
+    """
+    keys = list(spec.grid)
+    points, dropped = [], []
+    first_problem: ConfigError | None = None
+    for combo in itertools.product(*(spec.grid[k] for k in keys)):
+        data: dict[str, Any] = dict(spec.base)
+        for key, value in zip(keys, combo, strict=True):
+            data = _with(data, key, value)
+        controller = data.get("controller", Scenario.controller)
+        saturation = data.get("saturation", Scenario.saturation)
+        problem = unsupported(controller, saturation)
+        if problem is not None:
+            dropped.append(f"{controller} with saturation = {saturation!r}")
+            if first_problem is None:
+                where = "grid.saturation" if "saturation" in spec.grid else "base.saturation"
+                first_problem = ConfigError(where, problem, repr(saturation))
+            continue
+        try:
+            points.append(Scenario.from_dict(data, lenient_settings=True))
+        except ConfigError as err:
+            prefix = "grid" if err.argument in spec.grid else "base"
+            raise ConfigError(f"{prefix}.{err.argument}", err.expected, err.found) from None
+    if not points and first_problem is not None:
+        raise first_problem
+    return points, dropped
+
+
+def expand(spec: SweepSpec) -> list[Scenario]:
+    """Every case of the sweep, in grid order (each grid point followed by its draws), without repeats.
+
+    Grid combinations a controller cannot run are left out (see :func:`left_out`).
+    """
+    points, _ = _grid_points(spec)
+    draws = None
+    if spec.montecarlo is not None:
+        rng = np.random.default_rng(spec.montecarlo["seed"])
+        draws = rng.uniform(-1.0, 1.0, size=(spec.montecarlo["n"], 3))
+    out: list[Scenario] = []
+    seen: set[str] = set()
+    for scenario in points:
+        variants = [scenario]
+        if draws is not None:
+            variants = []
+            for u in draws:
+                factors = np.full(3, u[0]) if scenario.mode == "scalar" else u
+                inertia = [
+                    float(j * (1.0 + scenario.spread * f))
+                    for j, f in zip(PAPER_P_INERTIA, factors, strict=True)
+                ]
+                variants.append(Scenario.from_dict({**scenario.to_dict(), "true_inertia": inertia}))
+        for sc in variants:
+            if sc.case_id not in seen:
+                seen.add(sc.case_id)
+                out.append(sc)
+    return out
+
+
+def left_out(spec: SweepSpec) -> list[str]:
+    """The grid combinations :func:`expand` leaves out, in words.
+
+    Examples
+    --------
+    >>> grid = {"controller": ["LQR", "RMPC"], "saturation": ["limiter", "constraint"]}
+    >>> left_out(parse_sweep({"grid": grid}))
+    ["LQR with saturation = 'constraint'"]
+    """
+    return _grid_points(spec)[1]
+
+
+@dataclass
+class SweepOutcome:
+    """Counts of a sweep invocation and the files it wrote."""
+
+    name: str
+    total: int
+    skipped: int
+    ran: int = 0
+    failed: int = 0
+    stored_errors: int = 0
+    execution: ExecOutcome | None = None
+    files: list[Path] = field(default_factory=list)
+    wall_time_s: float = 0.0
+
+
+def run_sweep(
+    config: str | Path,
+    out: str | Path,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    retry_errors: bool = False,
+    progress: bool | None = None,
+    argv: Sequence[str] | None = None,
+) -> SweepOutcome:
+    """Run the cases of ``config`` not yet in ``out``'s store, then write the reports from the store.
+
+    Parameters
+    ----------
+    config : str or Path
+        The sweep TOML file.
+    out : str or Path
+        Output directory; holds the store (``sweep.sqlite``) and the reports.
+    workers : int, optional
+        Local worker processes (default: one per CPU; 0 runs in-process).
+    scheduler : str, optional
+        Address of a Dask scheduler; used instead of local workers.
+    retry_errors : bool
+        Run again the cases stored with an error (by default they count as finished).
+    progress : bool, optional
+        Force the progress bar on or off (default: on when stderr is a terminal).
+    argv : sequence of str, optional
+        The command line, recorded in the store's ``runs`` table.
+    """
+    spec = load_sweep(config)
+    cases = expand(spec)
+    executor = make_executor(workers, scheduler)  # a bad --scheduler fails before anything is written
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        executor.close()
+        raise
+    start = time.perf_counter()
+    position = {sc.case_id: i for i, sc in enumerate(cases)}
+    with CaseStore(out / STORE_NAME) as store:
+        finished = store.finished_ids(include_errors=not retry_errors)
+        todo = [sc for sc in cases if sc.case_id not in finished]
+        outcome = SweepOutcome(name=spec.name, total=len(cases), skipped=len(cases) - len(todo))
+        if todo:
+            run = store.begin_run(shlex.join(["rmpc", *(argv or sys.argv[1:])]))
+            by_id = {sc.case_id: sc for sc in todo}
+            tasks = [Task(sc.case_id, {"scenario": sc.to_dict(), "experiment": sc.case_id}) for sc in todo]
+            with CaseProgress(len(tasks), f"sweep {spec.name}", progress) as bar:
+
+                def on_result(task: Task, result: dict[str, Any]) -> None:
+                    sc = by_id[task.key]
+                    if result.get("ok"):
+                        store.put_done(task.key, position[task.key], sc.to_dict(), result["record"], run)
+                    else:
+                        store.put_error(
+                            task.key,
+                            position[task.key],
+                            sc.to_dict(),
+                            result["error"],
+                            result.get("traceback", ""),
+                            run,
+                        )
+                        outcome.failed += 1
+                    outcome.ran += 1
+                    bar.advance(sc.label(), ok=bool(result.get("ok")))
+
+                outcome.execution = execute(tasks, executor, on_result)
+        outcome.wall_time_s = time.perf_counter() - start
+        rows = [r for r in store.rows() if r["case_id"] in position]
+        extra = len(store.finished_ids()) - len(rows)
+    if not todo:
+        executor.close()
+    outcome.stored_errors = sum(1 for r in rows if r["status"] == "error")
+    where = executor.description if todo else "nothing to run"
+    outcome.files = _write(out, spec, cases, rows, extra, outcome, where)
+    return outcome
+
+
+def _write(
+    out: Path,
+    spec: SweepSpec,
+    cases: list[Scenario],
+    rows: list[dict[str, Any]],
+    extra: int,
+    outcome: SweepOutcome,
+    where: str,
+) -> list[Path]:
+    records = [r["record"] for r in rows if r["status"] == "done"]
+    errors = [r for r in rows if r["status"] == "error"]
+    fields = [
+        f
+        for f in varying_fields([sc.to_dict() for sc in cases])
+        if f not in ("controller", "plant", "saturation")
+    ]
+    header, table = metric_table(records, scenario_fields=fields)
+    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    tables = write_tables(out, header, table, f"Sweep {spec.name}")
+    failed = [
+        {
+            "case_id": r["case_id"],
+            "error": r["error"],
+            "scenario": r["scenario"],
+            "traceback": (r["record"] or {}).get("traceback", ""),
+        }
+        for r in errors
+    ]
+    (out / "errors.json").write_text(json.dumps(failed, indent=1) + "\n", encoding="utf-8")
+    ex = outcome.execution
+    status = (
+        "interrupted"
+        if ex is not None and ex.interrupted
+        else "complete"
+        if len(rows) == len(cases)
+        else "partial"
+    )
+    lines = [f"# Sweep `{spec.name}`", ""]
+    if spec.description:
+        lines += [spec.description, ""]
+    lines += [
+        f"{len(cases)} cases: {len(records)} done, {len(errors)} failed, "
+        f"{len(cases) - len(rows)} not run yet ({status}). This invocation ran {outcome.ran} on {where} "
+        f"in {outcome.wall_time_s:.1f} s and skipped "
+        f"{outcome.skipped} finished earlier."
+        + (
+            f" The store also holds {extra} cases of earlier versions of the sweep file, left out here."
+            if extra
+            else ""
+        ),
+        _machine_line(),
+        "",
+        "`experiment` is the case id; varying fields are shown; metrics as in `rmpc bench paper` "
+        "(errors in rad, worst axis for settling and overshoot).",
+        "",
+        to_markdown(header, table),
+        "",
+    ]
+    dropped = left_out(spec)
+    if dropped:
+        lines += [
+            f"Left out of the grid ({len(dropped)} combinations a controller cannot run): "
+            + "; ".join(sorted(set(dropped)))
+            + ".",
+            "",
+        ]
+    if errors:
+        lines += ["## Failed cases", ""] + [f"- `{r['case_id']}`: {r['error']}" for r in errors] + [""]
+    lines += [
+        "## Base scenario",
+        "",
+        "```json",
+        json.dumps(Scenario.from_dict(spec.base, lenient_settings=True).to_dict(), indent=1),
+        "```",
+        "",
+    ]
+    (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
+    return [out / n for n in ("results.json", "results.md", "errors.json", STORE_NAME)] + tables
+
+
+def _machine_line() -> str:
+    m = machine_info()
+    versions = ", ".join(f"{k} {v}" for k, v in package_versions().items())
+    return (
+        f"Machine: {m['platform']}, {m['cpu_count']} CPUs, Python {m['python']}, load average "
+        f"{m['load_average']} at the end; {versions}."
+    )
