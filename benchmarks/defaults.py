@@ -186,7 +186,11 @@ def settings_rows() -> list[tuple[str, str, str]]:
     rows += [
         ("CRMPC error output, theta bound", "full state; |theta_i| <= u_max (CRMPC defaults)", "toolkit"),
         ("GIPC outputs, memory", "the attitude; at rest with u(-1) = 0 (rmpc.GIPC defaults)", "toolkit"),
-        ("OfflineRMPC design states", "from the first state along the nominal closed loop", "toolkit"),
+        (
+            "OfflineRMPC design states",
+            "along the ray of the first state, halving each time (rmpc.OfflineRMPC default)",
+            "toolkit",
+        ),
         ("linear plant", "the discretised linearisation at the true inertia (in the polytope)", "toolkit"),
         ("nonlinear integration", "DOP853, rtol 1e-10, atol 1e-12, torque held over each sample", "toolkit"),
         ("saturation 'limiter'", "no constraint in the controller, per-axis clip at u_max", "toolkit"),
