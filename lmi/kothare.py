@@ -7,18 +7,20 @@ control using linear matrix inequalities", Automatica 32(10), 1361-1379, 1996.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lmi.backend_clarabel import ClarabelKothare, RawResult
-from lmi.backend_cvxpy import CvxpyKothare
 from lmi.backend_ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.status import OPTIMAL, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
+
+if TYPE_CHECKING:
+    from lmi.backend_cvxpy import CvxpyKothare
 
 __all__ = ["KothareProblem", "LMISolution"]
 
@@ -179,6 +181,8 @@ class KothareProblem:
                 raise InvalidArgumentError("solver", "None with backend='ipm'", repr(solver))
             self._backend = IPMKothare(self.data, solver_options)
         elif backend == "cvxpy":
+            from lmi.backend_cvxpy import CvxpyKothare  # cvxpy costs ~0.5 s to import
+
             self._backend = CvxpyKothare(self.data, solver or "CLARABEL", solver_options)
         else:
             raise InvalidArgumentError("backend", "'clarabel', 'ipm' or 'cvxpy'", repr(backend))

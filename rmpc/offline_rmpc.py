@@ -14,16 +14,18 @@ controller finds the smallest ``E_i`` that contains ``x`` and applies ``u = F x`
 from __future__ import annotations
 
 import time
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from lmi.offline import NestedKothareProblem, OfflineTable
 from lmi.status import INFEASIBLE, OPTIMAL
 from models import PolytopicModel
 from rmpc.controller import StepInfo
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
+
+if TYPE_CHECKING:  # lmi.offline imports cvxpy (~0.5 s); it is imported when a controller is built
+    from lmi.offline import OfflineTable
 
 __all__ = ["OUTSIDE", "OfflineRMPC"]
 
@@ -131,6 +133,8 @@ class OfflineRMPC:
         _check_bool(interpolate, "interpolate")
         self.path = check_choice(path, "path", ("ray", "trajectory"))
         self.plant = plant
+        from lmi.offline import NestedKothareProblem
+
         self.problem = NestedKothareProblem(
             plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
             output_matrix=output_matrix, y_max=y_max, solver=solver, solver_options=solver_options,

@@ -15,13 +15,15 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
-import cvxpy as cp
 import numpy as np
 
 from rmpc.qp.base import BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
+
+if TYPE_CHECKING:  # cvxpy itself is imported on set-up: it costs ~0.5 s at start-up
+    import cvxpy as cp
 
 __all__ = ["CvxpyBackend", "CvxpySettings"]
 
@@ -78,14 +80,14 @@ class CvxpyBackend(QPBackend):
     name = "cvxpy"
     settings_class = CvxpySettings
     STATUS_MAP: ClassVar[dict[Any, str]] = {
-        cp.OPTIMAL: "optimal",
-        cp.OPTIMAL_INACCURATE: "inaccurate",
-        cp.INFEASIBLE: "infeasible",
-        cp.INFEASIBLE_INACCURATE: "infeasible",
-        cp.UNBOUNDED: "unbounded",
-        cp.UNBOUNDED_INACCURATE: "unbounded",
-        cp.USER_LIMIT: "max_iterations",
-        cp.SOLVER_ERROR: "numerical_error",
+        "optimal": "optimal",
+        "optimal_inaccurate": "inaccurate",
+        "infeasible": "infeasible",
+        "infeasible_inaccurate": "infeasible",
+        "unbounded": "unbounded",
+        "unbounded_inaccurate": "unbounded",
+        "user_limit": "max_iterations",
+        "solver_error": "numerical_error",
     }
 
     def _structure(self) -> tuple[bytes, ...]:
@@ -97,6 +99,8 @@ class CvxpyBackend(QPBackend):
         return tuple(keys)
 
     def _setup(self) -> None:
+        import cvxpy as cp
+
         assert self._qp is not None
         qp, v = self._qp, self._vec
         n = qp.n_vars
@@ -133,6 +137,8 @@ class CvxpyBackend(QPBackend):
                 par.value = changed[key][idx]
 
     def _solve(self) -> QPResult:
+        import cvxpy as cp
+
         assert self._qp is not None
         start = time.perf_counter()
         try:
