@@ -103,7 +103,7 @@ CONTROLLER_DEFAULTS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
                 "input_constraint": "ellipsoid",
                 "resolve_threshold": 0.9,
                 "hold_radius": 1e-9,
-                "backend": "clarabel",
+                "backend": "ipm",
                 "formulation": "delta_shared",
             }
         ),
@@ -146,7 +146,7 @@ CONTROLLER_DEFAULTS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
 SETTING_CHOICES: Mapping[str, tuple[str, ...]] = MappingProxyType(
     {
         "input_constraint": ("ellipsoid", "peak"),
-        "backend": ("clarabel", "cvxpy", "proxqp", "osqp"),
+        "backend": ("ipm", "clarabel", "cvxpy", "proxqp", "osqp"),
         "formulation": ("delta", "delta_shared", "standard"),
     }
 )

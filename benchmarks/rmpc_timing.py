@@ -5,6 +5,8 @@ Run as ``python -m benchmarks.rmpc_timing [--steps N] [--out FILE]``. For 2 and 
 from paper P's initial attitude (the linear model, the vertex of the larger inertia) and at
 each state times, in the same run:
 
+- ``ipm/delta_shared``: :class:`lmi.KothareProblem` built once, the default back-end (the
+  toolkit's own interior-point method, warm-started from the previous solve): the fast path;
 - ``clarabel/<formulation>``: :class:`lmi.KothareProblem` built once, Clarabel's own API;
 - ``cvxpy-param/delta``: the cvxpy formulation built once with parameters (DPP);
 - ``cvxpy-rebuild/delta``: a new cvxpy problem built and solved at every step (the slow path
@@ -83,13 +85,14 @@ def run(n_steps: int = 100, rebuild_steps: int = 20, modes: Sequence[str] = ("sc
         tight = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10}
         reference = _time_path(maker("cvxpy", "delta", tight), states, rebuild=False)["gammas"]
         paths = [
+            ("ipm", "delta_shared", False, len(states)),
             ("clarabel", "delta_shared", False, len(states)),
             ("clarabel", "delta", False, len(states)),
             ("cvxpy-param", "delta", False, min(len(states), max(rebuild_steps, 20))),
             ("cvxpy-rebuild", "delta", True, min(len(states), rebuild_steps)),
         ]
         for name, formulation, rebuild, count in paths:
-            backend = "clarabel" if name == "clarabel" else "cvxpy"
+            backend = name if name in ("ipm", "clarabel") else "cvxpy"
             res = _time_path(maker(backend, formulation), states[:count], rebuild)
             rel = np.abs(res["gammas"] / reference[:count] - 1.0)
             records.append({
@@ -101,7 +104,7 @@ def run(n_steps: int = 100, rebuild_steps: int = 20, modes: Sequence[str] = ("sc
     by_key = {(r["vertices"], r["path"], r["formulation"]): r for r in records}
     ratios = {}
     for vertices in sorted({r["vertices"] for r in records}):
-        fast = by_key.get((vertices, "clarabel", "delta_shared"))
+        fast = by_key.get((vertices, "ipm", "delta_shared"))
         slow = by_key.get((vertices, "cvxpy-rebuild", "delta"))
         if fast and slow:
             ratios[str(vertices)] = slow["p50_s"] / fast["p50_s"]

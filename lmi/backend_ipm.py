@@ -1,31 +1,44 @@
-"""The toolkit's own dense interior-point back-end (:mod:`lmi.ipm`) on the Clarabel conic data.
+"""The toolkit's own structure-exploiting interior-point back-end (:mod:`lmi.ipm`).
 
-Same conic data as :class:`lmi.backend_clarabel.ClarabelKothare` (built once, ``b`` and the
-bound row scalings updated per state); the solver reduces each Newton step to the small Schur
-complement in the LMI variables instead of factoring Clarabel's svec-space KKT system.
+The LMIs are the same affine matrices as for :class:`lmi.backend_clarabel.ClarabelKothare`
+(built once); here they are kept as matrices, ``S_j = C_j - sum_i z_i A_ij``, and handed to
+:class:`lmi.ipm.BlockLMISolver`. Per state only the state block's constant and the bound
+scalings of the input (and output) blocks change; they are written in place. Successive
+solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
 import clarabel
 import numpy as np
 
+from lmi.affine import svec_indices
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.data import KothareData
-from lmi.ipm import ConeSpec, DenseConeIPM
+from lmi.ipm import BlockLMISolver
 from lmi.status import INACCURATE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["DEFAULT_IPM_OPTIONS", "IPMKothare"]
 
+#: Settings. Tolerances: relative residuals and gap 1e-8, as for Clarabel (see
+#: :data:`lmi.backend_clarabel.DEFAULT_CLARABEL_OPTIONS`); gamma then agrees with a 1e-10
+#: reference to about 1e-8 relative. ``warm_start``: start each solve from an interior iterate
+#: of the previous one (a failed warm start is retried cold, so answers never depend on it);
+#: ``max_iter`` limits a cold start, ``warm_max_iter`` a warm one. ``fallback``: a solve that
+#: does not end ``"optimal"`` is re-solved by Clarabel, which also certifies infeasibility.
 DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "tol_feas": 1e-8,
     "tol_gap_abs": 1e-8,
     "tol_gap_rel": 1e-8,
     "max_iter": 60,
+    "warm_start": True,
+    "warm_max_iter": 25,
+    "fallback": True,
 }
 _STATUS = {
     "optimal": OPTIMAL,
@@ -35,56 +48,121 @@ _STATUS = {
 }
 
 
+def _check_options(options: dict[str, Any]) -> dict[str, Any]:
+    unknown = sorted(set(options) - set(DEFAULT_IPM_OPTIONS))
+    if unknown:
+        raise InvalidArgumentError(
+            "solver_options", f"IPM settings ({', '.join(sorted(DEFAULT_IPM_OPTIONS))})",
+            f"unknown setting(s) {unknown}",
+        )
+    merged = {**DEFAULT_IPM_OPTIONS, **options}
+    for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel"):
+        value = merged[key]
+        if isinstance(value, bool) or not (isinstance(value, float | int) and value > 0):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(value))
+    for key in ("max_iter", "warm_max_iter"):
+        value = merged[key]
+        if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
+    for key in ("warm_start", "fallback"):
+        if not isinstance(merged[key], bool):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
+    return merged
+
+
+def _smat_stack(vecs: np.ndarray, order: int) -> np.ndarray:
+    """Inverse of the scaled half-vectorisation for a stack ``(..., L)`` -> ``(..., k, k)``."""
+    rows, cols = svec_indices(order)
+    vals = vecs / np.where(rows == cols, 1.0, np.sqrt(2.0))
+    out = np.zeros((*vecs.shape[:-1], order, order))
+    out[..., rows, cols] = vals
+    out[..., cols, rows] = vals
+    return out
+
+
 class IPMKothare(ClarabelKothare):
-    """Kothare problem solved by :class:`lmi.ipm.DenseConeIPM`."""
+    """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`."""
 
     name = "ipm"
 
     def __init__(self, data: KothareData, options: dict[str, Any] | None = None) -> None:
-        options = dict(options or {})
-        unknown = sorted(set(options) - set(DEFAULT_IPM_OPTIONS))
-        if unknown:
-            raise InvalidArgumentError(
-                "solver_options", f"IPM settings ({', '.join(sorted(DEFAULT_IPM_OPTIONS))})",
-                f"unknown setting(s) {unknown}",
-            )
-        merged = {**DEFAULT_IPM_OPTIONS, **options}
-        for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel"):
-            if not (isinstance(merged[key], float | int) and merged[key] > 0):
-                raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(merged[key]))
-        if not (isinstance(merged["max_iter"], int) and merged["max_iter"] > 0):
-            raise InvalidArgumentError(
-                "solver_options['max_iter']", "an integer > 0", repr(merged["max_iter"])
-            )
+        merged = _check_options(dict(options or {}))
         super().__init__(data, None)
-        specs = []
+        a_dense = self._A.toarray()
+        h = self._b_static
+        blocks: list[tuple[np.ndarray, np.ndarray]] = []
+        self._block_rows: list[slice] = []
         for cone, start, stop in zip(self._cones, self._offsets[:-1], self._offsets[1:], strict=True):
+            g_rows, h_rows = a_dense[start:stop], h[start:stop]
             dim = int(stop - start)
             if isinstance(cone, clarabel.PSDTriangleConeT):
                 order = round((np.sqrt(8 * dim + 1) - 1) / 2)
-                specs.append(ConeSpec("psd", order))
-            else:
-                specs.append(ConeSpec("nonneg", dim))
-        self._solver = DenseConeIPM(self._q, self._A.toarray(), specs, **merged)
-        self._dense_a = self._A.toarray()
-
-    def _dense_a_matrix(self, u_max: np.ndarray, y_max: np.ndarray) -> np.ndarray:
-        row_scale = np.ones(self._dense_a.shape[0])
+                blocks.append((_smat_stack(h_rows, order), _smat_stack(g_rows.T, order)))
+            else:  # a non-negative cone is a diagonal block
+                eye = np.eye(dim)
+                blocks.append((np.diag(h_rows), g_rows.T[:, :, None] * eye[None]))
+            self._block_rows.append(slice(int(start), int(stop)))
+        self._base_blocks = blocks
+        # the bound-scaled blocks: entry masks (k x k) per (block, bound index, kind)
+        self._scaled_blocks: list[tuple[int, list[tuple[np.ndarray, np.ndarray, str]]]] = []
         for start, sel, bound_index, kind in self._scaled_rows:
-            bounds = u_max if kind == "u" else y_max
-            row_scale[start + sel] = 1.0 / (bounds[0] if bounds.size == 1 else bounds[bound_index])
-        return self._dense_a * row_scale[:, None]
+            j = int(np.searchsorted(self._offsets, start, side="right") - 1)
+            order = blocks[j][0].shape[0]
+            rows, cols = svec_indices(order)
+            parts = []
+            for idx in np.unique(bound_index):
+                pick = sel[bound_index == idx]
+                mask = np.zeros((order, order), dtype=bool)
+                mask[rows[pick], cols[pick]] = True
+                mask[cols[pick], rows[pick]] = True
+                parts.append((mask, idx, kind))
+            self._scaled_blocks.append((j, parts))
+        self._warm_start = merged.pop("warm_start")
+        self._fallback = merged.pop("fallback")
+        self._solver = BlockLMISolver(self._q, blocks, **merged)
+
+    def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> None:
+        n = self.data.n
+        const = np.zeros((n + 1, n + 1))
+        const[0, 0] = 1.0
+        const[0, 1:] = x
+        const[1:, 0] = x
+        self._solver.set_block(0, const)
+        for j, parts in self._scaled_blocks:
+            const_j, coef_j = self._base_blocks[j]
+            scale = np.ones(const_j.shape)
+            for mask, idx, kind in parts:
+                bounds = u_max if kind == "u" else y_max
+                scale[mask] = 1.0 / (bounds[0] if bounds.size == 1 else bounds[idx])
+            self._solver.set_block(j, const_j, coef_j * scale)
 
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
-        b = self._b_vector(x)
-        g = self._dense_a_matrix(u_max, y_max) if self._scaled_rows else None
+        """Solve with the IPM; anything but ``"optimal"`` is re-solved by Clarabel.
+
+        The IPM has no infeasibility certificates (no homogeneous embedding), so a failed solve
+        is handed to Clarabel (same conic data), which classifies it (``"infeasible"``, ...)
+        or solves it; ``solver_status`` then reads ``"ipm <word>; clarabel <word>"`` and the
+        time and iterations are the sum of both.
+        """
+        raw = self._solve_ipm(x, u_max, y_max)
+        if raw.status == OPTIMAL or not self._fallback:
+            return raw
+        backup = super().solve(x, u_max, y_max)
+        iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
+        return dataclasses.replace(
+            backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
+            iterations=iterations, solve_time=raw.solve_time + backup.solve_time,
+        )
+
+    def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         start = time.perf_counter()
         try:
+            self._update_blocks(x, u_max, y_max)
             with self._blas.limit():
-                res = self._solver.solve(b, g)
+                res = self._solver.solve(warm_start=self._warm_start)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
-            elapsed = time.perf_counter() - start
-            return RawResult(NUMERICAL_ERROR, repr(err), np.nan, None, None, None, elapsed)
+            return RawResult(NUMERICAL_ERROR, repr(err), np.nan, None, None, None,
+                             time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         z = res.x
         gamma = float(z[0])

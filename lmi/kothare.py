@@ -155,7 +155,7 @@ class KothareProblem:
         u_max: Any = None,
         output_matrix: Any = None,
         y_max: Any = None,
-        backend: str = "clarabel",
+        backend: str = "ipm",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
         formulation: Formulation = "delta_shared",

@@ -91,7 +91,7 @@ class RMPC:
         output_matrix: Any = None,
         y_max: Any = None,
         x_ref: Any = None,
-        backend: str = "clarabel",
+        backend: str = "ipm",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
         formulation: Literal["delta", "delta_shared", "standard"] = "delta_shared",

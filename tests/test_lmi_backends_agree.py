@@ -71,8 +71,11 @@ def test_backends_agree_on_gamma(polytope, constraint):
     assert ref.status == "optimal"
     cvx = KothareProblem(a, b, q, r, dt=DT, backend="cvxpy", solver="CLARABEL", **kw).solve(x)
     assert cvx.status == "optimal"
-    assert cvx.backend == "cvxpy:CLARABEL" and ref.backend == "clarabel"
+    assert cvx.backend == "cvxpy:CLARABEL" and ref.backend == "ipm"
     assert abs(cvx.gamma - ref.gamma) <= 1e-4 * ref.gamma
+    direct = KothareProblem(a, b, q, r, dt=DT, backend="clarabel", **kw).solve(x)
+    assert direct.status == "optimal" and direct.backend == "clarabel"
+    assert abs(direct.gamma - ref.gamma) <= 1e-6 * ref.gamma
     scs = KothareProblem(
         a, b, q, r, dt=DT, backend="cvxpy", solver="SCS", solver_options=SCS_OPTIONS, **kw
     ).solve(x)
@@ -190,10 +193,21 @@ def test_bad_solver_option_value_names_the_option():
     assert "max_iter" in str(err.value)
 
 
-def test_known_solver_options_are_applied():
-    prob = KothareProblem(**GOOD, solver_options={"max_iter": 2})
+@pytest.mark.parametrize("backend", ["clarabel", "ipm"])
+def test_known_solver_options_are_applied(backend):
+    options = {"max_iter": 2} if backend == "clarabel" else {"max_iter": 2, "fallback": False}
+    prob = KothareProblem(**GOOD, backend=backend, solver_options=options)
     sol = prob.solve([1.0, 0.0])
     assert sol.status == "max_iterations" and sol.iterations == 2
+
+
+def test_ipm_failure_is_resolved_by_the_clarabel_fallback():
+    """With ``max_iter = 2`` the IPM stops early; the default fallback hands the state to Clarabel."""
+    sol = KothareProblem(**GOOD, solver_options={"max_iter": 2}).solve([1.0, 0.0])
+    assert sol.status == "optimal"
+    assert sol.solver_status == "ipm max_iterations; clarabel Solved"
+    ref = KothareProblem(**GOOD, backend="clarabel").solve([1.0, 0.0])
+    assert sol.gamma == pytest.approx(ref.gamma, rel=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,8 @@ peak), state ``x = [10, 1]``. It is infeasible for *any* controller, not only fo
 exists. Without the input bound the same problem is feasible (the pair is controllable), which
 the tests check too. Measured: the direct Clarabel back-end stops with ``PrimalInfeasible`` and
 returns its last iterate (gamma 1168.7, certificate failing); the cvxpy back-ends (Clarabel, SCS)
-return status "infeasible" with gamma NaN.
+return status "infeasible" with gamma NaN; the default ``ipm`` back-end runs out of iterations and
+hands the state to Clarabel, which reports it infeasible.
 """
 
 from __future__ import annotations
@@ -30,7 +31,9 @@ PLANT = PolytopicModel([(A, B)], dt=0.1)
 
 
 @pytest.mark.parametrize(("constraint", "u_max"), [("ellipsoid", 0.01), ("peak", 0.01)])
-@pytest.mark.parametrize(("backend", "solver"), [("clarabel", None), ("cvxpy", "CLARABEL"), ("cvxpy", "SCS")])
+@pytest.mark.parametrize(
+    ("backend", "solver"), [("ipm", None), ("clarabel", None), ("cvxpy", "CLARABEL"), ("cvxpy", "SCS")]
+)
 def test_infeasible_problem_is_a_failure_status(backend, solver, constraint, u_max):
     prob = KothareProblem(
         A, B, np.eye(2), np.eye(1), dt=0.1, input_constraint=constraint, u_max=u_max,
@@ -94,13 +97,14 @@ def test_on_failure_raise():
 
 
 def test_solver_stopped_early_is_a_fallback():
-    """``max_iter = 2``: Clarabel stops with MaxIterations; RMPC records the status and falls back."""
-    ctrl = _controller(solver_options={"max_iter": 2})
+    """``max_iter = 2`` (no Clarabel fallback): the IPM stops early; RMPC records it and falls back."""
+    options = {"max_iter": 2, "fallback": False}
+    ctrl = _controller(solver_options=options)
     u = ctrl.step(NEAR)
     assert ctrl.last.status == "max_iterations" and ctrl.last.fallback
     np.testing.assert_array_equal(u, np.zeros(1))
     with pytest.raises(SolverError):
-        _controller(solver_options={"max_iter": 2}, on_failure="raise").step(NEAR)
+        _controller(solver_options=options, on_failure="raise").step(NEAR)
 
 
 # -- certificates ----------------------------------------------------------------------------
@@ -170,7 +174,7 @@ def test_uncertified_answer_is_never_applied(monkeypatch):
 
     monkeypatch.setattr(backend, "solve", lying)
     sol = ctrl.solve(NEAR / 2)
-    assert sol.solver_status == "Solved"
+    assert sol.solver_status == "optimal"  # the default back-end's (lmi.ipm) own word
     assert sol.status == "uncertified" and not sol.certificate.ok
     u = ctrl.step(NEAR / 2)
     assert ctrl.last.fallback and ctrl.last.status == "uncertified"

@@ -35,15 +35,18 @@ def test_ipm_one_vertex_unconstrained_is_lqr(seed):
     k, p, _ = control.dlqr(a, b, np.eye(4), np.eye(2))
     x = rng.normal(size=4)
     sol = KothareProblem(a, b, np.eye(4), np.eye(2), input_constraint=None, backend="ipm").solve(x)
-    assert sol.status in ("optimal", "inaccurate")
+    assert sol.status == "optimal"
     assert sol.gamma == pytest.approx(float(x @ p @ x), rel=1e-6)
-    # F is first-order sensitive to the iterate while gamma is second-order: at the default
-    # tolerances (1e-8) the gain agrees with dlqr to about 5e-3 (measured), not 1e-4.
-    np.testing.assert_allclose(sol.F, -k, rtol=1e-2, atol=1e-4)
+    # F (and P) are not unique at the optimum: any P with x'Px = x'P_lqr x that satisfies the
+    # Riccati inequality is optimal, and an interior-point method returns one inside that face
+    # (measured: F up to 2 % from dlqr's). What must hold is P >= P_lqr, the least solution.
+    gap = np.linalg.eigvalsh(sol.P - p)
+    assert gap[0] >= -1e-6 * np.max(np.abs(gap))
+    del k
 
 
-def test_ipm_failures_are_statuses_on_the_8_vertex_problem():
-    """Known limit: on the 8-vertex box some solves stall (``numerical_error``); never a crash."""
+def test_ipm_solves_the_8_vertex_problem():
+    """Every 8-vertex solve is optimal, certified and agrees with Clarabel."""
     sat = RigidSatellite.paper_p()
     x0 = sat.initial_state()
     poly = sat.polytope(x0, 0.01, 0.3, "box")
@@ -54,10 +57,9 @@ def test_ipm_failures_are_statuses_on_the_8_vertex_problem():
     for _ in range(4):
         x = x0 + rng.normal(size=6) * np.r_[0.1, 0.1, 0.1, 0.05, 0.05, 0.05]
         got = ipm.solve(x)
-        assert got.status in ("optimal", "inaccurate", "numerical_error", "max_iterations")
-        if got.status == "optimal":
-            assert got.certificate.ok
-            assert got.gamma == pytest.approx(ref.solve(x).gamma, rel=1e-5)
+        assert got.status == "optimal"
+        assert got.certificate.ok
+        assert got.gamma == pytest.approx(ref.solve(x).gamma, rel=1e-5)
 
 
 @pytest.mark.parametrize("mode", ["scalar"])
@@ -72,7 +74,7 @@ def test_ipm_agrees_with_clarabel_on_paper_p(mode):
     for _ in range(4):
         x = x0 + rng.normal(size=6) * np.r_[0.1, 0.1, 0.1, 0.05, 0.05, 0.05]
         got, want = ipm.solve(x), ref.solve(x)
-        assert got.status in ("optimal", "inaccurate")
+        assert got.status == "optimal"
         assert got.certificate.ok
         assert got.gamma == pytest.approx(want.gamma, rel=1e-6)
 
