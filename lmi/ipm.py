@@ -243,6 +243,7 @@ class BlockLMISolver:
         bounds = np.cumsum([0, *sizes])
         self._p_rows = [slice(int(lo), int(hi)) for lo, hi in itertools.pairwise(bounds)]
         self._p_buf = np.empty((int(bounds[-1]), n))
+        self._build_pack_maps()
         for j, (const, coef) in enumerate(checked):
             self.set_block(j, const, coef)
 
@@ -438,26 +439,45 @@ class BlockLMISolver:
 
     def _pack(self, mats: list[np.ndarray]) -> np.ndarray:
         """Scaled half-vectorisation of the stacks ``(..., c, k, k)``, entries ordered (entry, block)."""
-        return np.concatenate([
-            np.swapaxes(m[..., st.iu0, st.iu1] * st.w, -1, -2).reshape(*m.shape[:-3], -1)
-            for m, st in zip(mats, self._stacks, strict=True)
-        ], axis=-1)
+        lead = mats[0].shape[:-3]
+        flat = np.concatenate([m.reshape(*lead, -1) for m in mats], axis=-1)
+        return np.take(flat, self._pack_index, axis=-1) * self._pack_weight
 
     def _unpack(self, vec: np.ndarray) -> list[np.ndarray]:
-        """Inverse of :meth:`_pack` for ``(..., total)`` -> per stack ``(..., c, k, k)``."""
-        out = []
-        offset = 0
+        """Inverse of :meth:`_pack` for ``(..., total)`` -> per stack ``(..., c, k, k)`` (views)."""
         lead = vec.shape[:-1]
+        full = np.take(vec, self._unpack_index, axis=-1) * self._unpack_weight
+        return [full[..., sl].reshape(*lead, st.count, st.order, st.order)
+                for sl, st in zip(self._full_slices, self._stacks, strict=True)]
+
+    def _build_pack_maps(self) -> None:
+        """Index maps between the packed vector and the stacks' full entries, all stacks at once."""
+        pack_index, pack_weight, unpack_index, unpack_weight = [], [], [], []
+        self._full_slices = []
+        full_offset = packed_offset = 0
         for st in self._stacks:
-            size = st.iu0.shape[0] * st.count
-            seg = vec[..., offset : offset + size].reshape(*lead, -1, st.count)
-            vals = np.swapaxes(seg, -1, -2) / st.w
-            offset += size
-            mat = np.empty((*lead, st.count, st.order, st.order))
-            mat[..., st.iu0, st.iu1] = vals
-            mat[..., st.iu1, st.iu0] = vals
-            out.append(mat)
-        return out
+            c, k = st.count, st.order
+            n_entries = st.iu0.shape[0]
+            # packed position (l, b) <- full position (b, iu0[l], iu1[l])
+            l_idx, b_idx = np.meshgrid(np.arange(n_entries), np.arange(c), indexing="ij")
+            pack_index.append(full_offset + np.ravel_multi_index((b_idx, st.iu0[l_idx], st.iu1[l_idx]),
+                                                                 (c, k, k)).ravel())
+            pack_weight.append(np.repeat(st.w, c))
+            # full position (b, p, q) <- packed position of (min(p, q), max(p, q)), block b
+            entry = np.zeros((k, k), dtype=int)
+            entry[st.iu0, st.iu1] = np.arange(n_entries)
+            entry[st.iu1, st.iu0] = np.arange(n_entries)
+            weight = np.where(np.eye(k, dtype=bool), 1.0, 1.0 / np.sqrt(2.0))
+            b_full = np.arange(c)[:, None, None]
+            unpack_index.append((packed_offset + entry[None] * c + b_full).ravel())
+            unpack_weight.append(np.broadcast_to(weight, (c, k, k)).ravel())
+            self._full_slices.append(slice(full_offset, full_offset + c * k * k))
+            full_offset += c * k * k
+            packed_offset += n_entries * c
+        self._pack_index = np.concatenate(pack_index)
+        self._pack_weight = np.concatenate(pack_weight)
+        self._unpack_index = np.concatenate(unpack_index)
+        self._unpack_weight = np.concatenate(unpack_weight)
 
 
 # -- helpers -------------------------------------------------------------------------------
