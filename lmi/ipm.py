@@ -258,7 +258,7 @@ class BlockLMISolver:
 
     def set_block(self, j: int, const: np.ndarray, coef: np.ndarray | None = None) -> None:
         """Replace block ``j``'s constant (and coefficients, if given)."""
-        if not (isinstance(j, int | np.integer) and 0 <= j < len(self.block_orders)):
+        if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < len(self.block_orders)):
             raise InvalidArgumentError("j", f"a block index in [0, {len(self.block_orders)})", repr(j))
         const_c, coef_c = _check_block(int(j), const, coef, self.n, self.block_orders[j])
         si, pos = self._where[j]

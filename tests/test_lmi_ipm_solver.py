@@ -381,6 +381,7 @@ BAD_SET_BLOCK = {
     "index too large": (lambda: (2, np.eye(3), None), r"^j:"),
     "negative index": (lambda: (-1, np.eye(2), None), r"^j:"),
     "float index": (lambda: (0.0, np.eye(2), None), r"^j:"),
+    "bool index": (lambda: (True, np.eye(3), None), r"^j:"),
     "C of another order": (lambda: (0, np.eye(3), None), r"blocks\[0\] C"),
     "A of wrong shape": (lambda: (1, np.eye(3), np.zeros((3, 2, 2))), r"blocks\[1\] A"),
     "NaN in C": (lambda: (1, np.full((3, 3), np.nan), None), r"blocks\[1\] C"),
