@@ -50,9 +50,11 @@ _LOG = logging.getLogger(__name__)
 #: ``"inaccurate"`` (Clarabel's ``AlmostSolved``).
 REDUCED_TOL = 1e-6
 
-#: The Newton system is solved by Cholesky of the Schur complement until the ratio of the
-#: smallest to the largest diagonal entry of its factor falls below this, then by a QR
-#: factorisation of the scaled coefficients (accurate to the end, about twice the cost).
+#: The Newton system is solved by Cholesky of the Schur complement ``H`` until a pivot falls
+#: below this fraction of ``sqrt(H_jj)`` (a scale-invariant measure of the accuracy lost), then,
+#: for the rest of the solve, by a QR factorisation of the scaled coefficients ``P`` (about twice
+#: the cost; it does not square ``P``'s condition number). Measured on paper P: 1e-6 gave the
+#: fewest iterations; 1e-7 and below cost 2 more iterations per solve at 2 vertices.
 QR_SWITCH = 1e-6
 
 #: Cost model of the default stacking (see :func:`_default_levels`).
@@ -581,14 +583,17 @@ def _factor(p_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
     """Upper factor ``R`` with ``R'R = P'P``; switches to QR for good once Cholesky degrades.
 
     ``H = P'P`` squares ``P``'s condition number, which grows like ``1/mu`` near the optimum;
-    once the Cholesky factor's diagonal ratio falls below :data:`QR_SWITCH` (or Cholesky
+    once a relative pivot of the Cholesky factor falls below :data:`QR_SWITCH` (or Cholesky
     fails), ``P`` itself is factored.
     """
     r_fac = None
     if not use_qr:
-        r_fac, info = dpotrf(p_mat.T @ p_mat, lower=0, clean=1)
-        diag = np.abs(np.diag(r_fac))
-        if info != 0 or float(np.min(diag)) < QR_SWITCH * float(np.max(diag)):
+        hmat = p_mat.T @ p_mat
+        r_fac, info = dpotrf(hmat, lower=0, clean=1)
+        # the pivots relative to sqrt(H_jj) (invariant to the scaling of the variables): how
+        # much of each column is new, i.e. the loss of accuracy of the Cholesky factor
+        rel = np.abs(np.diag(r_fac)) / np.sqrt(np.maximum(np.diag(hmat), 1e-300))
+        if info != 0 or float(np.min(rel)) < QR_SWITCH:
             use_qr, r_fac = True, None
     if r_fac is None:
         r_fac = np.linalg.qr(p_mat, mode="r")
