@@ -175,6 +175,11 @@ class BlockLMISolver:
         For data of the wrong shape, non-finite or non-symmetric data, or bad settings; the
         message names the argument.
 
+    Notes
+    -----
+    An instance keeps work buffers and the warm-start point between solves: use one instance
+    per thread (each :class:`lmi.KothareProblem` has its own).
+
     Examples
     --------
     The largest eigenvalue of ``M`` is ``min t`` subject to ``t I - M >= 0``:
