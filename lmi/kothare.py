@@ -111,9 +111,10 @@ class KothareProblem:
     output_matrix, y_max : array_like, optional
         Output constraints ``|(C x(k+i))_r| <= y_max_r`` for ``i >= 1`` (Kothare 1996, sec. 3.2).
     backend : str
-        ``"clarabel"`` (Clarabel's own API, data built once; default), ``"ipm"``
-        (experimental: the toolkit's own dense interior-point method :mod:`lmi.ipm` on the same
-        conic data, :mod:`lmi.backend_ipm`) or ``"cvxpy"`` with ``solver`` naming any installed
+        ``"ipm"`` (default: the toolkit's own structure-exploiting interior-point method
+        :mod:`lmi.ipm`, data built once, warm-started, any non-optimal solve handed to Clarabel;
+        :mod:`lmi.backend_ipm`), ``"clarabel"`` (Clarabel's own API, data built once) or
+        ``"cvxpy"`` with ``solver`` naming any installed
         cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
     solver : str, optional
         The cvxpy solver for ``backend="cvxpy"`` (default ``"CLARABEL"``).
@@ -189,7 +190,7 @@ class KothareProblem:
 
     @property
     def backend(self) -> str:
-        """Name of the back-end (``"clarabel"`` or ``"cvxpy:SOLVER"``)."""
+        """Name of the back-end (``"ipm"``, ``"clarabel"`` or ``"cvxpy:SOLVER"``)."""
         return self._backend.name
 
     @property
