@@ -23,11 +23,11 @@ A sweep file has up to five top-level entries, all optional::
 Each grid point is repeated for the ``n`` draws: the true principal inertias are
 ``J0_i (1 + spread u_i)`` with ``u`` uniform in ``[-1, 1]^3`` (one common ``u`` in
 ``"scalar"`` mode), from ``numpy.random.default_rng(seed)``; every grid point gets the same
-draws. Cases are keyed by :attr:`Scenario.case_id`, so re-running a sweep skips the cases its
-store already holds and a grid that repeats a case runs it once. A ``settings`` table may hold
-settings of several controllers (each case takes those of its own controller); grid
-combinations a controller cannot run (LQR with ``saturation = "constraint"``) are left out and
-listed in ``results.md``.
+draws. Cases are keyed by :attr:`benchmarks.scenario.Scenario.case_id`, so re-running a sweep
+skips the cases its store already holds and a grid that repeats a case runs it once. A
+``settings`` table may hold settings of several controllers (each case takes those of its own
+controller); grid combinations a controller cannot run (LQR with ``saturation = "constraint"``)
+are left out and listed in ``results.md``.
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def resolve_config(path: str | Path) -> Path:
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
-    """Read and validate a sweep file (:class:`ConfigError` naming the field on any problem).
+    """Read and validate a sweep file (a :class:`~toolkit_common.errors.ConfigError` names the field).
 
     ``path`` may also name a shipped sweep (``"smoke"``, see :func:`resolve_config`).
     """
@@ -229,7 +229,7 @@ def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:
 
     A combination a controller cannot run (LQR with ``saturation = "constraint"``) is left out
     and listed; if that leaves nothing, or a combination is impossible otherwise, it raises
-    :class:`ConfigError` naming the field (``grid.<field>`` when the grid sets it).
+    :class:`~toolkit_common.errors.ConfigError` naming the field (``grid.<field>`` when the grid sets it).
     """
     keys = list(spec.grid)
     points, dropped = [], []

@@ -78,7 +78,7 @@ class RawResult:
 def clarabel_settings(options: dict[str, Any] | None) -> Any:
     """Clarabel ``DefaultSettings`` from the defaults above and ``options``.
 
-    Unknown keys raise :class:`InvalidArgumentError` naming them.
+    Unknown keys raise :class:`~toolkit_common.errors.InvalidArgumentError` naming them.
     """
     settings = clarabel.DefaultSettings()
     known = {name for name in dir(settings) if not name.startswith("_") and name != "default"}

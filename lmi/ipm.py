@@ -19,7 +19,7 @@ predictor-corrector, as in Vandenberghe's CVXOPT ``coneqp`` (L. Vandenberghe, "T
 linear and quadratic cone program solvers", 2010), without the homogeneous self-dual embedding:
 an infeasible or unbounded problem ends as ``"max_iterations"`` or ``"numerical_error"``, never
 as a wrong ``"optimal"``. The NT scaling of each block comes from one Cholesky factor and one
-small symmetric eigen-decomposition (:func:`_nt_scaling`, as in SDPT3). Variables are
+small symmetric eigen-decomposition (``_nt_scaling``, as in SDPT3). Variables are
 equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is factored by Cholesky until it
 becomes ill-conditioned near the optimum, then through a QR factorisation of ``P`` (which does
 not square the condition number); each Newton solve is iteratively refined on the exact
@@ -57,7 +57,7 @@ REDUCED_TOL = 1e-6
 #: fewest iterations; 1e-7 and below cost 2 more iterations per solve at 2 vertices.
 QR_SWITCH = 1e-6
 
-#: Cost model of the default stacking (see :func:`_default_levels`).
+#: Cost model of the default stacking (see ``_default_levels``).
 STACK_OVERHEAD_US = 90.0
 BLOCK_FLOP_US = 0.02
 
@@ -166,7 +166,7 @@ class BlockLMISolver:
         took 8-10 iterations per solve against 16-20 cold; ``1e-1`` took 10-11, ``1e-3`` 13.
     stack_orders : sequence of int, optional
         The orders blocks are padded to (each block goes into the smallest listed order that
-        holds it). Default: chosen by a cost model (:func:`_default_levels`); for paper P's
+        holds it). Default: chosen by a cost model (``_default_levels``); for paper P's
         problem, orders 12 and 15.
 
     Raises
@@ -276,7 +276,7 @@ class BlockLMISolver:
         """Solve with the current data.
 
         With ``warm_start``, start from the iterate the previous solve passed through at a
-        relative gap of :attr:`warm_gap` (an interior, roughly centred point) instead of the
+        relative gap of ``warm_gap`` (an interior, roughly centred point) instead of the
         default initial point; the residuals the new data cause are handled like any
         infeasible start. A warm start that fails is retried cold.
         """

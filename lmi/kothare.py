@@ -119,7 +119,7 @@ class KothareProblem:
     solver : str, optional
         The cvxpy solver for ``backend="cvxpy"`` (default ``"CLARABEL"``).
     solver_options : dict, optional
-        Solver settings; unknown names raise :class:`InvalidArgumentError`.
+        Solver settings; unknown names raise :class:`~toolkit_common.errors.InvalidArgumentError`.
     formulation : {"delta_shared", "delta", "standard"}
         Default ``"delta_shared"``. ``"delta"`` rewrites the vertex LMIs with ``(A_j - I)/dt``
         (a congruence; same optimum, better conditioned at small ``dt``); ``"delta_shared"``

@@ -70,17 +70,17 @@ class CRMPC:
         Passed to the inner :class:`~rmpc.RMPC` (weights, input bound and its kind).
     adaptation_gain : float, optional
         The MIT-rule gain ``gamma_a`` (>= 0; 0 turns the adaptation off and leaves plain
-        RMPC). Default: :data:`DEFAULT_GAIN_NORMALIZED` (20 1/s) for the normalised rule,
-        :data:`DEFAULT_GAIN_PLAIN` (0.3) for the plain rule.
+        RMPC). Default: ``DEFAULT_GAIN_NORMALIZED`` (20 1/s) for the normalised rule,
+        ``DEFAULT_GAIN_PLAIN`` (0.3) for the plain rule.
     normalized : bool
         Use the normalised MIT rule (default). The sensitivity grows like ``t^2`` inside a
         reset window, so the plain rule's speed varies by orders of magnitude across it and
         the plain rule is unstable at gains the normalised rule takes in its stride.
     alpha : float
-        Regularisation of the normalised rule (default :data:`DEFAULT_ALPHA`).
+        Regularisation of the normalised rule (default ``DEFAULT_ALPHA``).
     reset_period : float or None
         Reset the reference model to the measured state (and the sensitivity filter to
-        zero) every this many seconds (default :data:`DEFAULT_RESET_PERIOD` = 2 s); rounded
+        zero) every this many seconds (default ``DEFAULT_RESET_PERIOD`` = 2 s); rounded
         to whole samples. ``None``: only at the first step after :meth:`reset`.
     reference_gain : (m, n) array_like, optional
         ``None`` (default): the reference model is driven by the RMPC's own control (see the

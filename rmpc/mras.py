@@ -308,7 +308,7 @@ class Example52Result:
     def settling_time(self, tol: float, sampled: bool = False) -> float:
         """The first time after which both gains stay within ``tol`` of the target (inf if never).
 
-        ``sampled=True`` measures against :attr:`target_sampled` instead of :attr:`target`.
+        ``sampled=True`` measures against ``target_sampled`` instead of ``target``.
         """
         target = self.target_sampled if sampled else self.target
         err = np.max(np.abs(self.theta - np.asarray(target)), axis=1)
