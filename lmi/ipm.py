@@ -393,6 +393,8 @@ class BlockLMISolver:
             dx, dst, dzt = newton(self._pack(u_cor))
             d_cor = self._unpack(np.stack([dst, dzt]))
             alpha = min(1.0, 0.99 * _max_step(lams, d_cor))
+            if debug:
+                _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
             if not np.isfinite(alpha) or alpha <= 1e-12:
                 status = "numerical_error"
                 break
