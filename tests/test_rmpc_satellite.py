@@ -5,17 +5,19 @@ Setup: ``RigidSatellite.paper_p()``, linearised at paper P's initial attitude
 (scalar: 2 vertices; box: 8), ``Q1 = diag(1, 1, 1, 0.1, 0.1, 0.1)``, ``R = I``,
 ``||u||_2 <= 1`` N m.
 
-Measured: 50 random states (attitude within +-0.1 rad, rates within +-0.05 rad/s of the
-initial state) all "optimal", worst relative LMI margin -6.0e-9, largest ||F x|| 0.79 N m,
-40-140 ms per solve (median; on a loaded 2-core machine); box mode, 10 states: all "optimal",
-worst margin -1.5e-9, 0.2-0.3 s per solve.
+Measured with the default back-end (``ipm``; every solve its own, no Clarabel fallback): 50
+random states (attitude within +-0.1 rad, rates within +-0.05 rad/s of the initial state) all
+"optimal", worst relative LMI margin -5.4e-10, largest ||F x|| 0.786 N m, median 11.5 ms per
+solve (8-24 ms; random states warm-start less well than a closed loop); box mode, 10 states:
+all "optimal", worst margin -2.0e-11, median 21 ms (15-30 ms). With Clarabel these took 40-140
+ms and 0.2-0.3 s (worst margins -6.0e-9 and -1.5e-9).
 
 Closed loops with ``resolve_threshold=0.9`` over 25 s (2500 steps): on the linear model at the
 heavy vertex (J x 1.3) the attitude error stays below 1e-3 rad from t = 16.51 s on, 7.5e-4 at
-20 s, 1.5e-4 at 25 s, with 151 solves; on the nonlinear satellite from 16.33 s on, 4.1e-4 at
-20 s, 6.9e-5 at 25 s, with 164 solves. The largest ||u||_2 is 0.659 N m (the first step). No
-fallback. Asserted: below 1e-3 rad from 20 s on and below 5e-4 rad at 25 s; at most 300 solves.
-Each loop takes 10-20 s here.
+20 s, 1.5e-4 at 25 s, with 151 solves; on the nonlinear satellite from 16.33 s on, 4.0e-4 at
+20 s, 6.9e-5 at 25 s, with 164 solves (the same as with Clarabel). The largest ||u||_2 is
+0.659 N m (the first step). No fallback. Asserted: below 1e-3 rad from 20 s on and below 5e-4
+rad at 25 s; at most 300 solves. Each loop takes 1.4-2.5 s here (10-20 s with Clarabel).
 """
 
 from __future__ import annotations
