@@ -46,6 +46,7 @@ _STATUS = {
     "inaccurate": INACCURATE,
     "max_iterations": MAX_ITERATIONS,
     "numerical_error": NUMERICAL_ERROR,
+    "insufficient_progress": NUMERICAL_ERROR,
 }
 
 

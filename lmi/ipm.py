@@ -17,10 +17,10 @@ work arrays are allocated once.
 Algorithm: infeasible-start path following with Nesterov-Todd scaling and Mehrotra's
 predictor-corrector, as in Vandenberghe's CVXOPT ``coneqp`` (L. Vandenberghe, "The CVXOPT
 linear and quadratic cone program solvers", 2010), without the homogeneous self-dual embedding:
-an infeasible or unbounded problem ends as ``"max_iterations"`` or ``"numerical_error"``, never
-as a wrong ``"optimal"``. The NT scaling of each block comes from one Cholesky factor and one
-small symmetric eigen-decomposition (``_nt_scaling``, as in SDPT3). Variables are
-equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is factored by Cholesky until it
+an infeasible or unbounded problem ends as ``"insufficient_progress"``, ``"max_iterations"`` or
+``"numerical_error"``, never as a wrong ``"optimal"``. The NT scaling of each block comes from
+one Cholesky factor and one small symmetric eigen-decomposition (``_nt_scaling``, as in SDPT3).
+Variables are equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is factored by Cholesky until it
 becomes ill-conditioned near the optimum, then through a QR factorisation of ``P`` (which does
 not square the condition number); each Newton solve is iteratively refined on the exact
 equations. Successive solves can be warm-started from an interior iterate of the previous one.
@@ -42,7 +42,7 @@ from scipy.linalg.lapack import dpotrf, dpotrs
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["REDUCED_TOL", "BlockLMISolver", "IPMResult"]
+__all__ = ["REDUCED_TOL", "STALL_WINDOW", "BlockLMISolver", "IPMResult"]
 
 _LOG = logging.getLogger(__name__)
 
@@ -56,6 +56,14 @@ REDUCED_TOL = 1e-6
 #: the cost; it does not square ``P``'s condition number). Measured on paper P: 1e-6 gave the
 #: fewest iterations; 1e-7 and below cost 2 more iterations per solve at 2 vertices.
 QR_SWITCH = 1e-6
+
+#: A run stops as ``"insufficient_progress"`` when its worst measure (relative residuals and
+#: gap) has not halved over this many iterations. Infeasible problems stall like this. On 60
+#: random Kothare problems (n 2-10, 1-5 vertices, 42 of them infeasible or failing) a window of
+#: 15 stopped the failing runs after a median of 18 iterations (max 33) instead of 60 and lost
+#: none of the 18 optimal ones; a window of 10 lost one (it converged at iteration 28).
+STALL_WINDOW = 15
+STALL_FACTOR = 0.5
 
 #: Cost model of the default stacking (see ``_default_levels``).
 STACK_OVERHEAD_US = 90.0
@@ -333,6 +341,7 @@ class BlockLMISolver:
         use_qr = False
         best: tuple | None = None
         warm_next: tuple | None = None
+        merits: list[float] = []
         debug = _LOG.isEnabledFor(logging.DEBUG)
         for it in range(max_iter + 1):
             sp, zp = self._pack([np.stack([a, b]) for a, b in zip(s, z, strict=True)])
@@ -356,6 +365,10 @@ class BlockLMISolver:
                 break
             if max(pres, dres) <= REDUCED_TOL and min(gap, rel_gap) <= REDUCED_TOL:
                 best = (x, s, z, pres, dres, gap)
+            merits.append(max(pres, dres, min(gap, rel_gap)))
+            if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW]:
+                status = "insufficient_progress"
+                break
             if (0.1 * self.warm_gap <= rel_gap <= self.warm_gap
                     and max(pres, dres) <= self.warm_feas):
                 warm_next = (x * dscale, s, z)
