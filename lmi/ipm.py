@@ -551,10 +551,6 @@ def _default_levels(orders: list[int]) -> list[int]:
     return best
 
 
-def _norm(mats: list[np.ndarray]) -> float:
-    return float(np.sqrt(sum(np.sum(m * m) for m in mats)))
-
-
 def _diag(lam: np.ndarray) -> np.ndarray:
     out = np.zeros((*lam.shape, lam.shape[-1]))
     idx = np.arange(lam.shape[-1])
