@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["AffineMatrix", "svec_indices", "svec_matrix"]
+__all__ = ["AffineMatrix", "smat_matrix", "svec_indices", "svec_matrix"]
 
 
 class AffineMatrix:
@@ -137,3 +137,13 @@ def svec_matrix(stack: np.ndarray) -> np.ndarray:
     rows, cols = svec_indices(size)
     scale = np.where(rows == cols, 1.0, np.sqrt(2.0))
     return stack[..., rows, cols] * scale
+
+
+def smat_matrix(vecs: np.ndarray, size: int) -> np.ndarray:
+    """Inverse of :func:`svec_matrix`: a stack ``(..., s(s+1)/2)`` -> ``(..., s, s)``."""
+    rows, cols = svec_indices(size)
+    vals = vecs / np.where(rows == cols, 1.0, np.sqrt(2.0))
+    out = np.zeros((*vecs.shape[:-1], size, size))
+    out[..., rows, cols] = vals
+    out[..., cols, rows] = vals
+    return out

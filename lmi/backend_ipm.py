@@ -16,7 +16,7 @@ from typing import Any
 import clarabel
 import numpy as np
 
-from lmi.affine import svec_indices
+from lmi.affine import smat_matrix, svec_indices
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.data import KothareData
 from lmi.ipm import BlockLMISolver
@@ -72,16 +72,6 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
-def _smat_stack(vecs: np.ndarray, order: int) -> np.ndarray:
-    """Inverse of the scaled half-vectorisation for a stack ``(..., L)`` -> ``(..., k, k)``."""
-    rows, cols = svec_indices(order)
-    vals = vecs / np.where(rows == cols, 1.0, np.sqrt(2.0))
-    out = np.zeros((*vecs.shape[:-1], order, order))
-    out[..., rows, cols] = vals
-    out[..., cols, rows] = vals
-    return out
-
-
 class IPMKothare(ClarabelKothare):
     """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`."""
 
@@ -99,7 +89,7 @@ class IPMKothare(ClarabelKothare):
             dim = int(stop - start)
             if isinstance(cone, clarabel.PSDTriangleConeT):
                 order = round((np.sqrt(8 * dim + 1) - 1) / 2)
-                blocks.append((_smat_stack(h_rows, order), _smat_stack(g_rows.T, order)))
+                blocks.append((smat_matrix(h_rows, order), smat_matrix(g_rows.T, order)))
             else:  # a non-negative cone is a diagonal block
                 eye = np.eye(dim)
                 blocks.append((np.diag(h_rows), g_rows.T[:, :, None] * eye[None]))
