@@ -342,6 +342,7 @@ class BlockLMISolver:
         best: tuple | None = None
         warm_next: tuple | None = None
         merits: list[float] = []
+        s_chol: list[np.ndarray] | None = None  # Cholesky factors of s, when already known
         debug = _LOG.isEnabledFor(logging.DEBUG)
         for it in range(max_iter + 1):
             sp, zp = self._pack([np.stack([a, b]) for a, b in zip(s, z, strict=True)])
@@ -375,7 +376,9 @@ class BlockLMISolver:
             if it == max_iter:
                 break
             try:
-                scal = [_nt_scaling(a, b) for a, b in zip(s, z, strict=True)]
+                if s_chol is None:
+                    s_chol = [np.linalg.cholesky(a) for a in s]
+                scal = [_nt_scaling(ls, b) for ls, b in zip(s_chol, z, strict=True)]
                 for (kk, _r, _l), st, rows in zip(scal, stacks, p_rows, strict=True):
                     _congruence_packed(kk, st, p_buf[rows])
                 r_fac, use_qr = _factor(p_buf, use_qr)
@@ -415,7 +418,7 @@ class BlockLMISolver:
             if step is None:
                 status = "numerical_error"
                 break
-            x, s, z, theta = step
+            x, s, z, theta, s_chol = step
         if status == "optimal" and warm_next is not None:
             self._warm = warm_next
         if status != "optimal" and best is not None:
@@ -436,8 +439,9 @@ class BlockLMISolver:
     def _take_step(
         self, x: np.ndarray, dx: np.ndarray, scal: list, d_cor: list[np.ndarray], alpha: float,
         theta: float, r0: np.ndarray, g_mat: np.ndarray, h_vec: np.ndarray,
-    ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float] | None:
-        """``x + a dx``, ``S = h - G x + theta r0`` and ``Z`` from the scaled update.
+    ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float, list[np.ndarray]] | None:
+        """``x + a dx``, ``S = h - G x + theta r0`` (and its Cholesky factors), ``Z`` from the
+        scaled update.
 
         If rounding leaves the recomputed ``S`` not positive definite, the step is shortened
         (at most five times by 0.8); ``None`` if that does not help.
@@ -447,8 +451,7 @@ class BlockLMISolver:
             theta_new = theta * (1.0 - alpha)
             s_new = [_sym(m) for m in self._unpack(h_vec - g_mat @ x_new + theta_new * r0)]
             try:
-                for m in s_new:
-                    np.linalg.cholesky(m)
+                s_chol = [np.linalg.cholesky(m) for m in s_new]  # reused by the next scaling
             except np.linalg.LinAlgError:
                 alpha *= 0.8
                 continue
@@ -456,7 +459,7 @@ class BlockLMISolver:
             for (kk, _rr, lam), dd in zip(scal, d_cor, strict=True):
                 lz_ = _diag(lam) + alpha * dd[1]
                 z_new.append(_sym(np.swapaxes(kk, -1, -2) @ lz_ @ kk))
-            return x_new, s_new, z_new, theta_new
+            return x_new, s_new, z_new, theta_new, s_chol
         return None
 
     def _pack(self, mats: list[np.ndarray]) -> np.ndarray:
@@ -564,15 +567,14 @@ def _shift_interior(mats: list[np.ndarray]) -> list[np.ndarray]:
     return [m + shift * np.eye(m.shape[-1]) for m in mats]
 
 
-def _nt_scaling(s: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _nt_scaling(ls: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(K, R, lambda)`` per block of a stack: ``K S K' = R' Z R = diag(lambda)``, ``K = R^-1``.
 
     As in SDPT3: ``S = L L'``, ``L' Z L = Q diag(d) Q'``, ``R = L Q diag(d)^-1/4``,
     ``lambda = sqrt(d)`` and ``K = diag(lambda)^-1 R' Z`` (no inverse). Near the central path
     ``L' Z L`` is close to ``mu I``, so its eigen-decomposition is well conditioned even when
-    ``S`` and ``Z`` are not.
+    ``S`` and ``Z`` are not. ``ls`` is the Cholesky factor ``L`` of ``S``.
     """
-    ls = np.linalg.cholesky(s)
     d, qv = np.linalg.eigh(np.swapaxes(ls, -1, -2) @ z @ ls)
     if np.any(d <= 0.0):
         raise np.linalg.LinAlgError("lost positive definiteness")
