@@ -231,6 +231,7 @@ class BlockLMISolver:
         self.warm_gap, self.warm_feas = warm_gap, warm_feas
         self._warm: tuple | None = None
         self._dscale: np.ndarray | None = None
+        self._g_mat: np.ndarray | None = None  # all stacks' packed coefficients, stacked
         checked = [_check_block(j, const, coef, n) for j, (const, coef) in enumerate(blocks)]
         orders = [const.shape[0] for const, _ in checked]
         self.block_orders = orders
@@ -312,13 +313,15 @@ class BlockLMISolver:
             for st in stacks:
                 st.dirty.update(range(st.count))
         dscale = self._dscale
-        for st in stacks:
-            if st.dirty:
-                st.refresh(dscale)
+        if any(st.dirty for st in stacks) or self._g_mat is None:
+            for st in stacks:
+                if st.dirty:
+                    st.refresh(dscale)
+            self._g_mat = np.vstack([st.packed for st in stacks])
+        g_mat = self._g_mat
         cvec = self.c * dscale
         p_buf = self._p_buf
         p_rows = self._p_rows
-        g_mat = np.vstack([st.packed for st in stacks]) if len(stacks) > 1 else stacks[0].packed
         h_vec = self._pack([st.c_mat for st in stacks])
         c_norm = max(1.0, float(np.linalg.norm(cvec)))
         h_norm = max(1.0, float(np.linalg.norm(h_vec)))
