@@ -172,8 +172,8 @@ class BlockLMISolver:
         self._dirty: set[int] = set()
         self._h_vec = np.zeros(lay.size)
         self._g_mat = np.zeros((lay.size, n))  # packed scaled coefficients
-        self._coef_off = np.cumsum([0, *(n * k * k for k in orders)]).astype(np.int64)
-        self._coef_left = np.zeros(int(self._coef_off[-1]))
+        self._sparse: tuple[np.ndarray, ...] = ()  # non-zero scaled coefficients (kernels' sp_*)
+        self._sparse_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
         for j, (const, coef) in enumerate(checked):
             self._set_checked(j, const, coef)
 
@@ -198,21 +198,34 @@ class BlockLMISolver:
 
     def _refresh(self) -> None:
         """Variable scaling (once) and the scaled coefficients of the changed blocks."""
-        n = self.n
         if self._dscale is None:
             # equilibrate the variables once, x = D x~ with unit-norm scaled coefficients
             # (later coefficient updates, e.g. a bound scaling, keep D)
             norms = np.sqrt(sum(np.einsum("ikl,ikl->i", a, a) for a in self._coef))
             self._dscale = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
             self._dirty = set(range(len(self.block_orders)))
+        if not self._dirty:
+            return
+        rebuild = not self._sparse
         for j in sorted(self._dirty):
-            k = self.block_orders[j]
             scaled = self._coef[j] * self._dscale[:, None, None]  # (n, k, k)
-            lo, hi = self._coef_off[j], self._coef_off[j + 1]
-            self._coef_left[lo:hi] = scaled.transpose(1, 0, 2).reshape(k, n * k).ravel()
             iu0, iu1, w = self._layout.triangle(j)
-            self._g_mat[self._layout.rows(j)] = (scaled[:, iu0, iu1] * w).T
+            upper = scaled[:, iu0, iu1]  # (n, entries), entries in packed order
+            self._g_mat[self._layout.rows(j)] = (upper * w).T
+            pattern = upper != 0.0
+            old = self._sparse_parts[j]
+            if old and np.array_equal(pattern, old[0]):  # same non-zeros (e.g. a bound scaling)
+                lo, hi = self._sparse[0][j], self._sparse[0][j + 1]
+                self._sparse[3][lo:hi] = upper[pattern]
+                continue
+            var, entry = np.nonzero(pattern)  # ordered (variable, entry), as upper[pattern]
+            pair_entries, pair_of = np.unique(entry, return_inverse=True)
+            self._sparse_parts[j] = (pattern, var, pair_of, upper[pattern], iu0[pair_entries],
+                                     iu1[pair_entries])
+            rebuild = True
         self._dirty.clear()
+        if rebuild:
+            self._sparse = _concatenate_sparse(self._sparse_parts)
 
     # -- the solve -----------------------------------------------------------------------
     def solve(self, warm_start: bool = False) -> IPMResult:
@@ -268,7 +281,7 @@ class BlockLMISolver:
         kmax = self._kmax
         kk = np.zeros((len(orders), kmax, kmax))
         lam = np.zeros((len(orders), kmax))
-        p_mat = np.zeros((lay.size, n))
+        pt_mat = np.zeros((n, lay.size))  # P', P = the scaled coefficients, packed
         s_chol = np.zeros_like(s)
         status = "max_iterations"
         pres = dres = gap = np.inf
@@ -305,18 +318,18 @@ class BlockLMISolver:
                 warm_next = (x * dscale, s, z)
             if it == max_iter:
                 break
-            if not _kernels.scaling_and_schur_rows(s_chol, z, *packing, self._coef_left,
-                                                   self._coef_off, n, kk, lam, p_mat):
+            if not _kernels.scaling_and_schur_rows(s_chol, z, *packing, *self._sparse, kk, lam,
+                                                   pt_mat):
                 status = "numerical_error"
                 break
             try:
-                r_fac, use_qr = _factor(p_mat, use_qr)
+                r_fac, use_qr = _factor(pt_mat, use_qr)
             except (np.linalg.LinAlgError, ValueError):
                 status = "numerical_error"
                 break
             s_new, z_new, chol_new = np.zeros_like(s), np.zeros_like(z), np.zeros_like(s)
             code, x_new, theta, a_aff, sigma, alpha = _kernels.newton_step(
-                p_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
+                pt_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
                 max(c_norm, n_gtz), *packing, s_new, z_new, chol_new)
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
@@ -376,6 +389,22 @@ class _PackedLayout:
 
 
 # -- helpers -------------------------------------------------------------------------------
+def _concatenate_sparse(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
+    """The kernels' ``sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col`` from the
+    per-block ``(pattern, var, pair, value, pair_row, pair_col)``."""
+    entry_base = np.cumsum([0, *(part[1].shape[0] for part in parts)]).astype(np.int64)
+    pair_base = np.cumsum([0, *(part[4].shape[0] for part in parts)]).astype(np.int64)
+    return (
+        entry_base,
+        np.concatenate([part[1] for part in parts]).astype(np.int64),
+        np.concatenate([part[2] + pair_base[j] for j, part in enumerate(parts)]).astype(np.int64),
+        np.concatenate([part[3] for part in parts]).astype(float),
+        pair_base,
+        np.concatenate([part[4] for part in parts]).astype(np.int64),
+        np.concatenate([part[5] for part in parts]).astype(np.int64),
+    )
+
+
 def _check_block(
     j: int, const: Any, coef: Any, n: int, order: int | None = None
 ) -> tuple[np.ndarray, np.ndarray | None]:
@@ -403,7 +432,7 @@ def _check_block(
     return c_mat, a_mat
 
 
-def _factor(p_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
+def _factor(pt_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
     """Upper factor ``R`` with ``R'R = P'P``; switches to QR for good once Cholesky degrades.
 
     ``H = P'P`` squares ``P``'s condition number, which grows like ``1/mu`` near the optimum;
@@ -412,7 +441,7 @@ def _factor(p_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
     """
     r_fac = None
     if not use_qr:
-        hmat = p_mat.T @ p_mat
+        hmat = pt_mat @ pt_mat.T
         r_fac, info = dpotrf(hmat, lower=0, clean=1)
         # the pivots relative to sqrt(H_jj) (invariant to the scaling of the variables): how
         # much of each column is new, i.e. the loss of accuracy of the Cholesky factor
@@ -420,7 +449,7 @@ def _factor(p_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
         if info != 0 or float(np.min(rel)) < QR_SWITCH:
             use_qr, r_fac = True, None
     if r_fac is None:
-        r_fac = np.linalg.qr(p_mat, mode="r")
+        r_fac = np.linalg.qr(pt_mat.T, mode="r")
     diag = np.abs(np.diag(r_fac))
     if not np.all(np.isfinite(r_fac)) or float(np.min(diag)) == 0.0:
         raise np.linalg.LinAlgError("singular Schur complement")

@@ -13,8 +13,13 @@ in ``(nb, kmax, kmax)`` arrays, only ``[:k, :k]`` used. A packed vector holds, b
 block (``offsets[j]:offsets[j + 1]``), the upper triangle of each block row by row (the order
 of ``numpy.triu_indices``) scaled by ``w`` (1 on the diagonal, sqrt(2) off it), entry ``t`` at
 row ``ent_row[t]`` and column ``ent_col[t]``.
-The coefficients of block ``j`` are held, with the variable scaling applied, as one contiguous
-``(k, n k)`` matrix (``left[p, i k + q] = A_ij[p, q]``) at ``coef_left[coef_off[j]:]``.
+The coefficients, with the variable scaling applied, are held as their non-zero upper-triangle
+entries: entry ``e`` (block ``j``'s entries are ``sp_off[j]:sp_off[j + 1]``) is
+``A_ij[a, b] = sp_val[e]`` with ``i = sp_var[e]`` and ``(a, b)`` the position pair
+``sp_pair[e]``; the distinct pairs of block ``j`` are ``pair_off[j]:pair_off[j + 1]``, pair
+``q`` being ``(pair_row[q], pair_col[q])`` with ``a <= b``. The
+Schur complement is ``H = P'P``; its factor is held transposed, ``pt`` ``(n, size)``, so that
+the rows the kernels write are contiguous.
 
 Compiled on first use and cached next to this file (``cache=True``): the first process after
 an install pays the compilation (about 10-20 s here), later ones load it (well under 1 s).
@@ -125,17 +130,25 @@ def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, en
 
 
 @njit(**_JIT)
-def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, coef_left,
-                           coef_off, n, kk_out, lam_out, p_out):
-    """Nesterov-Todd scaling of every block and the rows ``P`` of the Schur complement.
+def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
+                           sp_pair, sp_val, pair_off, pair_row, pair_col, kk_out, lam_out, pt_out):
+    """Nesterov-Todd scaling of every block and the Schur complement factor ``P'`` (``pt_out``).
 
     For block ``j``, with ``S = L L'`` (``s_chol``) and ``L' Z L = Q diag(d) Q'`` (as in
     SDPT3): ``lambda = sqrt(d)``, ``R = L Q diag(lambda)^-1/2``, ``K = diag(lambda)^-1 R' Z``,
     so that ``K S K' = R' Z R = diag(lambda)``. Near the central path ``L' Z L`` is close to
     ``mu I``, so the eigen-decomposition is well conditioned even when ``S`` and ``Z`` are
-    not. Then ``P[t, i]`` is entry ``t`` of the packed ``K A_ij K'``, from two matrix products
-    per block. Returns ``False`` if a block lost positive definiteness.
+    not.
+
+    Then ``pt_out[i, t]`` is entry ``t`` of the packed ``K A_ij K'``. By linearity it is a sum,
+    over the non-zero entries ``A_ij[a, b]`` (``a <= b``), of ``A_ij[a, b]`` times the packed
+    ``K (e_a e_b' + e_b e_a') K'`` (halved for ``a = b``); those packed matrices are formed once
+    per pair ``(a, b)`` that occurs (``pair_*``) and each entry is one contiguous multiply-add.
+    The Kothare blocks have 1-5 % non-zero coefficient entries, so this is several times less
+    arithmetic than two dense products per block. Returns ``False`` if a block lost positive
+    definiteness.
     """
+    n = pt_out.shape[0]
     for j in range(orders.shape[0]):
         k = orders[j]
         ell = np.ascontiguousarray(s_chol[j, :k, :k])
@@ -150,16 +163,29 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
         kk = (rr.T @ zj) / lam.reshape(k, 1)  # rows scaled
         kk_out[j, :k, :k] = kk
         lam_out[j, :k] = lam
-        left = coef_left[coef_off[j]:coef_off[j] + k * n * k].reshape(k, n * k)
-        # (K A_i)[p, q] at [p, i k + q]; as (k n, k) its row p n + i is row p of K A_i
-        ka = (kk @ left).reshape(k * n, k)
-        kak = ka @ np.ascontiguousarray(kk.T)  # row p n + i: row p of K A_i K'
-        for t in range(offsets[j], offsets[j + 1]):
-            base = ent_row[t] * n
-            col = ent_col[t]
-            w = ent_w[t]
-            for i in range(n):
-                p_out[t, i] = w * kak[base + i, col]
+        kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
+        lo, hi = offsets[j], offsets[j + 1]
+        size = hi - lo
+        first = pair_off[j]
+        basis = np.empty((pair_off[j + 1] - first, size))
+        for q in range(first, pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            out = basis[q - first]
+            for t in range(size):
+                p, r = ent_row[lo + t], ent_col[lo + t]
+                if a == b:
+                    out[t] = ent_w[lo + t] * kt[a, p] * kt[a, r]
+                else:
+                    out[t] = ent_w[lo + t] * (kt[a, p] * kt[b, r] + kt[b, p] * kt[a, r])
+        for i in range(n):
+            for t in range(lo, hi):
+                pt_out[i, t] = 0.0
+        for e in range(sp_off[j], sp_off[j + 1]):
+            v = sp_val[e]
+            row = pt_out[sp_var[e]]
+            src = basis[sp_pair[e] - first]
+            for t in range(size):
+                row[lo + t] += v * src[t]
     return True
 
 
@@ -183,23 +209,23 @@ def _triangular_solve(r_fac, b):
 
 
 @njit(**_JIT)
-def _newton(p_mat, r_fac, rd, rpt, u, ref_scale):
+def _newton(pt, r_fac, rd, rpt, u, ref_scale):
     """Scaled Newton step ``(dx, ds~, dz~)`` for the complementarity right-hand side ``u``.
 
     Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
     refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks.
     """
     v = u + rpt
-    dx = _triangular_solve(r_fac, -rd - p_mat.T @ v)
-    dzt = p_mat @ dx + v
-    err = p_mat.T @ dzt + rd
+    dx = _triangular_solve(r_fac, -rd - pt @ v)
+    dzt = pt.T @ dx + v
+    err = pt @ dzt + rd
     err_norm = np.linalg.norm(err)
     for _ in range(REFINE_STEPS):
         if err_norm <= 1e-14 * ref_scale:
             break
         ddx = _triangular_solve(r_fac, -err)
-        dzt_new = dzt + p_mat @ ddx
-        err_new = p_mat.T @ dzt_new + rd
+        dzt_new = dzt + pt.T @ ddx
+        err_new = pt @ dzt_new + rd
         new_norm = np.linalg.norm(err_new)
         if new_norm >= err_norm:
             break
@@ -223,15 +249,9 @@ def _sturm_count(d, e, k, sigma):
 
 
 @njit(**_JIT)
-def smallest_eigenvalue(a, k):
-    """A lower bound, tight to rounding, on the smallest eigenvalue of symmetric ``a[:k, :k]``.
-
-    Householder reduction to tridiagonal form (overwrites ``a``), then bisection on Sturm
-    counts from the Gershgorin interval to a width of ``4 eps`` of its largest end. The lower
-    end of the final bracket is returned, so a step length ``-1 / lambda`` computed from it is
-    never too long. For the small blocks here this is about 5x faster than a LAPACK
-    eigenvalue call from compiled code, whose fixed cost (copies, workspace queries) dominates.
-    """
+def _tridiagonalize(a, k):
+    """Diagonal ``d`` and sub-diagonal ``e`` of a tridiagonal matrix similar to symmetric
+    ``a[:k, :k]`` (Householder reflections; overwrites ``a``)."""
     d = np.empty(k)
     e = np.zeros(k)
     v = np.zeros(k)
@@ -268,12 +288,34 @@ def smallest_eigenvalue(a, k):
         d[i] = a[i, i]
     if k >= 2:
         e[k - 2] = a[k - 1, k - 2]
+    return d, e
+
+
+@njit(**_JIT)
+def smallest_eigenvalue(a, k, upper=np.inf, rtol=4.0 * 2.220446049250313e-16):
+    """A lower bound on the smallest eigenvalue of symmetric ``a[:k, :k]`` (overwrites ``a``).
+
+    Householder reduction to tridiagonal form, then bisection on Sturm counts from the
+    Gershgorin interval until the bracket is narrower than ``rtol`` times its largest end. The
+    lower end of the bracket is returned, so a step length ``-1 / lambda`` computed from it is
+    never too long. If the smallest eigenvalue is not below ``upper``, ``upper`` is returned
+    after one Sturm count (the step-length search only needs eigenvalues below ``-1 / cap``).
+    For the small blocks here this is several times faster than a LAPACK eigenvalue call from
+    compiled code, whose fixed cost (copies, workspace queries) dominates.
+    """
+    d, e = _tridiagonalize(a, k)
     lo, hi = np.inf, -np.inf
     for i in range(k):
         radius = (abs(e[i - 1]) if i > 0 else 0.0) + (abs(e[i]) if i < k - 1 else 0.0)
         lo = min(lo, d[i] - radius)
         hi = max(hi, d[i] + radius)
-    width = 4.0 * 2.220446049250313e-16 * max(abs(lo), abs(hi)) + 1e-300
+    if upper < hi:
+        if _sturm_count(d, e, k, upper) == 0:
+            return upper
+        hi = upper
+    if not lo < hi:
+        return lo
+    width = rtol * max(abs(lo), abs(hi)) + 1e-300
     for _ in range(200):
         if hi - lo <= width:
             break
@@ -285,10 +327,17 @@ def smallest_eigenvalue(a, k):
     return lo
 
 
+#: Step lengths are computed up to this cap (the callers use ``min(1, a)`` and
+#: ``min(1, 0.99 a)``), to this relative accuracy (a lower bound, never too long).
+_STEP_CAP = 1.0 / 0.99
+_STEP_RTOL = 1e-9
+
+
 @njit(**_JIT)
 def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
-    """Largest ``a`` with ``diag(lambda) + a d >= 0`` for ``d`` = ``ds`` and ``dz``, every block."""
-    alpha = np.inf
+    """Largest ``a`` (up to ``_STEP_CAP``) with ``diag(lambda) + a d >= 0`` for ``d`` = ``ds``
+    and ``dz``, every block."""
+    alpha = _STEP_CAP
     for j in range(orders.shape[0]):
         k = orders[j]
         isq = 1.0 / np.sqrt(lam[j, :k])
@@ -297,14 +346,14 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
             for a in range(k):
                 for b in range(k):
                     dd[a, b] *= isq[a] * isq[b]
-            t = smallest_eigenvalue(dd, k)
-            if t < 0.0:
-                alpha = min(alpha, -1.0 / t)
+            t = smallest_eigenvalue(dd, k, -1.0 / alpha, _STEP_RTOL)
+            if t < -1.0 / alpha:
+                alpha = -1.0 / t
     return alpha
 
 
 @njit(**_JIT)
-def newton_step(p_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
+def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
                 orders, offsets, ent_row, ent_col, ent_w, s_out, z_out, chol_out):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
 
@@ -332,7 +381,7 @@ def newton_step(p_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, r
         k = orders[j]
         for a in range(k):
             u[_diagonal_entry(offsets, j, k, a)] = -lam[j, a]
-    _dx, dsa, dza = _newton(p_mat, r_fac, rd, rpt, u, ref_scale)
+    _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
     sigma = (1.0 - alpha_aff) ** 3
     # corrector: u = lambda^{o-1}(sigma mu e - lambda o lambda - ds_a o dz_a)
@@ -349,7 +398,7 @@ def newton_step(p_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, r
             for b in range(k):
                 rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
         _pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
-    dx, dst, dzt = _newton(p_mat, r_fac, rd, rpt, u_cor, ref_scale)
+    dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale)
     alpha = min(1.0, 0.99 * _max_step(lam, dst, dzt, orders, offsets, ent_row, ent_col, ent_w))
     if not (np.isfinite(alpha) and alpha > 1e-12):
         return 1, x, theta, alpha_aff, sigma, alpha
