@@ -3,7 +3,11 @@
 The certificate does not trust the solver: it forms each LMI in its original form (Kothare,
 Balakrishnan & Morari 1996, eqs. (13), (14), (28)/(29), (34)) from the returned matrices and
 reports the smallest eigenvalue of each, divided by the matrix's spectral norm (a relative
-margin, invariant to the scaling of the state). The input-peak and output bounds are checked in
+margin). Every margin is invariant to the scaling of the state (``Q``, ``Y`` and ``gamma`` scale
+with ``|x|^2``): the vertex and input LMIs are then multiplied by a scalar, and the state LMI is
+checked at the normalised state, ``[[1, x'/|x|], [x/|x|, Q/|x|^2]]`` (a congruence of
+``[[1, x'], [x, Q]]``, so the same matrices pass; formed from the raw matrix, its relative margin
+shrank like ``|x|^2`` and could not show a violation at small states). The input-peak and output bounds are checked in
 their exact per-axis form ``(Y Q^-1 Y')_jj <= u_j^2``, which is what the LMIs with ``X``/``Z``
 guarantee.
 """
@@ -87,7 +91,11 @@ def certify(
     margins: dict[str, float] = {}
     if not (np.all(np.isfinite(Q)) and np.all(np.isfinite(Y)) and np.isfinite(gamma)):
         return Certificate({"finite": -np.inf}, tol)
-    margins["state"] = _rel_min_eig(np.block([[np.ones((1, 1)), x[None, :]], [x[:, None], Q]]))
+    norm = float(np.linalg.norm(x))
+    scale = 1.0 / norm if norm > 0.0 else 1.0
+    margins["state"] = _rel_min_eig(
+        np.block([[np.ones((1, 1)), scale * x[None, :]], [scale * x[:, None], scale**2 * Q]])
+    )
     q1h, rh = data.Q1h, data.Rh
     # The vertex LMIs, all vertices stacked (one batched eigenvalue call per form), as printed
     # and after the exact congruence of the delta form (see lmi.backend_clarabel): at small dt

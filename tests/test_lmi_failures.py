@@ -152,6 +152,23 @@ def test_corrupted_solution_fails_the_certificate(corrupt, failing):
     assert cert.margins[failing] < -1e-7, cert.margins
 
 
+@pytest.mark.parametrize("factor", [1e-6, 1.0, 1e3])
+def test_certificate_margins_do_not_depend_on_the_scale_of_the_state(factor):
+    """At ``c x`` the answer is ``c^2 (gamma, Q, Y)`` and every margin is the same, so a state
+    1e-4 outside its ellipsoid is caught at every scale (formed from the raw ``[[1, x'], [x, Q]]``,
+    the state margin shrank like ``c^2``: at ``c = 1e-6`` the violation read as about -1e-16)."""
+    prob, x, sol = _kothare_solution("peak")
+    base = certify(prob.data, x, sol.gamma, sol.Q, sol.Y)
+    c2 = factor**2
+    scaled = certify(prob.data, factor * x, c2 * sol.gamma, c2 * sol.Q, c2 * sol.Y)
+    for name, margin in base.margins.items():
+        if not name.startswith(("input", "output")):  # bounds do not scale with the state
+            assert scaled.margins[name] == pytest.approx(margin, rel=1e-6, abs=1e-12), name
+    shrunk = (1.0 - 1e-4) * c2 * sol.Q  # x' Q^-1 x = 1 / (1 - 1e-4) > 1
+    cert = certify(prob.data, factor * x, c2 * sol.gamma, shrunk, c2 * sol.Y)
+    assert cert.margins["state"] < -1e-7, cert.margins
+
+
 def test_tighter_output_bound_fails_the_certificate():
     """The solution at y_max = 0.2 does not certify a bound of 0.05 (the constraint is active)."""
     prob, x, sol = _kothare_solution("peak")
