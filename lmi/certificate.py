@@ -6,10 +6,10 @@ reports the smallest eigenvalue of each, divided by the matrix's spectral norm (
 margin). Every margin is invariant to the scaling of the state (``Q``, ``Y`` and ``gamma`` scale
 with ``|x|^2``): the vertex and input LMIs are then multiplied by a scalar, and the state LMI is
 checked at the normalised state, ``[[1, x'/|x|], [x/|x|, Q/|x|^2]]`` (a congruence of
-``[[1, x'], [x, Q]]``, so the same matrices pass; formed from the raw matrix, its relative margin
-shrank like ``|x|^2`` and could not show a violation at small states). The input-peak and output bounds are checked in
-their exact per-axis form ``(Y Q^-1 Y')_jj <= u_j^2``, which is what the LMIs with ``X``/``Z``
-guarantee.
+``[[1, x'], [x, Q]]``, so the same matrices pass; formed from the raw matrix, its relative
+margin shrank like ``|x|^2`` and could not show a violation at small states). The input-peak and
+output bounds are checked in their exact per-axis form ``(Y Q^-1 Y')_jj <= u_j^2``, which is
+what the LMIs with ``X``/``Z`` guarantee.
 """
 
 from __future__ import annotations

@@ -88,7 +88,7 @@ def _cholesky_into(a, k, out):
         s = a[j, j]
         for p in range(j):
             s -= out[j, p] * out[j, p]
-        if not s > 0.0:
+        if not 0.0 < s < np.inf:
             return False
         d = np.sqrt(s)
         out[j, j] = d
@@ -155,6 +155,8 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
         zj = np.ascontiguousarray(z[j, :k, :k])
         m = ell.T @ (zj @ ell)
         m = 0.5 * (m + m.T)
+        if not np.all(np.isfinite(m)):
+            return False
         d, qv = np.linalg.eigh(m)
         if not d[0] > 0.0:
             return False
