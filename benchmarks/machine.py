@@ -9,7 +9,7 @@ from typing import Any
 
 __all__ = ["machine_info", "package_versions", "percentiles"]
 
-_PACKAGES = ("numpy", "scipy", "cvxpy", "clarabel", "osqp", "proxsuite", "control", "scs")
+_PACKAGES = ("numpy", "scipy", "numba", "cvxpy", "clarabel", "osqp", "proxsuite", "control", "scs")
 
 
 def machine_info() -> dict[str, Any]:

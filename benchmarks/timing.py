@@ -285,9 +285,10 @@ def _rmpc_paths(poly: PolytopicModel, cfg: TimingConfig) -> tuple[list[_Path], l
     n = cfg.steps
     paths = [
         _Path("ipm", "delta_shared", maker("ipm", "delta_shared"), n,
-              settings="defaults (1e-8), warm-started from the previous solve"),
+              settings="defaults (residuals and relative gap 1e-8), warm-started from the previous solve"),
         _Path("ipm-cold", "delta_shared", maker("ipm", "delta_shared", opts={"warm_start": False}), n,
-              settings="defaults (1e-8), every solve from the default initial point"),
+              settings="defaults (residuals and relative gap 1e-8), every solve from the default "
+                       "initial point"),
         _Path("clarabel", "delta_shared", maker("clarabel", "delta_shared"), n, settings="defaults (1e-8)"),
         _Path("clarabel", "delta", maker("clarabel", "delta"), n, settings="defaults (1e-8)"),
         _Path("clarabel", "standard", maker("clarabel", "standard"), n, settings="defaults (1e-8)"),
