@@ -4,9 +4,10 @@ The blocks of the Kothare problems are small (orders 7-15) and few (5-11), so a 
 implementation of an iteration is dominated by the fixed cost of its ~250 array calls, not by
 arithmetic (measured on paper P at 2 vertices: 0.55 of 0.8 ms per iteration). These kernels do
 one iteration's work in three calls: :func:`residuals`, :func:`scaling_and_schur_rows` and
-:func:`newton_step`; the Schur complement itself is factored by LAPACK from Python
-(:func:`lmi.ipm._factor`). Matrix products, eigen-decompositions and the Cholesky
-factorisations of the blocks are LAPACK/BLAS calls made from compiled code.
+:func:`newton_step`; the Schur complement itself is factored by LAPACK from Python (in
+:mod:`lmi.ipm`). Matrix products and eigen-decompositions are BLAS/LAPACK calls made from
+compiled code; the Cholesky factorisations of the blocks and the smallest eigenvalues of the
+step-length test are plain loops.
 
 Layout shared by every kernel. ``nb`` blocks of orders ``orders[j]``; block matrices are held
 in ``(nb, kmax, kmax)`` arrays, only ``[:k, :k]`` used. A packed vector holds, block after
