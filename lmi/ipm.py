@@ -29,6 +29,7 @@ equations. Successive solves can be warm-started from an interior iterate of the
 from __future__ import annotations
 
 import logging
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -118,7 +119,9 @@ class BlockLMISolver:
     -----
     An instance keeps work buffers and the warm-start point between solves: use one instance
     per thread (each :class:`lmi.KothareProblem` has its own). The iterations run in compiled
-    kernels (:mod:`lmi.ipm_kernels`); the first solve in a fresh install compiles them.
+    kernels (:mod:`lmi.ipm_kernels`). The first solver built in a process loads them (about
+    0.3 s; after a fresh install it compiles them, 10-20 s), so that this cost falls on the
+    construction and not on the first solve of a real-time loop.
 
     Examples
     --------
@@ -176,6 +179,7 @@ class BlockLMISolver:
         self._sparse_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
         for j, (const, coef) in enumerate(checked):
             self._set_checked(j, const, coef)
+        _load_kernels()
 
     def reset_warm_start(self) -> None:
         """Forget the stored warm-start point (the next warm solve starts cold)."""
@@ -389,6 +393,24 @@ class _PackedLayout:
 
 
 # -- helpers -------------------------------------------------------------------------------
+#: Set once a solver in this process has run the kernels (see :func:`_load_kernels`).
+_KERNELS_LOADED = threading.Event()
+
+
+def _load_kernels() -> None:
+    """Load (or, after an install, compile) the kernels once per process, at construction.
+
+    numba loads a cached kernel on its first call with given argument types: measured, the
+    first solve of a process took 294 ms instead of 3 ms. A one-variable problem solved here
+    makes every kernel run once with the argument types of real solves. The flag is set first,
+    so the solver built here does not recurse.
+    """
+    if _KERNELS_LOADED.is_set():
+        return
+    _KERNELS_LOADED.set()
+    BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
+
+
 def _concatenate_sparse(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
     """The kernels' ``sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col`` from the
     per-block ``(pattern, var, pair, value, pair_row, pair_col)``."""
