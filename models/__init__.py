@@ -11,6 +11,7 @@ Examples
 
 from models.actuators import ReactionWheelActuator, TorqueLimiter
 from models.discretize import zoh
+from models.flexible import FlexibleSatellite
 from models.kinematics import kinematics_matrix
 from models.polytope import PolytopicModel
 from models.satellite import (
@@ -30,6 +31,7 @@ __all__ = [
     "PAPER_P_SAMPLE_TIME",
     "PAPER_P_TORQUE_LIMIT",
     "STATE_NAMES",
+    "FlexibleSatellite",
     "PolytopicModel",
     "ReactionWheelActuator",
     "RigidSatellite",
