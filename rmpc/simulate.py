@@ -30,8 +30,10 @@ class Trajectory:
     u_cmd : (N, m) ndarray
         Controller outputs.
     u_applied : (N, m) ndarray
-        Torques applied to the plant (after the limiter and the actuator), without ``d``.
-    d : (N, m) ndarray
+        Inputs applied to the plant (after the limiter, the actuator and, for a
+        :class:`~rmpc.plants.NonlinearPlant` with an input stage, the stage evaluated at the
+        start of the sample), without ``d``.
+    d : (N, n_d) ndarray
         Disturbance at the start of each sample.
     status : list of str
         Each step's controller status.
@@ -47,6 +49,9 @@ class Trajectory:
         ``"linear"`` or ``"nonlinear"``.
     dt : float
         Sample time (s).
+    stage_log : dict of ndarray
+        What the input stage reported at the start of each sample (``begin_sample``), one
+        array per name with the samples along the first axis; empty without a stage.
     """
 
     t: np.ndarray
@@ -61,6 +66,7 @@ class Trajectory:
     info: list[Any] = field(repr=False)
     plant: str
     dt: float
+    stage_log: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_steps(self) -> int:
@@ -116,9 +122,11 @@ def simulate(
     ----------
     controller : object with ``step(x)``
         Any controller of the toolkit (see :class:`rmpc.controller.Controller`).
-    plant : PolytopicModel or RigidSatellite
-        A polytope (the linear plant; ``true_plant`` picks the member) or the nonlinear
-        satellite (``dt`` required).
+    plant : PolytopicModel, RigidSatellite, NonlinearPlant or a model with ``dynamics``
+        A polytope (the linear plant; ``true_plant`` picks the member), the nonlinear
+        satellite or any model with ``dynamics(x, u, d=None)`` (``dt`` required), or a
+        :class:`~rmpc.plants.NonlinearPlant` that fixes the integrator and an input stage
+        (faults, actuator limits; see :class:`~rmpc.plants.InputStage`).
     x0 : array_like
         Initial state.
     duration : float, optional
@@ -174,7 +182,13 @@ def simulate(
         n_steps = round(duration / step_dt)
     if not isinstance(n_steps, int | np.integer) or n_steps < 1:
         raise InvalidArgumentError("n_steps", "a positive integer", repr(n_steps))
-    d_fn = as_disturbance(disturbance, m)
+    n_d = int(getattr(sim_plant, "n_disturbances", m))
+    d_fn = as_disturbance(disturbance, n_d)
+    stage = getattr(sim_plant, "input_stage", None)
+    if stage is not None and callable(getattr(stage, "reset", None)):
+        stage.reset()
+    begin_sample = getattr(stage, "begin_sample", None) if stage is not None else None
+    stage_rows: list[dict[str, Any]] = []
     if actuator is not None:
         if not isinstance(actuator, ReactionWheelActuator) or actuator.n_axes != m:
             raise InvalidArgumentError(
@@ -189,7 +203,7 @@ def simulate(
     xs = np.empty((n_steps + 1, n))
     u_cmd = np.empty((n_steps, m))
     u_app = np.empty((n_steps, m))
-    d_log = np.zeros((n_steps, m))
+    d_log = np.zeros((n_steps, n_d))
     solve_time = np.empty(n_steps)
     step_time = np.empty(n_steps)
     gamma = np.full(n_steps, np.nan)
@@ -216,7 +230,9 @@ def simulate(
         applied = limiter(u) if limiter is not None else u
         if actuator is not None:
             applied = actuator.step(applied)
-        u_app[k] = applied
+        if callable(begin_sample):
+            stage_rows.append(dict(begin_sample(t, x, applied) or {}))
+        u_app[k] = applied if stage is None else sim_plant.applied(t, x, applied)
         if d_fn is not None:
             d_log[k] = d_fn(t)
         x = sim_plant.advance(x, applied, t, d_fn)
@@ -226,5 +242,17 @@ def simulate(
     return Trajectory(
         t=np.arange(n_steps + 1) * step_dt, x=xs, u_cmd=u_cmd, u_applied=u_app, d=d_log,
         status=status, solve_time=solve_time, step_time=step_time, gamma=gamma, info=info,
-        plant=sim_plant.kind, dt=step_dt,
+        plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows),
     )
+
+
+def _stack_rows(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+    """Per-sample mappings of the input stage, stacked into one array per name."""
+    if not rows:
+        return {}
+    names = sorted({name for row in rows for name in row})
+    out = {}
+    for name in names:
+        if all(name in row for row in rows):
+            out[name] = np.asarray([row[name] for row in rows])
+    return out
