@@ -11,6 +11,7 @@ from rmpc.lqr import LQR
 from rmpc.offline_rmpc import OfflineRMPC
 from rmpc.robust_mpc import RMPC
 from rmpc.simulate import Trajectory, simulate
+from rmpc.wrappers import MappedController
 
 __all__ = [
     "CRMPC",
@@ -19,6 +20,7 @@ __all__ = [
     "RMPC",
     "ConstantDisturbance",
     "Controller",
+    "MappedController",
     "OfflineRMPC",
     "SineDisturbance",
     "StepDisturbance",

@@ -110,6 +110,7 @@ def simulate(
     atol: float = 1e-12,
     reset: bool = True,
     progress: Any = None,
+    sensor: Any = None,
 ) -> Trajectory:
     """Run ``controller`` in closed loop on ``plant`` from ``x0``.
 
@@ -150,6 +151,10 @@ def simulate(
         Call ``controller.reset()`` first (default).
     progress : callable, optional
         Called as ``progress(k, n_steps)`` after each step.
+    sensor : callable, optional
+        ``sensor(t, x) -> y``: what the controller measures (sensor noise, say); the
+        trajectory keeps the true state. Its ``reset()`` is called before the run when present.
+        Default: the controller sees the true state.
 
     Returns
     -------
@@ -199,6 +204,11 @@ def simulate(
         raise ArgumentTypeError("limiter", "a TorqueLimiter or callable", type(limiter).__name__)
     if reset and callable(getattr(controller, "reset", None)):
         controller.reset()
+    if sensor is not None:
+        if not callable(sensor):
+            raise ArgumentTypeError("sensor", "None or a callable sensor(t, x)", type(sensor).__name__)
+        if callable(getattr(sensor, "reset", None)):
+            sensor.reset()
 
     xs = np.empty((n_steps + 1, n))
     u_cmd = np.empty((n_steps, m))
@@ -212,8 +222,9 @@ def simulate(
     xs[0] = x
     for k in range(n_steps):
         t = k * step_dt
+        measured = x if sensor is None else np.asarray(sensor(t, x), dtype=float)
         start = time.perf_counter()
-        u = np.asarray(controller.step(x), dtype=float).reshape(-1)
+        u = np.asarray(controller.step(measured), dtype=float).reshape(-1)
         step_time[k] = time.perf_counter() - start
         if u.shape != (m,) or not np.all(np.isfinite(u)):
             raise InvalidArgumentError(
