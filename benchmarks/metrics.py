@@ -46,8 +46,9 @@ __all__ = [
 AXES: tuple[str, str, str] = ("roll", "pitch", "yaw")
 #: Largest number of (t, gamma) points kept in ``metrics["gamma"]`` (evenly thinned).
 GAMMA_POINTS = 200
-#: Step statuses that are not failures: solved, solved less accurately, or a kept gain.
-FAILURE_FREE_STATUSES: frozenset[str] = frozenset({"optimal", "inaccurate", "reused"})
+#: Step statuses that are not failures: solved, solved less accurately, a kept gain, or a
+#: control law without an optimiser that computed its output (``"ok"``).
+FAILURE_FREE_STATUSES: frozenset[str] = frozenset({"optimal", "inaccurate", "reused", "ok"})
 
 
 def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:

@@ -84,15 +84,23 @@ class SineDisturbance:
         return ()
 
 
-def as_disturbance(value: Any, size: int) -> Callable[[float], np.ndarray] | None:
-    """Accept ``None``, a profile object or any callable ``d(t)`` returning ``size`` values."""
+def as_disturbance(value: Any, size: int, x0: Any = None) -> Callable[..., np.ndarray] | None:
+    """Accept ``None``, a profile object or any callable ``d(t)`` returning ``size`` values.
+
+    A disturbance whose attribute ``state_dependent`` is true is called as ``d(t, x)`` (the
+    torque of a spinning disk inside the bus depends on the body rates, say); ``x0`` is then
+    the state it is probed at.
+    """
     if value is None:
         return None
     if not callable(value):
         raise ArgumentTypeError(
             "disturbance", "None or a callable d(t) such as StepDisturbance", type(value).__name__
         )
-    probe = np.asarray(value(0.0), dtype=float)
+    if getattr(value, "state_dependent", False):
+        probe = np.asarray(value(0.0, np.asarray(x0, dtype=float)), dtype=float)
+    else:
+        probe = np.asarray(value(0.0), dtype=float)
     if probe.shape != (size,):
         raise InvalidArgumentError(
             "disturbance", f"d(t) of shape ({size},)", f"shape {probe.shape}"

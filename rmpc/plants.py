@@ -27,9 +27,23 @@ from models import PolytopicModel, RigidSatellite
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, check_positive
 
-__all__ = ["InputStage", "LinearPlant", "NonlinearPlant", "NonlinearSatellitePlant", "make_plant"]
+__all__ = [
+    "InputStage",
+    "LinearPlant",
+    "NonlinearPlant",
+    "NonlinearSatellitePlant",
+    "disturbance_at",
+    "make_plant",
+]
 
-DisturbanceFn = Callable[[float], np.ndarray]
+DisturbanceFn = Callable[..., np.ndarray]
+
+
+def disturbance_at(disturbance: DisturbanceFn, t: float, x: np.ndarray) -> np.ndarray:
+    """``d(t, x)`` for a state-dependent disturbance (``state_dependent = True``), else ``d(t)``."""
+    if getattr(disturbance, "state_dependent", False):
+        return disturbance(t, x)
+    return disturbance(t)
 
 
 @runtime_checkable
@@ -71,7 +85,7 @@ class LinearPlant:
         self, x: np.ndarray, u: np.ndarray, t: float, disturbance: DisturbanceFn | None
     ) -> np.ndarray:
         """State one sample later."""
-        torque = u if disturbance is None else u + disturbance(t)
+        torque = u if disturbance is None else u + disturbance_at(disturbance, t, x)
         return self.A @ x + self.B @ torque
 
 
@@ -125,7 +139,7 @@ class NonlinearSatellitePlant:
                 t_last = float(np.nextafter(t1, t0))
 
                 def fun(_t: float, y: np.ndarray, t_last: float = t_last) -> np.ndarray:
-                    return rhs(y, u + disturbance(min(_t, t_last)))
+                    return rhs(y, u + disturbance_at(disturbance, min(_t, t_last), y))
             sol = solve_ivp(fun, (t0, t1), state, method="DOP853", rtol=self.rtol, atol=self.atol)
             if not sol.success:  # pragma: no cover - DOP853 fails only on NaN input
                 raise InvalidArgumentError(
@@ -204,7 +218,7 @@ class NonlinearPlant:
         return u if self.input_stage is None else np.asarray(self.input_stage(t, x, u), dtype=float)
 
     def _rhs(self, t: float, x: np.ndarray, u: np.ndarray, disturbance: DisturbanceFn | None) -> np.ndarray:
-        d = None if disturbance is None else disturbance(t)
+        d = None if disturbance is None else disturbance_at(disturbance, t, x)
         return np.asarray(self.model.dynamics(x, self.applied(t, x, u), d), dtype=float)
 
     def advance(

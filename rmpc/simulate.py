@@ -10,7 +10,7 @@ import numpy as np
 
 from models import ReactionWheelActuator, TorqueLimiter
 from rmpc.disturbances import as_disturbance
-from rmpc.plants import make_plant
+from rmpc.plants import disturbance_at, make_plant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
@@ -144,7 +144,8 @@ def simulate(
     limiter : TorqueLimiter, optional
         Saturation applied to the controller output.
     disturbance : callable, optional
-        Disturbance torque ``d(t)`` (e.g. :class:`rmpc.StepDisturbance`).
+        Disturbance torque ``d(t)`` (e.g. :class:`rmpc.StepDisturbance`), or ``d(t, x)`` for an
+        object whose ``state_dependent`` attribute is true.
     rtol, atol : float
         Tolerances of the nonlinear integrator.
     reset : bool
@@ -188,7 +189,7 @@ def simulate(
     if not isinstance(n_steps, int | np.integer) or n_steps < 1:
         raise InvalidArgumentError("n_steps", "a positive integer", repr(n_steps))
     n_d = int(getattr(sim_plant, "n_disturbances", m))
-    d_fn = as_disturbance(disturbance, n_d)
+    d_fn = as_disturbance(disturbance, n_d, x)
     stage = getattr(sim_plant, "input_stage", None)
     if stage is not None and callable(getattr(stage, "reset", None)):
         stage.reset()
@@ -245,7 +246,7 @@ def simulate(
             stage_rows.append(dict(begin_sample(t, x, applied) or {}))
         u_app[k] = applied if stage is None else sim_plant.applied(t, x, applied)
         if d_fn is not None:
-            d_log[k] = d_fn(t)
+            d_log[k] = disturbance_at(d_fn, t, x)
         x = sim_plant.advance(x, applied, t, d_fn)
         xs[k + 1] = x
         if progress is not None:

@@ -180,3 +180,33 @@ def test_bad_plants_and_options_name_the_argument(sat: RigidSatellite) -> None:
         simulate(HoldOne(), UnitCircle(), [1.0, 0.0], duration=1.0)
     with pytest.raises(InvalidArgumentError, match="dt"):
         simulate(HoldOne(), NonlinearPlant(UnitCircle(), 0.5), [1.0, 0.0], duration=1.0, dt=0.1)
+
+
+class RateDrag:
+    """A state-dependent disturbance d(t, x) = -c w (a drag on the rates)."""
+
+    state_dependent = True
+
+    def __init__(self, c: float) -> None:
+        self.c = c
+
+    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        return -self.c * np.asarray(x)[3:6]
+
+
+def test_state_dependent_disturbance_is_called_with_the_state(sat: RigidSatellite) -> None:
+    x0 = np.array([0.0, 0.0, 0.0, 0.1, 0.0, 0.0])
+    run = simulate(Zero3(), sat, x0, duration=10.0, dt=0.1, disturbance=RateDrag(0.5))
+    # p' = -c p / Ixx about a principal axis: exponential decay
+    np.testing.assert_allclose(run.x[-1, 3], 0.1 * np.exp(-0.5 * 10.0 / sat.inertia[0, 0]), rtol=1e-9)
+    np.testing.assert_allclose(run.d[:, 0], -0.5 * run.x[:-1, 3], rtol=1e-12)
+    rk4 = simulate(Zero3(), NonlinearPlant(sat, 0.1, method="RK4", substep=0.01), x0, duration=10.0,
+                   disturbance=RateDrag(0.5))
+    np.testing.assert_allclose(rk4.x[-1], run.x[-1], atol=1e-9)
+
+
+class Zero3:
+    last = None
+
+    def step(self, x: np.ndarray) -> np.ndarray:
+        return np.zeros(3)
