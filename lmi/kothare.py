@@ -6,6 +6,7 @@ control using linear matrix inequalities", Automatica 32(10), 1361-1379, 1996.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -201,18 +202,51 @@ class KothareProblem:
     def n_inputs(self) -> int:
         return self.data.m
 
-    def solve(self, x: Any) -> LMISolution:
-        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised."""
+    def solve(self, x: Any, u_max: Any = None) -> LMISolution:
+        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised.
+
+        Parameters
+        ----------
+        x : (n,) array_like
+            The measured state (non-zero).
+        u_max : float or array_like, optional
+            The input bound for this solve only, instead of the one the problem was built with
+            (same kind: a scalar for the ellipsoid, a scalar or ``(m,)`` for the peak bound). The
+            certificate checks the bound actually used. :class:`rmpc.CRMPC` uses it to give the
+            robust MPC what its disturbance correction leaves of the torque limit.
+        """
         x = as_vector(x, "x", self.data.n)
         scale = float(np.linalg.norm(x))
         if scale == 0.0:
             raise InvalidArgumentError(
                 "x", "a non-zero state (the problem is degenerate at the origin)", "x = 0"
             )
-        raw: RawResult = self._backend.solve(x / scale, self.data.u_max / scale, self.data.y_max / scale)
-        return self._finish(raw, x, scale)
+        data = self.data if u_max is None else self._with_bound(u_max)
+        raw: RawResult = self._backend.solve(x / scale, data.u_max / scale, data.y_max / scale)
+        return self._finish(raw, x, scale, data)
 
-    def _finish(self, raw: RawResult, x: np.ndarray, scale: float) -> LMISolution:
+    def _with_bound(self, u_max: Any) -> KothareData:
+        """The problem data with another input bound of the same kind (checked)."""
+        kind = self.data.input_constraint
+        if kind is None:
+            raise InvalidArgumentError("u_max", "None (the problem has no input constraint)", repr(u_max))
+        if kind == "ellipsoid":
+            if np.size(u_max) != 1 or np.ndim(u_max) > 1:
+                expected = "a scalar bound for the ellipsoid constraint"
+                raise InvalidArgumentError("u_max", expected, repr(u_max))
+            bound = np.array([check_positive(float(np.asarray(u_max, dtype=float).reshape(-1)[0]), "u_max")])
+        else:
+            if np.ndim(u_max) == 0:
+                bound = np.full(self.data.m, check_positive(u_max, "u_max"))
+            else:
+                bound = as_vector(u_max, "u_max", self.data.m)
+                if np.any(bound <= 0.0):
+                    raise InvalidArgumentError("u_max", "bounds > 0", repr(bound.tolist()))
+        return dataclasses.replace(self.data, u_max=bound)
+
+    def _finish(
+        self, raw: RawResult, x: np.ndarray, scale: float, data: KothareData | None = None
+    ) -> LMISolution:
         if raw.Q is None or raw.Y is None:
             return LMISolution(
                 raw.status, np.nan, None, None, None, raw.solve_time, raw.iterations,
@@ -222,7 +256,7 @@ class KothareProblem:
         q_mat = 0.5 * (raw.Q + raw.Q.T) * s2
         y_mat = raw.Y * s2
         gamma = raw.gamma * s2
-        cert = certify(self.data, x, gamma, q_mat, y_mat, tol=self.certificate_tol)
+        cert = certify(self.data if data is None else data, x, gamma, q_mat, y_mat, tol=self.certificate_tol)
         try:
             f_mat = np.linalg.solve(q_mat.T, y_mat.T).T
         except np.linalg.LinAlgError:

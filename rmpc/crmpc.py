@@ -2,30 +2,40 @@
 
 State feedback alone leaves an offset under a persistent input disturbance. Paper P adds a
 model reference adaptive system (MRAS) around its robust MPC: a reference model, the error
-between plant and model, and a parameter tuned by the MIT rule through a discrete integrator
-that corrects the control. Paper P gives this structure but not all its equations; the
-equations below are the toolkit's reconstruction (SPEC 2.2; ``docs/crmpc.rst`` has the block
-diagram and the derivations).
+between plant and model, and a parameter ``theta`` that corrects the control so that the
+disturbance's effect is cancelled. Paper P tunes it by the MIT rule; this module offers that
+rule (``rule="mit"``) and, as the default, the Lyapunov redesign of the same MRAS
+(``rule="lyapunov"``), whose adaptation law comes with a stability argument over the whole
+inertia polytope the robust MPC is designed for. ``docs/crmpc.rst`` has the block diagrams,
+the derivations and the measurements behind the choice.
 
 In deviation coordinates ``z = x - x_ref`` (``x_ref`` of the inner :class:`~rmpc.RMPC`), with
-the nominal model ``(A, B)`` of the polytope, ``F(k)`` the gain the RMPC applies at step
-``k``, ``C_e`` the error output and ``k0`` the last reset of the reference model::
+the nominal model ``(A, B)`` of the polytope and ``F(k)`` the gain the RMPC applies at step
+``k``:
 
-    u_rmpc(k)  = F(k) z(k)                          robust MPC, its constraint on u_rmpc
-    u(k)       = u_rmpc(k) - theta(k)               applied control; theta estimates d
-    zm(k+1)    = A zm(k) + B u_rmpc(k)              reference model: the nominal plant under
-    zm(k0)     = z(k0)                              the same control, without disturbance
-    e(k)       = C_e (z(k) - zm(k))                 model-following error
-    s(k+1)     = A s(k) - B,   s(k0) = 0            sensitivity filter, de/dtheta = C_e s
+``rule="lyapunov"`` (default)::
+
+    theta(k)   = Proj[theta(k-1) + Ts g (Bd' P Bd)^-1 Bd' P e(k)]     Bd = B / Ts, P = gamma Q^-1
+    u_rmpc(k)  = F(k) z(k),   ||u_rmpc(k)|| <= u_max - |theta(k)|      the torque budget
+    u(k)       = u_rmpc(k) - theta(k)
+    zm(k+1)    = (A + B F(k)) zm(k),   zm(0) = z(0)                    nominal closed loop, never reset
+    e(k)       = z(k) - zm(k)
+
+``P`` is the cost matrix of the RMPC's last certified solution, a common Lyapunov matrix of the
+closed loops ``A_j + B_j F`` at every vertex of the polytope (Kothare's LMIs certify it).
+
+``rule="mit"`` (paper P's MIT rule, the toolkit's earlier default)::
+
+    zm(k+1)    = A zm(k) + B u_rmpc(k),   zm(k0) = z(k0)                reset every reset_period
+    s(k+1)     = A s(k) - B,   s(k0) = 0                                 sensitivity, de/dtheta = C_e s
     theta(k)   = theta(k-1) - gamma_a Ts (C_e s(k))' e(k) / (alpha + ||C_e s(k)||_F^2)
 
-(the plain MIT rule drops the division). On the nominal model
-``e(k) = C_e sum_j A^(k-1-j) B (d(j) - theta(j))``: the same control drives plant and model,
-so the feedback cancels from the error and ``de/dtheta`` is the open-loop filter above,
-exactly. The reference model is reset to the measured state every ``reset_period`` seconds
-(the open-loop model drifts with any model error; the reset bounds the drift). With a fixed
-``reference_gain`` ``Fm`` the reference model is instead the classical closed loop
-``zm(k+1) = (A + B Fm) zm(k)`` and the filter ``s(k+1) = (A + B F(k)) s(k) - B``.
+**The torque budget.** With an input bound, ``|theta_i|`` is projected onto
+``theta_bound_i < u_max`` and the robust MPC gets what the correction leaves of the limit
+(``torque_budget="current"``: ``u_max - max_i |theta_i(k)|`` for the ellipsoid, ``u_max_i -
+|theta_i(k)|`` per axis for the peak bound, re-solved at every step; ``"split"``: the fixed
+``u_max - theta_bound``). Every certified step then satisfies ``|u_i(k)| <= |u_rmpc,i(k)| +
+|theta_i(k)| <= u_max`` on the nonlinear plant as on the linear one, without a limiter.
 """
 
 from __future__ import annotations
@@ -38,59 +48,73 @@ import numpy as np
 
 from models import PolytopicModel
 from rmpc.controller import StepInfo
-from rmpc.mras import MITRule, SensitivityFilter, _bound
+from rmpc.mras import LyapunovRule, MITRule, SensitivityFilter, _bound
 from rmpc.robust_mpc import RMPC
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_positive
+from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
 
 __all__ = ["CRMPC"]
 
-#: Default adaptation gain ``gamma_a`` of the normalised rule (1/s), tuned on paper P's satellite.
+#: Default gain ``g`` of the Lyapunov rule (1/s^2): an estimator bandwidth of about 10 rad/s.
+DEFAULT_GAIN_LYAPUNOV = 100.0
+#: Default adaptation gain ``gamma_a`` of the normalised MIT rule (1/s), tuned on paper P's satellite.
 DEFAULT_GAIN_NORMALIZED = 20.0
 #: Default adaptation gain ``gamma_a`` of the plain rule, paper P's satellite: bounded but slow.
 DEFAULT_GAIN_PLAIN = 0.3
 #: Default regularisation ``alpha`` of the normalised rule.
 DEFAULT_ALPHA = 1e-3
-#: Default period (s) of the reference-model reset.
+#: Default period (s) of the reference-model reset of the MIT rule.
 DEFAULT_RESET_PERIOD = 2.0
+#: Default ``theta_bound`` as a fraction of ``u_max``: the robust MPC keeps at least 20 % of the limit.
+DEFAULT_THETA_FRACTION = 0.8
+#: Adaptation laws.
+RULES = ("lyapunov", "mit")
+#: How the torque limit is shared between the robust MPC and the correction.
+TORQUE_BUDGETS = ("current", "split", "none")
 
 #: Arguments of :class:`~rmpc.RMPC` that CRMPC sets itself (not accepted in ``rmpc_options``).
 _OWN_ARGUMENTS = ("self", "plant", "Q", "R", "u_max", "input_constraint")
 
 
 class CRMPC:
-    """Robust MPC plus a model reference adaptive system (MIT rule): paper P's CRMPC.
+    """Robust MPC plus a model reference adaptive system: paper P's CRMPC.
 
     Parameters
     ----------
     plant : PolytopicModel
-        The polytope of discrete-time models; its ``nominal`` model is the reference model
-        and the sensitivity filter.
+        The polytope of discrete-time models; its ``nominal`` model is the reference model.
     Q, R, u_max, input_constraint
         Passed to the inner :class:`~rmpc.RMPC` (weights, input bound and its kind).
+    rule : {"lyapunov", "mit"}
+        The adaptation law (module notes). ``"lyapunov"`` (default): the Lyapunov redesign,
+        robust over the polytope; ``"mit"``: paper P's MIT rule.
     adaptation_gain : float, optional
-        The MIT-rule gain ``gamma_a`` (>= 0; 0 turns the adaptation off and leaves plain
-        RMPC). Default: ``DEFAULT_GAIN_NORMALIZED`` (20 1/s) for the normalised rule,
-        ``DEFAULT_GAIN_PLAIN`` (0.3) for the plain rule.
-    normalized : bool
-        Use the normalised MIT rule (default). The sensitivity grows like ``t^2`` inside a
-        reset window, so the plain rule's speed varies by orders of magnitude across it and
-        the plain rule is unstable at gains the normalised rule takes in its stride.
-    alpha : float
-        Regularisation of the normalised rule (default ``DEFAULT_ALPHA``).
-    reset_period : float or None
-        Reset the reference model to the measured state (and the sensitivity filter to
-        zero) every this many seconds (default ``DEFAULT_RESET_PERIOD`` = 2 s); rounded
-        to whole samples. ``None``: only at the first step after :meth:`reset`.
+        ``g`` of the Lyapunov rule (1/s^2, default ``DEFAULT_GAIN_LYAPUNOV`` = 100) or
+        ``gamma_a`` of the MIT rule (default ``DEFAULT_GAIN_NORMALIZED`` = 20 1/s for the
+        normalised rule, ``DEFAULT_GAIN_PLAIN`` = 0.3 for the plain one). 0 turns the
+        adaptation off and leaves plain RMPC.
+    normalized, alpha : optional
+        MIT rule only: the normalised rule (default ``True``) and its regularisation (default
+        ``DEFAULT_ALPHA``). The plain rule is unstable at gains the normalised rule takes in
+        its stride (the sensitivity grows like ``t^2`` inside a reset window).
+    reset_period : float, None or "auto"
+        MIT rule only: reset the reference model to the measured state (and the sensitivity
+        to zero) every this many seconds; ``"auto"``: ``DEFAULT_RESET_PERIOD`` (2 s); ``None``:
+        only at the first step. The Lyapunov rule's reference model is never reset.
     reference_gain : (m, n) array_like, optional
-        ``None`` (default): the reference model is driven by the RMPC's own control (see the
-        module notes). A fixed gain ``Fm``: the classical MRAS reference model
-        ``zm(k+1) = (A + B Fm) zm(k)``, which must be Schur stable on the nominal model.
+        MIT rule only: a fixed gain ``Fm`` for the classical reference model
+        ``zm(k+1) = (A + B Fm) zm(k)`` (Schur stable on the nominal model).
     error_output : (p, n) array_like, optional
-        ``C_e`` of the error ``e = C_e (z - zm)``. Default: the identity (the full state).
-    theta_bound : float, array_like or None, optional
-        Projection ``|theta_i| <= theta_bound_i`` (anti-windup). Default ``"auto"``: ``u_max``
-        per input when ``u_max`` is given, else no bound. ``None``: no bound.
+        MIT rule only: ``C_e`` of the error ``e = C_e (z - zm)`` (default the identity).
+    theta_bound : "auto", float, array_like or None
+        Projection ``|theta_i| <= theta_bound_i``. ``"auto"``: ``DEFAULT_THETA_FRACTION``
+        (0.8) times ``u_max`` when there is an input bound, else none. With a torque budget it
+        must lie below ``u_max`` (the robust MPC needs some of the limit).
+    torque_budget : {"auto", "current", "split", "none"}
+        How the torque limit is shared (module notes). ``"auto"``: ``"current"`` with an input
+        bound, ``"none"`` without. ``"none"`` is the earlier behaviour: the RMPC's bound
+        applies to ``u_rmpc`` only and the applied torque may exceed it by ``|theta|`` (put a
+        limiter in the loop, ``simulate(..., limiter=TorqueLimiter(u_max))``).
     rmpc_options : dict, optional
         Further keyword arguments of :class:`~rmpc.RMPC` (``resolve_threshold``, ``backend``,
         ``x_ref``, ...). Unknown keys are errors.
@@ -99,36 +123,40 @@ class CRMPC:
     ----------
     rmpc : RMPC
         The inner robust MPC.
-    rule : MITRule
+    rule : LyapunovRule or MITRule
         The adaptation law; ``rule.theta`` is the current disturbance estimate.
     last : StepInfo or None
         ``status``, ``solve_time``, ``gamma``, ``iterations`` and ``fallback`` of the inner
         RMPC step; ``extra`` holds the adaptation state: ``theta`` (applied at this step),
-        ``error`` (``e(k)``), ``sensitivity`` (``de/dtheta``), ``x_model`` (the reference
-        model's state ``zm(k) + x_ref``), ``u_rmpc``, ``model_reset`` (whether the model was
-        reset at this step) and ``rmpc`` (the inner step's own :class:`StepInfo`).
+        ``error`` (the error the rule used), ``sensitivity`` (MIT rule; ``None`` otherwise),
+        ``x_model`` (the reference model's state ``zm(k) + x_ref``), ``u_rmpc``,
+        ``model_reset`` (whether the model was (re)started at this step), ``rmpc`` (the inner
+        step's own :class:`StepInfo`), ``u_bound`` (the RMPC's input bound at this step,
+        ``None`` without a budget) and ``budget_scaled`` (``True`` when a step without a
+        certified solution for the current budget, a fallback or a kept gain, had its
+        ``u_rmpc`` scaled back into the bound).
 
     Notes
     -----
-    **Constraints.** The RMPC enforces its input constraint on ``u_rmpc`` only. The applied
-    ``u = u_rmpc - theta`` is not bounded by it: ``|u_i| <= |u_rmpc,i| + |theta_i|``, and
-    ``|theta_i| <= theta_bound_i`` (``u_max`` by default). No limiter is applied inside; where
-    the torque limit is hard, put one outside (``simulate(..., limiter=TorqueLimiter(1.0))``).
-    The projection of ``theta`` keeps the adaptation from winding up against it.
+    **Guarantee on the applied torque.** With a torque budget, every step whose RMPC solution
+    is certified satisfies ``|u_i| <= u_max`` (``u_max_i`` for the peak bound) up to the
+    certificate's tolerance, on any plant: the bound holds for ``u_rmpc = F z`` at the
+    measured state because the state lies in the certified ellipsoid, and ``|theta_i|`` is
+    what the budget left out. A step without such a solution (a failed solve, or a gain kept
+    by ``resolve_threshold < 1`` that was certified for a larger bound) has ``u_rmpc`` scaled
+    into the bound, so the limit holds at every step; ``last.extra["budget_scaled"]`` says
+    when that happened.
 
-    **Defaults for paper P's satellite** (``Ts = 0.01`` s; ``Q = diag(1, 1, 1, 0.1, 0.1,
-    0.1)``, ``R = I``, ``u_max = 1``): normalised rule, ``gamma_a = 20`` 1/s,
-    ``alpha = 1e-3``, reset every 2 s, full-state error, ``theta_bound = u_max``. Inside a
-    window the normalised rule estimates a constant disturbance at a rate of the order of
-    ``gamma_a / 3`` per axis (the Frobenius norm of the 6 x 3 sensitivity spreads the gain over
-    three axes; yaw gets less because of its larger inertia). Measured on the nonlinear
-    satellite with a 0.5 N m step on every axis at t = 10 s: the attitude error peaks at
-    0.067 rad and stays below 1e-3 rad from 16 s after the onset. ``gamma_a = 30`` settles
-    faster on the nominal satellite (11 s) but rings, and had not settled 30 s after the onset
-    when the true inertia was 1.7 times the nominal (``gamma_a = 20``: 22 s); a 3 s window
-    lets the model drift too far; the plain rule is unstable from ``gamma_a = 1`` and too slow
-    below (``docs/crmpc.rst``). The classical reference model (``reference_gain=Fm``) without
-    resets needs ``gamma_a`` near 0.5.
+    **Why the Lyapunov rule.** For ``B_t = c B`` (the scalar inertia polytope, ``c > 0``
+    unknown) and a fixed gain, ``V = e' P e + c theta~' Gamma^-1 theta~`` is non-increasing
+    (continuous-time argument, :class:`~rmpc.mras.LyapunovRule`), so the estimate cannot
+    wind into a limit cycle; the MIT rule has no such argument and, with its open-loop
+    reference model reset every 2 s, falls into a 2 s limit cycle at 1.7 times the nominal
+    inertia. Measured on paper P's satellite, E5 settings (nonlinear plant, ``spread = 0.7``,
+    0.5 N m on each axis from 10 s, ``R = 0.01 I``, re-solving at every sample): at true
+    inertias of 0.3, 0.5, 0.7, 1.0, 1.3 and 1.7 times the nominal the attitude error stays
+    below 1e-3 rad from 1.4-2.1 s after the onset, peaks at 4-5e-3 rad, and the applied
+    torque stays below 0.77 N m (``docs/crmpc.rst``).
 
     Examples
     --------
@@ -140,8 +168,8 @@ class CRMPC:
     >>> plant = sat.polytope(x0, dt=0.01, spread=0.3, mode="scalar")
     >>> ctrl = CRMPC(plant, Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]), R=np.eye(3), u_max=1.0)
     >>> u = ctrl.step(x0)
-    >>> ctrl.last.status, ctrl.last.extra["theta"].tolist()
-    ('optimal', [0.0, 0.0, 0.0])
+    >>> ctrl.last.status, ctrl.last.extra["theta"].tolist(), ctrl.last.extra["u_bound"]
+    ('optimal', [0.0, 0.0, 0.0], 1.0)
     """
 
     def __init__(
@@ -152,13 +180,15 @@ class CRMPC:
         u_max: Any = None,
         input_constraint: str | None = "auto",
         *,
+        rule: str = "lyapunov",
         adaptation_gain: float | None = None,
-        normalized: bool = True,
-        alpha: float = DEFAULT_ALPHA,
-        reset_period: float | None = DEFAULT_RESET_PERIOD,
+        normalized: bool | None = None,
+        alpha: float | None = None,
+        reset_period: float | str | None = "auto",
         reference_gain: Any = None,
         error_output: Any = None,
         theta_bound: Any = "auto",
+        torque_budget: str = "auto",
         rmpc_options: Mapping[str, Any] | None = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
@@ -168,16 +198,37 @@ class CRMPC:
         self.dt = plant.dt
         n, m = plant.n_states, plant.n_inputs
         self._a, self._b = (np.array(mat, dtype=float) for mat in plant.nominal)
-
+        self.rule_name = str(check_choice(rule, "rule", RULES))
+        lyapunov = self.rule_name == "lyapunov"
+        if lyapunov:
+            for name, value in (("normalized", normalized), ("alpha", alpha),
+                                ("reference_gain", reference_gain), ("error_output", error_output)):
+                if value is not None:
+                    raise InvalidArgumentError(
+                        name, "None with rule='lyapunov' (an MIT-rule setting)", repr(value)
+                    )
+            if reset_period not in ("auto", None):
+                raise InvalidArgumentError(
+                    "reset_period",
+                    "'auto' or None with rule='lyapunov' (its reference model is never reset)",
+                    repr(reset_period),
+                )
+        if normalized is None:
+            normalized = True
         if not isinstance(normalized, bool | np.bool_):
             found = f"{type(normalized).__name__} {normalized!r}"
             raise ArgumentTypeError("normalized", "True or False", found)
         self.normalized = bool(normalized)
+        self.alpha = check_positive(DEFAULT_ALPHA if alpha is None else alpha, "alpha")
         if adaptation_gain is None:
-            adaptation_gain = DEFAULT_GAIN_NORMALIZED if self.normalized else DEFAULT_GAIN_PLAIN
+            if lyapunov:
+                adaptation_gain = DEFAULT_GAIN_LYAPUNOV
+            else:
+                adaptation_gain = DEFAULT_GAIN_NORMALIZED if self.normalized else DEFAULT_GAIN_PLAIN
         self.adaptation_gain = check_positive(adaptation_gain, "adaptation_gain", allow_zero=True)
-        self.alpha = check_positive(alpha, "alpha")
 
+        if reset_period == "auto":
+            reset_period = None if lyapunov else DEFAULT_RESET_PERIOD
         if reset_period is None:
             self.reset_period: float | None = None
             self._reset_steps = 0
@@ -208,23 +259,79 @@ class CRMPC:
             raise InvalidArgumentError("error_output", "a non-zero output matrix C_e", "all zeros")
         self.error_output = c_e
 
-        if isinstance(theta_bound, str):
-            if theta_bound != "auto":
-                raise InvalidArgumentError(
-                    "theta_bound", "'auto', None, a number or a vector", repr(theta_bound)
-                )
-            theta_bound = None if u_max is None else np.broadcast_to(np.asarray(u_max, float), (m,)).copy()
-        theta_bound = _bound(theta_bound, "theta_bound", m)
-        self.rule = MITRule(
-            m, self.adaptation_gain, self.dt, normalized=self.normalized, alpha=self.alpha, bound=theta_bound
-        )
-        self.theta_bound = self.rule.bound
-        self.rmpc = RMPC(plant, Q, R, u_max=u_max, input_constraint=input_constraint, **options)
+        # the inner RMPC's own constraint (validated there) decides the kind of bound
+        probe = RMPC(plant, Q, R, u_max=u_max, input_constraint=input_constraint, **options)
+        kind = probe.input_constraint
+        self.u_max = None if kind is None else np.array(probe.problem.data.u_max, dtype=float)
+        budget = check_choice(torque_budget, "torque_budget", ("auto", *TORQUE_BUDGETS))
+        if budget == "auto":
+            budget = "none" if kind is None else "current"
+        if budget != "none" and kind is None:
+            raise InvalidArgumentError(
+                "torque_budget", "'none' or 'auto' without an input bound (u_max)", repr(torque_budget)
+            )
+        self.torque_budget = str(budget)
+        theta_bound = self._theta_bound(theta_bound, m)
+        self.theta_bound = theta_bound
+        if self.torque_budget == "split":
+            assert self.u_max is not None and theta_bound is not None
+            split = self._budget(theta_bound)
+            self.rmpc = RMPC(plant, Q, R, u_max=split, input_constraint=kind, **options)
+        else:
+            self.rmpc = probe
+        if lyapunov:
+            self.rule: LyapunovRule | MITRule = LyapunovRule(
+                m, self.adaptation_gain, self.dt, bound=theta_bound
+            )
+        else:
+            self.rule = MITRule(
+                m, self.adaptation_gain, self.dt, normalized=self.normalized, alpha=self.alpha,
+                bound=theta_bound,
+            )
+        self._b_delta = self._b / self.dt
         self._sens = SensitivityFilter(self._a, self._b, c_e, columns=m)
         self._minus_eye = -np.eye(m)
         self._zm: np.ndarray | None = None
+        self._p: np.ndarray | None = None
         self._since_reset = 0
         self.last: StepInfo | None = None
+
+    def _theta_bound(self, value: Any, m: int) -> np.ndarray | None:
+        if isinstance(value, str):
+            if value != "auto":
+                raise InvalidArgumentError(
+                    "theta_bound", "'auto', None, a number or a vector", repr(value)
+                )
+            if self.u_max is None:
+                return None
+            return DEFAULT_THETA_FRACTION * np.broadcast_to(self.u_max, (m,)).copy()
+        bound = _bound(value, "theta_bound", m)
+        if self.torque_budget != "none":
+            if bound is None:
+                raise InvalidArgumentError(
+                    "theta_bound", f"a bound below u_max with torque_budget={self.torque_budget!r}", "None"
+                )
+            assert self.u_max is not None
+            limit = np.broadcast_to(self.u_max, (m,))
+            if np.any(bound >= limit):
+                raise InvalidArgumentError(
+                    "theta_bound",
+                    f"bounds below u_max = {limit.tolist()} (the robust MPC needs part of the torque limit)",
+                    repr(bound.tolist()),
+                )
+        return bound
+
+    def _budget(self, theta_abs: np.ndarray) -> float | np.ndarray:
+        """What the correction ``|theta|`` leaves of the input bound, in the RMPC's kind of bound."""
+        assert self.u_max is not None
+        if self.rmpc_kind == "ellipsoid":
+            return float(self.u_max[0] - np.max(theta_abs))
+        return self.u_max - theta_abs
+
+    @property
+    def rmpc_kind(self) -> str | None:
+        """The inner RMPC's input constraint (``"ellipsoid"``, ``"peak"`` or ``None``)."""
+        return None if self.u_max is None else ("ellipsoid" if self.u_max.shape == (1,) else "peak")
 
     # -- the step(x) protocol -----------------------------------------------------------
     @property
@@ -238,6 +345,7 @@ class CRMPC:
         self.rule.reset()
         self._sens.reset()
         self._zm = None
+        self._p = None
         self._since_reset = 0
         self.last = None
 
@@ -245,26 +353,49 @@ class CRMPC:
         """Adapt ``theta`` from the measured state, then return ``u = u_rmpc - theta``."""
         x = as_vector(x, "x", self.plant.n_states)
         z = x - self.rmpc.x_ref
-        model_reset = self._zm is None or (0 < self._reset_steps <= self._since_reset)
+        lyapunov = isinstance(self.rule, LyapunovRule)
+        model_reset = self._zm is None or (not lyapunov and 0 < self._reset_steps <= self._since_reset)
         if model_reset:
             self._zm = z.copy()
             self._sens.reset()
             self._since_reset = 0
         assert self._zm is not None
-        sens = self._sens.output()
-        error = self.error_output @ (z - self._zm)
-        theta = self.rule.update(error, sens)
+        sens = None
+        if lyapunov:
+            error = z - self._zm
+            if self._p is not None:
+                self.rule.update(error, self._b_delta, self._p)
+            theta = self.rule.theta
+        else:
+            sens = self._sens.output()
+            error = self.error_output @ (z - self._zm)
+            theta = self.rule.update(error, sens)
 
-        u_rmpc = np.asarray(self.rmpc.step(x), dtype=float)
+        bound: float | np.ndarray | None = None
+        step_bound: float | np.ndarray | None = None
+        if self.torque_budget == "current":
+            bound = step_bound = self._budget(np.abs(theta))
+        elif self.torque_budget == "split":
+            step_bound = self.rmpc.problem.data.u_max[0] if self.rmpc_kind == "ellipsoid" else (
+                self.rmpc.problem.data.u_max.copy())
+        u_rmpc = np.asarray(self.rmpc.step(x, u_max=bound), dtype=float)
         inner = self.rmpc.last
+        scaled = False
+        if step_bound is not None:
+            u_rmpc, scaled = _into_bound(u_rmpc, step_bound, self.rmpc_kind)
         zm = self._zm
-        if self.reference_gain is None:
+        gain = self.rmpc.gain
+        if gain is None:
+            gain = np.zeros((self.plant.n_inputs, self.plant.n_states))
+        if lyapunov:
+            self._zm = (self._a + self._b @ gain) @ zm
+            solution = None if inner is None else inner.extra.get("solution")
+            if solution is not None and inner is not None and not inner.fallback and solution.Q is not None:
+                self._p = solution.P
+        elif self.reference_gain is None:
             self._zm = self._a @ zm + self._b @ u_rmpc
             self._sens.advance(self._minus_eye)
         else:
-            gain = self.rmpc.gain
-            if gain is None:
-                gain = np.zeros((self.plant.n_inputs, self.plant.n_states))
             self._zm = (self._a + self._b @ self.reference_gain) @ zm
             self._sens.advance(self._minus_eye, a=self._a + self._b @ gain)
         self._since_reset += 1
@@ -278,9 +409,25 @@ class CRMPC:
             extra={
                 "theta": theta, "error": error, "sensitivity": sens, "x_model": zm + self.rmpc.x_ref,
                 "u_rmpc": u_rmpc, "model_reset": model_reset, "rmpc": inner,
+                "u_bound": step_bound if not isinstance(step_bound, np.ndarray) else step_bound.copy(),
+                "budget_scaled": scaled,
             },
         )
         return u_rmpc - theta
+
+
+def _into_bound(u: np.ndarray, bound: float | np.ndarray, kind: str | None) -> tuple[np.ndarray, bool]:
+    """``u`` scaled (radially) into the ellipsoid or box bound, and whether it had to be."""
+    tol = 1e-6
+    if kind == "ellipsoid":
+        norm = float(np.linalg.norm(u))
+        if norm <= float(bound) * (1.0 + tol):
+            return u, False
+        return u * (float(bound) / norm), True
+    ratio = float(np.max(np.abs(u) / np.asarray(bound)))
+    if ratio <= 1.0 + tol:
+        return u, False
+    return u / ratio, True
 
 
 def _rmpc_options(options: Mapping[str, Any] | None) -> dict[str, Any]:

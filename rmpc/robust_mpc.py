@@ -127,6 +127,7 @@ class RMPC:
         self.last: StepInfo | None = None
         self._gain: np.ndarray | None = None
         self._q_inv: np.ndarray | None = None
+        self._gain_bound: np.ndarray | None = None
 
     @property
     def input_constraint(self) -> str | None:
@@ -147,11 +148,21 @@ class RMPC:
         self.last = None
         self._gain = None
         self._q_inv = None
+        self._gain_bound = None
 
-    def solve(self, x: Any) -> LMISolution:
-        """Solve the LMI problem at ``x`` (the deviation ``x - x_ref`` is used); no side effects."""
+    def solve(self, x: Any, u_max: Any = None) -> LMISolution:
+        """Solve the LMI problem at ``x`` (the deviation ``x - x_ref`` is used); no side effects.
+
+        ``u_max`` replaces the input bound for this solve (see :meth:`lmi.KothareProblem.solve`).
+        """
         x = as_vector(x, "x", self.plant.n_states)
-        return self.problem.solve(x - self.x_ref)
+        return self.problem.solve(x - self.x_ref, u_max=u_max)
+
+    def _bound_vector(self, u_max: Any) -> np.ndarray | None:
+        """The input bound of a step as a vector (``None``: the constructed bound)."""
+        if u_max is None:
+            return None
+        return self.problem._with_bound(u_max).u_max
 
     def in_ellipsoid(self, x: Any) -> bool:
         """Whether ``x - x_ref`` lies in the invariant ellipsoid of the current gain."""
@@ -160,27 +171,44 @@ class RMPC:
         z = as_vector(x, "x", self.plant.n_states) - self.x_ref
         return bool(z @ self._q_inv @ z <= 1.0 + 1e-9)
 
-    def step(self, x: Any) -> np.ndarray:
-        """Solve at ``x`` and return ``u = F (x - x_ref)``; see the class notes on failures."""
+    def step(self, x: Any, u_max: Any = None) -> np.ndarray:
+        """Solve at ``x`` and return ``u = F (x - x_ref)``; see the class notes on failures.
+
+        Parameters
+        ----------
+        x : (n,) array_like
+            The measured state.
+        u_max : float or array_like, optional
+            The input bound for this step instead of the constructed one (same kind). With
+            ``resolve_threshold < 1`` a kept gain is re-solved when the requested bound is
+            tighter than the one it was certified for. :class:`rmpc.CRMPC` passes what its
+            disturbance correction leaves of the torque limit.
+        """
         x = as_vector(x, "x", self.plant.n_states)
+        bound = self._bound_vector(u_max)
         z = x - self.x_ref
         if float(np.linalg.norm(z)) <= self.hold_radius:
             gain = self._current_gain()
             self.last = StepInfo(status="reused", extra={"solution": None, "reason": "near origin"})
             return gain @ z
-        if self.resolve_threshold < 1.0 and self._q_inv is not None:
+        tighter = (
+            bound is not None and self._gain_bound is not None
+            and bool(np.any(bound < self._gain_bound * (1.0 - 1e-12)))
+        )
+        if self.resolve_threshold < 1.0 and self._q_inv is not None and not tighter:
             level = float(z @ self._q_inv @ z)
             if self.resolve_threshold < level <= 1.0:
                 self.last = StepInfo(
                     status="reused", extra={"solution": None, "reason": "inside ellipsoid", "level": level}
                 )
                 return self._current_gain() @ z
-        sol = self.problem.solve(z)
+        sol = self.problem.solve(z, u_max=bound)
         usable = sol.status in _USABLE and sol.certificate is not None and sol.certificate.ok
         if usable:
             assert sol.F is not None and sol.Q is not None
             self._gain = sol.F
             self._q_inv = np.linalg.inv(sol.Q)
+            self._gain_bound = self.problem.data.u_max if bound is None else bound
             self.last = StepInfo(
                 status=sol.status, solve_time=sol.solve_time, gamma=sol.gamma,
                 iterations=sol.iterations, extra={"solution": sol},
