@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from toolkit_common.errors import SingularityError
+from toolkit_common.errors import InvalidArgumentError, SingularityError
 
 __all__ = [
     "SINGULARITY_COS_TOL",
     "euler_rates",
     "euler_rates_jacobian",
+    "kinematics_cover",
     "kinematics_matrix",
     "rotation_matrix",
 ]
@@ -105,3 +106,82 @@ def rotation_matrix(attitude: np.ndarray) -> np.ndarray:
     ry = np.array([[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]])
     rz = np.array([[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]])
     return rz @ ry @ rx
+
+
+def _arc_triangle(lo: float, hi: float) -> list[np.ndarray]:
+    """Points whose convex hull contains ``(sin a, cos a)`` for every ``a`` in ``[lo, hi]``.
+
+    The arc lies between its chord and the tangents at its ends: the two end points and the
+    tangents' intersection (``(sin m, cos m) / cos h``, ``m`` the middle, ``h`` the half width).
+    """
+    if hi - lo <= 0.0:
+        return [np.array([np.sin(lo), np.cos(lo)])]
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    apex = np.array([np.sin(mid), np.cos(mid)]) / np.cos(half)
+    return [np.array([np.sin(lo), np.cos(lo)]), np.array([np.sin(hi), np.cos(hi)]), apex]
+
+
+def _secant_triangle(lo: float, hi: float) -> list[np.ndarray]:
+    """Points whose convex hull contains ``(tan t, sec t)`` for every ``t`` in ``[lo, hi]``.
+
+    On ``|t| < 90 deg`` the curve is ``y = sqrt(1 + x^2)``, convex: it lies below its chord and
+    above its end tangents ``y = sin(t_i) x + cos(t_i)``; their intersection closes the triangle.
+    """
+    ends = [np.array([np.tan(t), 1.0 / np.cos(t)]) for t in (lo, hi)]
+    if hi - lo <= 0.0:
+        return ends[:1]
+    s_lo, s_hi = np.sin(lo), np.sin(hi)
+    x = (np.cos(hi) - np.cos(lo)) / (s_lo - s_hi)
+    return [*ends, np.array([x, s_lo * x + np.cos(lo)])]
+
+
+def kinematics_cover(phi_bounds: tuple[float, float], theta_bounds: tuple[float, float]) -> list[np.ndarray]:
+    """Kinematics matrices whose convex hull contains ``K(phi, theta)`` over a box of attitudes.
+
+    ``K`` is affine in ``(sin phi, cos phi)`` for a fixed pitch and affine in
+    ``(tan theta, sec theta)`` for a fixed roll. Each pair runs along a curve that a triangle
+    contains (an arc of the unit circle; a branch of ``y = sqrt(1 + x^2)``), so ``K`` over the
+    box lies in the convex hull of ``K`` at the 3 x 3 pairs of triangle corners (at most 9
+    matrices; fewer when a range is a single value). The corners of the box alone do not
+    suffice: ``K`` is not affine in the angles.
+
+    Parameters
+    ----------
+    phi_bounds, theta_bounds : (float, float)
+        ``(lower, upper)`` roll and pitch (rad); the pitch interval must stay inside
+        ``(-90, 90)`` deg (a :class:`~toolkit_common.errors.SingularityError` otherwise).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models.kinematics import kinematics_cover
+    >>> len(kinematics_cover((0.0, 0.5), (-0.2, 0.6)))
+    9
+    >>> np.allclose(kinematics_cover((0.1, 0.1), (0.2, 0.2))[0], kinematics_matrix(0.1, 0.2))
+    True
+    """
+    phi_lo, phi_hi = (float(v) for v in phi_bounds)
+    theta_lo, theta_hi = (float(v) for v in theta_bounds)
+    if not (phi_lo <= phi_hi and phi_hi - phi_lo < np.pi):
+        raise InvalidArgumentError(
+            "phi_bounds", "lower <= upper, less than 180 deg apart", f"({phi_lo!r}, {phi_hi!r})"
+        )
+    if not theta_lo <= theta_hi:
+        raise InvalidArgumentError("theta_bounds", "lower <= upper", f"({theta_lo!r}, {theta_hi!r})")
+    for t in (theta_lo, theta_hi):
+        _check_pitch(t)
+    if theta_lo <= -0.5 * np.pi or theta_hi >= 0.5 * np.pi:
+        _check_pitch(0.5 * np.pi)  # the interval contains the singularity
+    mats = []
+    for s_p, c_p in _arc_triangle(phi_lo, phi_hi):
+        for t_t, sec_t in _secant_triangle(theta_lo, theta_hi):
+            mats.append(
+                np.array(
+                    [
+                        [1.0, s_p * t_t, c_p * t_t],
+                        [0.0, c_p, -s_p],
+                        [0.0, s_p * sec_t, c_p * sec_t],
+                    ]
+                )
+            )
+    return mats

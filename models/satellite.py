@@ -17,7 +17,9 @@ import numpy as np
 
 from models.discretize import zoh
 from models.kinematics import (
+    SINGULARITY_COS_TOL,
     euler_rates_jacobian,
+    kinematics_cover,
     kinematics_matrix,
     rotation_matrix,
 )
@@ -257,6 +259,7 @@ class RigidSatellite:
         dt: float,
         spread: float,
         mode: PolytopeMode = "scalar",
+        attitude_range: Any = None,
     ) -> PolytopicModel:
         """The discrete-time polytope of linearisations over the inertia uncertainty.
 
@@ -271,11 +274,18 @@ class RigidSatellite:
             toolkit assumes 0.3, and E5 uses 0.7.
         mode : {"scalar", "box"}
             See :meth:`inertia_vertices`.
+        attitude_range : (3,) array_like, optional
+            Half-widths (rad, >= 0) of a box of attitudes around ``x_op``'s: the polytope then
+            also covers the kinematics ``eta' = K(phi, theta) w`` at every attitude in the box
+            (SPEC section 1, going beyond paper P), so the LMIs' guarantees hold along a
+            manoeuvre through it and not only at ``x_op``. Yaw does not enter ``K``. ``x_op``
+            must have zero rates. The box must keep the pitch inside ``(-90, 90)`` deg.
 
         Returns
         -------
         PolytopicModel
-            One vertex per inertia corner; the nominal model is the linearisation at this
+            One vertex per inertia corner (times the kinematics vertices with
+            ``attitude_range``); the nominal model is the linearisation at ``x_op`` with this
             satellite's own inertia.
 
         Notes
@@ -284,9 +294,31 @@ class RigidSatellite:
         linear in ``J^-1``, so the polytope contains every plant of the uncertainty set
         exactly. At non-zero rates the gyroscopic block of ``A`` is not affine in ``J``;
         the vertices are then the corner linearisations, an approximation.
+
+        With ``attitude_range`` the model is the frozen-attitude (quasi-LPV) form of the
+        nonlinear model, ``x' = [[0, K(eta)], [0, 0]] x + [0; J^-1] u``, exact for the
+        kinematics at every attitude of the box (the gyroscopic term ``w x J w``, second
+        order in the rates, is left out). ``A_c`` is nilpotent, so its ZOH is
+        ``A_d = I + Ts A_c``, ``B_d = [Ts^2/2 K J^-1; Ts J^-1]``: affine in ``K`` and bilinear in
+        ``(K, J^-1)``. ``K`` over the box lies in the convex hull of the matrices of
+        :func:`~models.kinematics.kinematics_cover` (at most 9), so the products of those
+        with the inertia corners (at most 18 vertices in ``"scalar"`` mode, 72 in ``"box"``)
+        contain every frozen-attitude model of the box and the uncertainty set. The attitude
+        is taken as constant over a sample, an error of the order of ``Ts`` times its rate.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import RigidSatellite
+        >>> sat = RigidSatellite.paper_p()
+        >>> x_op = np.array([0.2, 0.3, 0.0, 0.0, 0.0, 0.0])
+        >>> sat.polytope(x_op, dt=0.01, spread=0.3, attitude_range=np.radians([15, 20, 0])).n_vertices
+        18
         """
         x_op = as_vector(x_op, "x_op", 6)
         dt = check_positive(dt, "dt")
+        if attitude_range is not None:
+            return self._covering_polytope(x_op, dt, spread, mode, attitude_range)
         verts = []
         for inertia in self.inertia_vertices(spread, mode):
             verts.append(RigidSatellite(inertia).discretize(x_op, dt))
@@ -294,6 +326,45 @@ class RigidSatellite:
         return PolytopicModel(
             verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES
         )
+
+    def _covering_polytope(
+        self, x_op: np.ndarray, dt: float, spread: float, mode: PolytopeMode, attitude_range: Any
+    ) -> PolytopicModel:
+        half = as_vector(attitude_range, "attitude_range", 3)
+        if np.any(half < 0.0):
+            raise InvalidArgumentError(
+                "attitude_range", "half-widths >= 0 (rad) of a non-empty box", f"{half.tolist()}"
+            )
+        if np.any(x_op[3:] != 0.0):
+            raise InvalidArgumentError(
+                "x_op", "zero rates with attitude_range (the covering model is the frozen-attitude one)",
+                f"rates {x_op[3:].tolist()}",
+            )
+        phi = (float(x_op[0] - half[0]), float(x_op[0] + half[0]))
+        theta = (float(x_op[1] - half[1]), float(x_op[1] + half[1]))
+        limit = 0.5 * np.pi - np.arccos(SINGULARITY_COS_TOL)
+        if theta[0] <= -0.5 * np.pi + limit or theta[1] >= 0.5 * np.pi - limit:
+            raise InvalidArgumentError(
+                "attitude_range",
+                "a box whose pitch stays inside (-90, 90) deg (3-2-1 Euler angles are singular there)",
+                f"pitch from {np.degrees(theta[0]):.2f} to {np.degrees(theta[1]):.2f} deg",
+            )
+        if phi[1] - phi[0] >= np.pi:
+            raise InvalidArgumentError(
+                "attitude_range", "a roll half-width below 90 deg", f"{np.degrees(half[0]):.2f} deg"
+            )
+        verts = []
+        for inertia in self.inertia_vertices(spread, mode):
+            j_inv = np.linalg.inv(inertia)
+            for k_mat in kinematics_cover(phi, theta):
+                a = np.eye(6)
+                a[:3, 3:] = dt * k_mat
+                b = np.zeros((6, 3))
+                b[:3] = 0.5 * dt * dt * k_mat @ j_inv
+                b[3:] = dt * j_inv
+                verts.append((a, b))
+        nominal = self.discretize(x_op, dt)
+        return PolytopicModel(verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES)
 
     # -- python-control ----------------------------------------------------------------
     def to_nlsys(self, with_disturbance: bool = False) -> Any:
