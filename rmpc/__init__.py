@@ -10,6 +10,7 @@ from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
 from rmpc.offline_rmpc import OfflineRMPC
 from rmpc.robust_mpc import RMPC
+from rmpc.scheduled_rmpc import ScheduledRMPC
 from rmpc.simulate import Trajectory, simulate
 from rmpc.wrappers import MappedController
 
@@ -22,6 +23,7 @@ __all__ = [
     "Controller",
     "MappedController",
     "OfflineRMPC",
+    "ScheduledRMPC",
     "SineDisturbance",
     "StepDisturbance",
     "StepInfo",
