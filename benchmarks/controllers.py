@@ -6,8 +6,11 @@ defaults of :data:`benchmarks.defaults.CONTROLLER_DEFAULTS` updated by the scena
 
 - ``"constraint"``: the controller's own constraint (RMPC and OfflineRMPC: the input
   ellipsoid ``||u||_2 <= u_max`` or, with ``input_constraint = "peak"``, ``|u_j| <= u_max``;
-  GIPC: ``|u| <= u_max`` and ``|du| <= du_max``; CRMPC: the inner RMPC's bound and a limiter,
-  since its adaptive term can exceed it). LQR has no constraint and refuses this mode.
+  GIPC: ``|u| <= u_max`` and ``|du| <= du_max``; CRMPC and CRMPC-MIT: the torque budget, the
+  inner RMPC solved with what the disturbance correction leaves of ``u_max``, so the applied
+  torque stays inside the limit without a limiter; the setting ``limiter = true`` adds one
+  anyway, and ``torque_budget = "none"`` (no guarantee) always does). LQR has no constraint
+  and refuses this mode.
 - ``"limiter"``: no constraint in the controller and a per-axis clip at ``u_max`` in the loop.
 - ``"none"``: neither.
 """
@@ -43,6 +46,18 @@ def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
+    if scenario.kinematics == "scheduled":
+        from models import RigidSatellite
+        from rmpc.scheduled_rmpc import ScheduledRMPC
+
+        sched = ScheduledRMPC.for_satellite(
+            RigidSatellite.paper_p(), poly.dt, scenario.spread, q, r,
+            u_max=scenario.u_max if constrained else None,
+            input_constraint=s["input_constraint"] if constrained else None,
+            mode=scenario.mode, hold_radius=s["hold_radius"], backend=s["backend"],
+            formulation=s["formulation"],
+        )
+        return BuiltController(sched, scenario.saturation == "limiter")
     ctrl = RMPC(
         poly,
         q,
@@ -57,23 +72,38 @@ def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _crmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -> BuiltController:
     from rmpc.crmpc import CRMPC
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
+    budget = s["torque_budget"] if constrained else "none"
     ctrl = CRMPC(
         poly,
         q,
         r,
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
-        adaptation_gain=s["adaptation_gain"],
-        normalized=s["normalized"],
-        alpha=s["alpha"],
+        theta_bound=s["theta_fraction"] * scenario.u_max if budget != "none" else None,
+        torque_budget=budget,
         rmpc_options={"resolve_threshold": s["resolve_threshold"]},
+        **rule,
     )
-    return BuiltController(ctrl, scenario.saturation != "none")
+    limiter = scenario.saturation == "limiter" or (
+        constrained and (bool(s["limiter"]) or budget == "none")
+    )
+    return BuiltController(ctrl, limiter)
+
+
+def _crmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    return _crmpc_common(poly, scenario, s, rule="lyapunov", adaptation_gain=s["adaptation_gain"])
+
+
+def _crmpc_mit(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    return _crmpc_common(
+        poly, scenario, s, rule="mit", adaptation_gain=s["mit_gain"], normalized=s["normalized"],
+        alpha=s["alpha"], reset_period=s["reset_period"],
+    )
 
 
 def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
@@ -123,15 +153,16 @@ CONTROLLERS: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltControlle
     "RMPC": _rmpc,
     "GIPC": _gipc,
     "CRMPC": _crmpc,
+    "CRMPC-MIT": _crmpc_mit,
     "OfflineRMPC": _offline,
     "LQR": _lqr,
 }
 
 #: Settings that may be 0 (0 turns the adaptation off; keeps re-solving down to the origin).
-_ZERO_ALLOWED = frozenset({"adaptation_gain", "hold_radius"})
+_ZERO_ALLOWED = frozenset({"adaptation_gain", "mit_gain", "hold_radius"})
 
 #: Controllers that can enforce the torque limit themselves (``saturation = "constraint"``).
-CONSTRAINED = ("RMPC", "GIPC", "CRMPC", "OfflineRMPC")
+CONSTRAINED = ("RMPC", "GIPC", "CRMPC", "CRMPC-MIT", "OfflineRMPC")
 
 
 def _check_value(default: Any, value: Any, where: str) -> Any:
@@ -217,8 +248,13 @@ def effective_settings(
                 f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
             )
         out[key] = _check_value(defaults[key], value, f"{where}.{key}")
-    if controller in ("RMPC", "CRMPC") and out["resolve_threshold"] > 1.0:
+    if controller in ("RMPC", "CRMPC", "CRMPC-MIT") and out["resolve_threshold"] > 1.0:
         raise ConfigError(f"{where}.resolve_threshold", "a level in (0, 1]", repr(out["resolve_threshold"]))
+    if "theta_fraction" in out and out["theta_fraction"] >= 1.0:
+        raise ConfigError(
+            f"{where}.theta_fraction", "a fraction of u_max in (0, 1) (the RMPC needs part of the limit)",
+            repr(out["theta_fraction"]),
+        )
     if controller == "OfflineRMPC" and out["shrink"] >= 1.0:
         raise ConfigError(f"{where}.shrink", "a number in (0, 1)", repr(out["shrink"]))
     if controller == "GIPC" and out["Nc"] > out["Np"]:

@@ -15,7 +15,7 @@ import numpy as np
 from benchmarks.controllers import build_controller
 from benchmarks.defaults import SETTLING_BAND
 from benchmarks.metrics import AXES, compute_metrics
-from benchmarks.scenario import Scenario
+from benchmarks.scenario import Scenario, initial_attitude
 
 __all__ = ["run_case", "simulate_scenario"]
 
@@ -60,8 +60,13 @@ def simulate_scenario(
 
     start, cpu_start = time.perf_counter(), time.process_time()
     sat = RigidSatellite.paper_p()
-    x0 = sat.initial_state(scenario.ic_scale)
-    poly = sat.polytope(x0, scenario.dt, scenario.spread, scenario.mode)
+    x0 = np.concatenate((initial_attitude(scenario.initial_attitude, scenario.ic_scale), np.zeros(3)))
+    if scenario.kinematics == "cover":
+        middle = np.concatenate((0.5 * x0[:3], np.zeros(3)))
+        half = 0.5 * np.abs(x0[:3]) + np.radians(scenario.cover_margin)
+        poly = sat.polytope(middle, scenario.dt, scenario.spread, scenario.mode, attitude_range=half)
+    else:
+        poly = sat.polytope(x0, scenario.dt, scenario.spread, scenario.mode)
     built = build_controller(poly, scenario)
     true_sat = sat if scenario.true_inertia is None else RigidSatellite(list(scenario.true_inertia))
     limiter = TorqueLimiter(scenario.u_max) if built.needs_limiter else None

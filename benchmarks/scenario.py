@@ -30,12 +30,13 @@ from benchmarks.metrics import AXES
 from models import PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 
-__all__ = ["Scenario", "run_scenario", "unsupported"]
+__all__ = ["Scenario", "initial_attitude", "run_scenario", "unsupported"]
 
 PLANTS = ("linear", "nonlinear")
 SATURATIONS = ("none", "limiter", "constraint")
 MODES = ("scalar", "box")
 ACTUATORS = ("none", "reaction_wheel")
+KINEMATICS = ("single", "cover", "scheduled")
 
 
 @dataclass(frozen=True)
@@ -63,8 +64,20 @@ class Scenario:
     u_max : float
         Torque limit per axis (N m), > 0 (default 1).
     ic_scale : float
-        Factor on paper P's initial attitude (E6: 1.3); the controller's model is linearised
-        at the scaled initial state.
+        Factor on the initial attitude (E6: 1.3); the controller's model is linearised at the
+        scaled initial state.
+    initial_attitude : (3,) tuple of float or None
+        Initial roll, pitch, yaw in degrees (zero rates); ``None``: paper P's. ``ic_scale``
+        multiplies it too.
+    kinematics : {"single", "cover", "scheduled"}
+        How the robust MPC's polytope treats the nonlinear kinematics. ``"single"`` (paper P):
+        the inertia polytope linearised at the initial attitude. ``"cover"``: the polytope also
+        covers every attitude of the box from zero to the initial attitude, widened by
+        ``cover_margin`` on each side (``RigidSatellite.polytope(..., attitude_range=...)``).
+        ``"scheduled"``: RMPC only, the polytope rebuilt at the measured attitude every step
+        (:class:`rmpc.ScheduledRMPC`).
+    cover_margin : float
+        Widening of the covering box on each side (deg, >= 0; default 5).
     disturbance : float
         Step disturbance torque (N m) on each of ``disturbance_axes``; 0 for none.
     disturbance_start : float
@@ -88,6 +101,9 @@ class Scenario:
     saturation: str = "constraint"
     u_max: float = defaults.U_MAX
     ic_scale: float = 1.0
+    initial_attitude: tuple[float, float, float] | None = None
+    kinematics: str = "single"
+    cover_margin: float = 5.0
     disturbance: float = 0.0
     disturbance_start: float = defaults.DISTURBANCE_START
     disturbance_axes: tuple[str, ...] = defaults.DISTURBANCE_AXES
@@ -140,6 +156,16 @@ class Scenario:
         problem = unsupported(out["controller"], out["saturation"])
         if problem is not None:
             raise ConfigError(name("saturation"), problem, "'constraint'")
+        if out["kinematics"] == "scheduled" and out["controller"] != "RMPC":
+            expected = "'single' or 'cover' for " + out["controller"]
+            raise ConfigError(name("kinematics"), expected, "'scheduled'")
+        attitude = initial_attitude(out["initial_attitude"], out["ic_scale"])
+        if abs(attitude[1]) >= 0.5 * math.pi - 1e-3:
+            raise ConfigError(
+                name("ic_scale") if out["initial_attitude"] is None else name("initial_attitude"),
+                "an initial pitch below 90 deg (3-2-1 Euler angles are singular there)",
+                f"pitch {math.degrees(attitude[1]):.1f} deg",
+            )
         if out["duration"] < out["dt"]:
             raise ConfigError(
                 name("duration"), f"at least one sample (dt = {out['dt']:g} s)", repr(out["duration"])
@@ -188,7 +214,20 @@ class Scenario:
             parts.append(f"d={self.disturbance:g}")
         if self.ic_scale != 1.0:
             parts.append(f"ic x{self.ic_scale:g}")
+        if self.initial_attitude is not None:
+            parts.append("ic " + "/".join(f"{v:g}" for v in self.initial_attitude) + " deg")
+        if self.kinematics != "single":
+            parts.append(self.kinematics)
         return " ".join(parts)
+
+
+def initial_attitude(attitude_deg: Any, ic_scale: float) -> tuple[float, float, float]:
+    """The initial roll, pitch, yaw (rad): ``attitude_deg`` (or paper P's) times ``ic_scale``."""
+    if attitude_deg is None:
+        base = PAPER_P_INITIAL_STATE[:3]
+    else:
+        base = tuple(math.radians(v) for v in attitude_deg)
+    return (base[0] * ic_scale, base[1] * ic_scale, base[2] * ic_scale)
 
 
 def _choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
@@ -243,15 +282,18 @@ def _axes(value: Any, where: str) -> tuple[str, ...]:
 
 
 def _ic_scale(value: Any, where: str) -> float:
-    scale = _real(value, where, low=0.0, low_open=True)
-    pitch = abs(PAPER_P_INITIAL_STATE[1] * scale)
-    if pitch >= 0.5 * math.pi - 1e-3:
-        raise ConfigError(
-            where,
-            "an initial pitch below 90 deg (3-2-1 Euler angles are singular there)",
-            f"{value!r} (pitch {math.degrees(pitch):.1f} deg)",
-        )
-    return scale
+    return _real(value, where, low=0.0, low_open=True)
+
+
+def _attitude_deg(value: Any, where: str) -> tuple[float, float, float] | None:
+    if value is None:
+        return None
+    ok = isinstance(value, list | tuple) and len(value) == 3
+    if ok:
+        nums = [_number(v, where) for v in value]
+    if not ok:
+        raise ConfigError(where, "three angles in degrees (roll, pitch, yaw)", repr(value))
+    return (nums[0], nums[1], nums[2])
 
 
 def _positive(value: Any, where: str) -> float:
@@ -268,6 +310,9 @@ _FIELD_CHECKS: dict[str, Callable[[Any, str], Any]] = {
     "saturation": lambda v, w: _choice(v, w, SATURATIONS),
     "u_max": _positive,
     "ic_scale": _ic_scale,
+    "initial_attitude": _attitude_deg,
+    "kinematics": lambda v, w: _choice(v, w, KINEMATICS),
+    "cover_margin": lambda v, w: _real(v, w, low=0.0, high=45.0),
     "disturbance": _real,
     "disturbance_start": lambda v, w: _real(v, w, low=0.0),
     "disturbance_axes": _axes,

@@ -135,8 +135,8 @@ def test_bad_input_through_the_installed_entry_point_has_no_traceback(tmp_path):
     )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
-        "rmpc: error: base.controller: expected one of 'RMPC', 'GIPC', 'CRMPC', 'OfflineRMPC', 'LQR', "
-        "but found 'PID'"
+        "rmpc: error: base.controller: expected one of 'RMPC', 'GIPC', 'CRMPC', 'CRMPC-MIT', 'OfflineRMPC', "
+        "'LQR', but found 'PID'"
     ]
 
 
