@@ -22,16 +22,16 @@ def test_paper_suite_short_writes_every_file(tmp_path, capsys):
     status = main(["bench", "paper", "--out", str(out), "--short", "--workers", "2"])
     stdout = capsys.readouterr().out
     assert status == 0, stdout
-    assert "20 cases done, 0 failed" in stdout
+    assert "21 cases done, 0 failed" in stdout
     for name in ("results.json", "results.md", "results.csv", "results.tex", "results_table.json",
                  "run.json"):
         assert (out / name).stat().st_size > 0, name
     figures = {p.name for p in (out / "figures").glob("*.png")}
     assert figures == {f"{e}.png" for e in EXPERIMENTS} | {"E3_linear_vs_nonlinear.png", "gamma.png"}
-    assert len(list((out / "traces").glob("*.npz"))) == 20
+    assert len(list((out / "traces").glob("*.npz"))) == 21
 
     records = json.loads((out / "results.json").read_text())
-    assert isinstance(records, list) and len(records) == 20
+    assert isinstance(records, list) and len(records) == 21
     expected = {(c.experiment, c.scenario.controller, c.scenario.plant, c.scenario.saturation)
                 for c in paper_cases()}
     assert {(r["experiment"], r["controller"], r["plant"], r["saturation"]) for r in records} == expected
@@ -59,7 +59,7 @@ def test_paper_suite_short_writes_every_file(tmp_path, capsys):
     assert "## Settings" in md and "resolve_threshold" in md and "R_diag" in md
     assert "disturbance axes" in md and "figures/gamma.png" in md
     assert "\\begin{tabular}" in (out / "results.tex").read_text()
-    assert (out / "results.csv").read_text().count("\n") == 21
+    assert (out / "results.csv").read_text().count("\n") == 22  # header + 21 cases
 
 
 def _sweep_file(tmp_path: Path, text: str) -> Path:
@@ -154,3 +154,14 @@ def test_timing_command_is_wired_into_the_parser(capsys):
         main(["timing", "--help"])
     assert info.value.code == 0
     assert "--out" in capsys.readouterr().out
+
+
+def test_paper_results_md_states_every_claim(tmp_path):
+    out = tmp_path / "paper"
+    assert main(["bench", "paper", "--out", str(out), "--short", "--workers", "0",
+                 "--experiments", "E4,E5"]) == 0
+    md = (out / "results.md").read_text()
+    assert "## Paper P's claims" in md
+    for exp in ("E4", "E5"):
+        assert f"**{exp}: " in md
+    assert "**E1: not run.**" in md
