@@ -1,17 +1,19 @@
 """Scenarios, sweeps, metrics, reports and the ``rmpc`` command line.
 
-One module per job:
+The package has one room per kind of work:
 
-- :mod:`benchmarks.defaults`: every setting paper P leaves out, in one place;
-- :mod:`benchmarks.scenario`: the validated :class:`~benchmarks.scenario.Scenario` of one run;
-- :mod:`benchmarks.controllers`: the controller registry and saturation handling;
-- :mod:`benchmarks.runner`: one scenario simulated and measured (what workers run);
-- :mod:`benchmarks.metrics`: errors, settling, overshoot, torques, solver effort;
-- :mod:`benchmarks.executors` and :mod:`benchmarks.execute`: local processes or Dask, one loop;
-- :mod:`benchmarks.store`: the SQLite store that makes sweeps resumable;
-- :mod:`benchmarks.sweep`: TOML sweeps (grid and Monte-Carlo) and their reports;
-- :mod:`benchmarks.paper`: experiments E1-E6 of paper P;
-- :mod:`benchmarks.report`, :mod:`benchmarks.plots`, :mod:`benchmarks.progress`: tables, figures,
-  the progress bar;
-- :mod:`benchmarks.cli`: ``rmpc demo``, ``rmpc bench paper``, ``rmpc bench sweep``.
+- :mod:`benchmarks.core`: the harness itself, independent of any plant: the validated
+  :class:`~benchmarks.core.scenario.Scenario`, the plant-family registry
+  (:mod:`benchmarks.core.family`), one case simulated and measured (:mod:`~benchmarks.core.runner`,
+  what workers run), generic metrics, local processes or Dask (:mod:`~benchmarks.core.executors`,
+  :mod:`~benchmarks.core.execute`), the resumable SQLite store and TOML sweeps;
+- :mod:`benchmarks.families`: one sub-package per plant family (its scenario fields and
+  defaults, its controllers, how a case is built and simulated, its own metrics); a new family
+  registers itself there without editing the core;
+- :mod:`benchmarks.suites`: the experiments of each paper the toolkit reproduces
+  (``rmpc bench paper``) and the checks of their claims;
+- :mod:`benchmarks.timing`: the solver timing reports (``rmpc timing``);
+- :mod:`benchmarks.reports`: tables (Markdown, CSV, LaTeX, JSON) and figures;
+- :mod:`benchmarks.cli`: the ``rmpc`` command;
+- ``benchmarks/sweeps/``: the shipped sweep files.
 """

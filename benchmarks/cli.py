@@ -60,8 +60,8 @@ def _experiments(text: str) -> list[str]:
 
 
 def _cmd_bench_paper(args: argparse.Namespace) -> int:
-    from benchmarks.defaults import SHORT_DURATION_SCALE
-    from benchmarks.paper import run_paper
+    from benchmarks.families.rigid.defaults import SHORT_DURATION_SCALE
+    from benchmarks.suites.paper import run_paper
 
     scale = SHORT_DURATION_SCALE if args.short else args.duration_scale
     outcome = run_paper(
@@ -87,7 +87,7 @@ def _cmd_bench_paper(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
-    from benchmarks.sweep import run_sweep
+    from benchmarks.core.sweep import run_sweep
 
     outcome = run_sweep(
         args.config,

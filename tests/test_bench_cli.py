@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from benchmarks.cli import main
-from benchmarks.paper import EXPERIMENTS, paper_cases
+from benchmarks.suites.paper import EXPERIMENTS, paper_cases
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.scenario import Scenario, initial_attitude, run_scenario
+from benchmarks.core.scenario import Scenario, initial_attitude, run_scenario
 from toolkit_common.errors import ConfigError
 
 

@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks import runner
+from benchmarks.core import runner
 from benchmarks.cli import main
-from benchmarks.store import STORE_NAME
-from benchmarks.sweep import expand, left_out, load_sweep, parse_sweep
+from benchmarks.core.store import STORE_NAME
+from benchmarks.core.sweep import expand, left_out, load_sweep, parse_sweep
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
 

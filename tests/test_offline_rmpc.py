@@ -183,7 +183,7 @@ def test_lookup_without_interpolation(kothare_plain) -> None:
 
 
 def test_lookup_is_fast(sat_ctrl, sat_x0) -> None:
-    """A loose regression guard; ``python -m benchmarks.offline_timing`` measures the real figure."""
+    """A loose regression guard; ``python -m benchmarks.timing.offline`` measures the real figure."""
     sat_ctrl.reset()
     times = []
     for s in np.geomspace(1.0, 1e-3, 300):

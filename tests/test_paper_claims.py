@@ -1,8 +1,8 @@
-"""benchmarks.paper_claims: each verdict follows the numbers (synthetic records)."""
+"""benchmarks.suites.paper_claims: each verdict follows the numbers (synthetic records)."""
 
 from __future__ import annotations
 
-from benchmarks.paper_claims import CLOSE_RELATIVE, assess_claims
+from benchmarks.suites.paper_claims import CLOSE_RELATIVE, assess_claims
 
 
 def _rec(exp, ctrl, plant, sat, sum_e=(10.0, 10.0, 10.0), final=1e-9, max_u=0.5, max_cmd=None,

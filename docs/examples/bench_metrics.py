@@ -1,9 +1,9 @@
 """The metrics of one benchmark case: a 10 s LQR run on the nonlinear satellite with a limiter."""
 
-from benchmarks.runner import simulate_scenario
-from benchmarks.scenario import Scenario
+from benchmarks.core.runner import simulate_scenario
+from benchmarks.core.scenario import Scenario
 
-# Every field not given takes its default (benchmarks.defaults): paper P's satellite and
+# Every field not given takes its default (benchmarks.families.rigid.defaults): paper P's satellite and
 # initial attitude, Ts = 0.01 s, u_max = 1 N m, the toolkit's weights Q1 and R.
 scenario = Scenario.from_dict(
     {"controller": "LQR", "plant": "nonlinear", "saturation": "limiter", "duration": 10.0}

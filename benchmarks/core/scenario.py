@@ -7,7 +7,7 @@ record that ``results.json`` holds.
 
 Examples
 --------
->>> from benchmarks.scenario import Scenario
+>>> from benchmarks.core.scenario import Scenario
 >>> sc = Scenario.from_dict({"controller": "LQR", "saturation": "limiter", "duration": 1.0})
 >>> sc.plant, sc.spread, sc.settings["R_diag"]
 ('nonlinear', 0.3, (0.01, 0.01, 0.01))
@@ -24,9 +24,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-from benchmarks import defaults
-from benchmarks.controllers import CONSTRAINED, CONTROLLERS, effective_settings
-from benchmarks.metrics import AXES
+from benchmarks.families.rigid import defaults
+from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, effective_settings
+from benchmarks.core.metrics import AXES
 from models import PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 
@@ -49,9 +49,9 @@ class Scenario:
         The simulated satellite: the nonlinear model, or the discretised linearisation at the
         initial state (the controller's model) with the true inertia.
     controller : {"RMPC", "GIPC", "CRMPC", "OfflineRMPC", "LQR"}
-        A name of :data:`benchmarks.controllers.CONTROLLERS`.
+        A name of :data:`benchmarks.families.rigid.controllers.CONTROLLERS`.
     settings : mapping
-        The controller's settings: its defaults (:data:`benchmarks.defaults.CONTROLLER_DEFAULTS`)
+        The controller's settings: its defaults (:data:`benchmarks.families.rigid.defaults.CONTROLLER_DEFAULTS`)
         updated by what the scenario gives; after validation it holds every setting.
     spread : float
         Relative inertia uncertainty of the controller's polytope, in ``[0, 1)`` (default 0.3).
@@ -60,7 +60,7 @@ class Scenario:
     true_inertia : (3,) tuple of float or None
         Principal inertias of the simulated satellite (kg m^2); ``None``: paper P's.
     saturation : {"constraint", "limiter", "none"}
-        How the torque limit is handled (see :mod:`benchmarks.controllers`).
+        How the torque limit is handled (see :mod:`benchmarks.families.rigid.controllers`).
     u_max : float
         Torque limit per axis (N m), > 0 (default 1).
     ic_scale : float
@@ -128,7 +128,7 @@ class Scenario:
             Dotted prefix naming ``data`` in error messages (e.g. ``"base"``).
         lenient_settings : bool
             Drop settings that belong to another controller (sweeps over several controllers
-            share one settings table); see :func:`benchmarks.controllers.effective_settings`.
+            share one settings table); see :func:`benchmarks.families.rigid.controllers.effective_settings`.
 
         Raises
         ------
@@ -330,8 +330,8 @@ def unsupported(controller: str, saturation: str) -> str | None:
 
 
 def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:
-    """Simulate ``scenario`` and return its record (see :func:`benchmarks.runner.simulate_scenario`)."""
-    from benchmarks.runner import simulate_scenario
+    """Simulate ``scenario`` and return its record (see :func:`benchmarks.core.runner.simulate_scenario`)."""
+    from benchmarks.core.runner import simulate_scenario
 
     record, _ = simulate_scenario(scenario, experiment=experiment)
     return record

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.controllers import build_controller
-from benchmarks.defaults import SETTLING_BAND
-from benchmarks.metrics import AXES, compute_metrics
-from benchmarks.scenario import Scenario, initial_attitude
+from benchmarks.families.rigid.controllers import build_controller
+from benchmarks.families.rigid.defaults import SETTLING_BAND
+from benchmarks.core.metrics import AXES, compute_metrics
+from benchmarks.core.scenario import Scenario, initial_attitude
 
 __all__ = ["run_case", "simulate_scenario"]
 

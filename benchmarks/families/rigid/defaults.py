@@ -4,7 +4,7 @@ Paper P fixes the satellite, the torque limit (1 N m), the initial attitude, the
 GIPC's bounds (``|u| <= 1``, ``|du| <= 0.01``), the disturbance (0.5 N m from t = 10 s), the
 E5 uncertainty (+-70 %) and the E6 initial-condition factor (1.3). Everything else below is
 the toolkit's choice; :func:`settings_rows` lists it for the reports, and every value is a
-field of :class:`benchmarks.scenario.Scenario` or a controller setting, so a sweep can vary it.
+field of :class:`benchmarks.core.scenario.Scenario` or a controller setting, so a sweep can vary it.
 
 Why these values
 ----------------

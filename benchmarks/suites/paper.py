@@ -11,7 +11,7 @@ E5    E4 with +-70 % inertia uncertainty (true inertia 1.7 x nominal)        non
 E6    initial attitude x 1.3: RMPC and GIPC                                  linear, nonlinear
 ====  =====================================================================  ================
 
-:func:`paper_cases` lists the cases (settings from :mod:`benchmarks.defaults`);
+:func:`paper_cases` lists the cases (settings from :mod:`benchmarks.families.rigid.defaults`);
 :func:`run_paper` runs them in parallel and writes ``results.json``, ``results.md``,
 ``results.csv``, ``results.tex``, ``results_table.json``, ``run.json``, the figures
 (``figures/*.png``) and the trajectories (``traces/*.npz``).
@@ -28,13 +28,13 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks import defaults
-from benchmarks.execute import ExecOutcome, Task, execute
-from benchmarks.executors import make_executor
-from benchmarks.machine import machine_info, package_versions
-from benchmarks.progress import CaseProgress
-from benchmarks.report import metric_table, to_markdown, write_tables
-from benchmarks.scenario import Scenario
+from benchmarks.families.rigid import defaults
+from benchmarks.core.execute import ExecOutcome, Task, execute
+from benchmarks.core.executors import make_executor
+from benchmarks.core.machine import machine_info, package_versions
+from benchmarks.core.progress import CaseProgress
+from benchmarks.reports.tables import metric_table, to_markdown, write_tables
+from benchmarks.core.scenario import Scenario
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
 
@@ -226,7 +226,7 @@ def _write(
     duration_scale: float,
     where: str,
 ) -> list[Path]:
-    from benchmarks.plots import plot_gamma, plot_responses
+    from benchmarks.reports.figures import plot_gamma, plot_responses
 
     files: list[Path] = []
     (out / "figures").mkdir(exist_ok=True)
@@ -289,8 +289,8 @@ def _markdown(
     info: dict[str, Any],
     out: Path,
 ) -> str:
-    from benchmarks.defaults import rationale, settings_rows
-    from benchmarks.paper_claims import assess_claims, claims_markdown
+    from benchmarks.families.rigid.defaults import rationale, settings_rows
+    from benchmarks.suites.paper_claims import assess_claims, claims_markdown
 
     lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", ""]
     m = info["machine"]

@@ -7,7 +7,7 @@ four significant digits in Markdown and LaTeX and in full in CSV and JSON.
 
 Examples
 --------
->>> from benchmarks.report import to_markdown
+>>> from benchmarks.reports.tables import to_markdown
 >>> print(to_markdown(["a", "b"], [[1, 0.123456], ["x", None]]))
 | a | b |
 | --- | --- |
@@ -24,7 +24,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from benchmarks.metrics import AXES
+from benchmarks.core.metrics import AXES
 
 __all__ = [
     "METRIC_COLUMNS",

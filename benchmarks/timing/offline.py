@@ -1,6 +1,6 @@
 """Per-step lookup time and design time of off-line robust MPC on paper P's satellite.
 
-Run as ``python -m benchmarks.offline_timing [--steps N] [--repeats R] [--out FILE]``. For
+Run as ``python -m benchmarks.timing.offline [--steps N] [--repeats R] [--out FILE]``. For
 2 and 8 vertices (inertia spread 0.3, ``||u|| <= 1``, Ts = 0.01 s, ``Q1 = diag(1, 1, 1, 0.1,
 0.1, 0.1)``, ``R = I``) it designs :class:`rmpc.OfflineRMPC` from paper P's initial state (15
 ellipsoids along its ray; the design time is the wall time of the construction), runs one closed
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.machine import machine_info, package_versions, percentiles
+from benchmarks.core.machine import machine_info, package_versions, percentiles
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import OfflineRMPC, simulate
 

@@ -52,7 +52,7 @@ def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: flo
     Parameters
     ----------
     runs : sequence of (record, trace)
-        ``trace`` has ``t``, ``x`` and ``u_applied`` (see :func:`benchmarks.runner.simulate_scenario`).
+        ``trace`` has ``t``, ``x`` and ``u_applied`` (see :func:`benchmarks.core.runner.simulate_scenario`).
     path : str or Path
         Output PNG.
     title : str

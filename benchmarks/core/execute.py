@@ -22,15 +22,15 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from benchmarks.executors import CaseExecutor, WorkerLost
-from benchmarks.runner import run_case
+from benchmarks.core.executors import CaseExecutor, WorkerLost
+from benchmarks.core.runner import run_case
 
 __all__ = ["ExecOutcome", "Task", "execute"]
 
 
 @dataclass(frozen=True)
 class Task:
-    """A case to run: its key (case id) and the payload of :func:`benchmarks.runner.run_case`."""
+    """A case to run: its key (case id) and the payload of :func:`benchmarks.core.runner.run_case`."""
 
     key: str
     payload: dict[str, Any]
@@ -95,7 +95,7 @@ def execute(
     executor : CaseExecutor
         Where they run.
     on_result : callable
-        Receives the task and the dict returned by :func:`benchmarks.runner.run_case`.
+        Receives the task and the dict returned by :func:`benchmarks.core.runner.run_case`.
     max_restarts : int
         How many times a broken worker pool is replaced before giving up.
     notice : callable

@@ -1,7 +1,7 @@
 """The controller registry of the benchmarks: names to factories, and their settings.
 
 Each factory takes the controller's polytope, the scenario and the effective settings (the
-defaults of :data:`benchmarks.defaults.CONTROLLER_DEFAULTS` updated by the scenario's
+defaults of :data:`benchmarks.families.rigid.defaults.CONTROLLER_DEFAULTS` updated by the scenario's
 ``settings``) and returns the controller. How saturation is handled:
 
 - ``"constraint"``: the controller's own constraint (RMPC and OfflineRMPC: the input
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.defaults import CONTROLLER_DEFAULTS, SETTING_CHOICES
+from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS, SETTING_CHOICES
 from toolkit_common.errors import ConfigError
 
 __all__ = ["CONTROLLERS", "BuiltController", "build_controller", "check_setting", "effective_settings"]

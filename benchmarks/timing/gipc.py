@@ -1,6 +1,6 @@
 """Per-step time of GIPC with each QP back-end, against the same QP through cvxpy, in one run.
 
-Run as ``python -m benchmarks.gipc_timing [--steps N] [--plant linear|nonlinear] [--json FILE]``.
+Run as ``python -m benchmarks.timing.gipc [--steps N] [--plant linear|nonlinear] [--json FILE]``.
 
 Each back-end drives its own closed loop of paper P's problem: the satellite from paper P's
 initial attitude, ``Ts = 0.01`` s, GIPC with its defaults (``Np = 400``, ``Nc = 4``,
@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.machine import machine_info, package_versions, percentiles
+from benchmarks.core.machine import machine_info, package_versions, percentiles
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import GIPC, StepDisturbance, simulate
 from rmpc.qp import reference_solution
@@ -123,7 +123,7 @@ def _print(report: dict[str, Any]) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
     parser = argparse.ArgumentParser(
-        prog="python -m benchmarks.gipc_timing", description=(__doc__ or "").split("\n")[0]
+        prog="python -m benchmarks.timing.gipc", description=(__doc__ or "").split("\n")[0]
     )
     parser.add_argument(
         "--steps", type=int, default=2000, help="closed-loop steps per back-end (default 2000)"

@@ -1,6 +1,6 @@
 """Per-step solve time of online robust MPC on paper P's problem, fast path vs rebuild path.
 
-Run as ``python -m benchmarks.rmpc_timing [--steps N] [--out FILE]``. For 2 and 8 vertices
+Run as ``python -m benchmarks.timing.rmpc [--steps N] [--out FILE]``. For 2 and 8 vertices
 (inertia spread 0.3, ``||u|| <= 1``, Ts = 0.01 s) it follows the states of one closed loop
 from paper P's initial attitude (the linear model, the vertex of the larger inertia) and at
 each state times, in the same run:
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.machine import machine_info, package_versions, percentiles
+from benchmarks.core.machine import machine_info, package_versions, percentiles
 from lmi import KothareProblem
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 

@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from benchmarks.metrics import AXES
+from benchmarks.core.metrics import AXES
 
 __all__ = [
     "CLOSE_RELATIVE",
@@ -276,7 +276,7 @@ def assess_claims(records: Sequence[dict[str, Any]]) -> list[Claim]:
 
     Examples
     --------
-    >>> from benchmarks.paper_claims import assess_claims
+    >>> from benchmarks.suites.paper_claims import assess_claims
     >>> [c.verdict for c in assess_claims([])]
     ['not run', 'not run', 'not run', 'not run', 'not run', 'not run']
     """

@@ -1,7 +1,7 @@
 """Where cases run: worker processes on this machine, in-process, or a Dask cluster.
 
 All three offer the same small interface (:class:`CaseExecutor`), so the loop of
-:mod:`benchmarks.execute` is one code path: ``submit`` a payload, ``wait_any`` for finished
+:mod:`benchmarks.core.execute` is one code path: ``submit`` a payload, ``wait_any`` for finished
 futures, ``result`` of one (raising :class:`WorkerLost` when the infrastructure, not the case,
 failed), ``restart`` after a crash where possible, and ``close``.
 
@@ -43,7 +43,7 @@ class WorkerLost(RuntimeError):
 
 
 class CaseExecutor(Protocol):
-    """The interface of :mod:`benchmarks.execute`."""
+    """The interface of :mod:`benchmarks.core.execute`."""
 
     workers: int
     description: str
@@ -78,7 +78,7 @@ def _init_worker() -> None:
 
 #: Modules the fork server imports once, so that each worker starts with them loaded (importing
 #: the controllers, cvxpy, python-control and SciPy costs about 2 s of CPU per process).
-PRELOAD: tuple[str, ...] = ("benchmarks.runner", "rmpc", "rmpc.gipc", "rmpc.crmpc", "lmi", "control",
+PRELOAD: tuple[str, ...] = ("benchmarks.core.runner", "rmpc", "rmpc.gipc", "rmpc.crmpc", "lmi", "control",
                             "scipy.integrate")
 
 

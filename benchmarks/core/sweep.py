@@ -5,10 +5,10 @@ A sweep file has up to five top-level entries, all optional::
     name = "smoke"                      # used in reports
     description = "what it is for"
 
-    [base]                              # scenario fields (benchmarks.scenario.Scenario)
+    [base]                              # scenario fields (benchmarks.core.scenario.Scenario)
     controller = "GIPC"
     duration = 2.0
-    [base.settings]                     # controller settings (benchmarks.defaults)
+    [base.settings]                     # controller settings (benchmarks.families.rigid.defaults)
     Np = 200
 
     [grid]                              # the product of these lists, over any field
@@ -23,7 +23,7 @@ A sweep file has up to five top-level entries, all optional::
 Each grid point is repeated for the ``n`` draws: the true principal inertias are
 ``J0_i (1 + spread u_i)`` with ``u`` uniform in ``[-1, 1]^3`` (one common ``u`` in
 ``"scalar"`` mode), from ``numpy.random.default_rng(seed)``; every grid point gets the same
-draws. Cases are keyed by :attr:`benchmarks.scenario.Scenario.case_id`, so re-running a sweep
+draws. Cases are keyed by :attr:`benchmarks.core.scenario.Scenario.case_id`, so re-running a sweep
 skips the cases its store already holds and a grid that repeats a case runs it once. A
 ``settings`` table may hold settings of several controllers (each case takes those of its own
 controller); grid combinations a controller cannot run (LQR with ``saturation = "constraint"``)
@@ -45,15 +45,15 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.controllers import check_setting
-from benchmarks.defaults import CONTROLLER_DEFAULTS
-from benchmarks.execute import ExecOutcome, Task, execute
-from benchmarks.executors import make_executor
-from benchmarks.machine import machine_info, package_versions
-from benchmarks.progress import CaseProgress
-from benchmarks.report import metric_table, to_markdown, varying_fields, write_tables
-from benchmarks.scenario import Scenario, unsupported
-from benchmarks.store import STORE_NAME, CaseStore
+from benchmarks.families.rigid.controllers import check_setting
+from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS
+from benchmarks.core.execute import ExecOutcome, Task, execute
+from benchmarks.core.executors import make_executor
+from benchmarks.core.machine import machine_info, package_versions
+from benchmarks.core.progress import CaseProgress
+from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
+from benchmarks.core.scenario import Scenario, unsupported
+from benchmarks.core.store import STORE_NAME, CaseStore
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
 
@@ -85,7 +85,7 @@ class SweepSpec:
 
 
 #: The example sweeps shipped with the package.
-SHIPPED = Path(__file__).resolve().parent / "sweeps"
+SHIPPED = Path(__file__).resolve().parent.parent / "sweeps"
 
 
 def resolve_config(path: str | Path) -> Path:

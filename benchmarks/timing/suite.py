@@ -42,13 +42,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from benchmarks.machine import machine_info, package_versions, percentiles
+from benchmarks.core.machine import machine_info, package_versions, percentiles
 from toolkit_common.errors import InvalidArgumentError
 
 # The solvers, models and controllers are imported where they are used, so that registering the
 # sub-command (add_timing_parser) costs the ``rmpc`` command line nothing at start-up.
 if TYPE_CHECKING:
-    from benchmarks.progress import CaseProgress
+    from benchmarks.core.progress import CaseProgress
     from lmi import KothareProblem, LMISolution
     from models import PolytopicModel
 
@@ -272,7 +272,7 @@ class _Path:
 
 
 def _rmpc_paths(poly: PolytopicModel, cfg: TimingConfig) -> tuple[list[_Path], list[_Path]]:
-    from benchmarks.rmpc_timing import Q1, U_MAX, R
+    from benchmarks.timing.rmpc import Q1, U_MAX, R
     from lmi import KothareProblem
 
     def maker(backend: str, formulation: str, solver: str | None = None,
@@ -409,7 +409,7 @@ def time_rmpc(poly: PolytopicModel, cfg: TimingConfig, bar: CaseProgress | None 
 
 def reference_gamma_at(poly: PolytopicModel, x: np.ndarray) -> float:
     """``gamma(x)`` from the first optimal candidate of :data:`REFERENCES` (NaN if none is)."""
-    from benchmarks.rmpc_timing import Q1, U_MAX, R
+    from benchmarks.timing.rmpc import Q1, U_MAX, R
     from lmi import KothareProblem
 
     for formulation, tol in REFERENCES:
@@ -423,8 +423,8 @@ def reference_gamma_at(poly: PolytopicModel, x: np.ndarray) -> float:
 # -- OfflineRMPC ----------------------------------------------------------------------------------
 def time_offline(poly: PolytopicModel, cfg: TimingConfig, gamma_x0: float | None) -> dict[str, Any]:
     """Design OfflineRMPC at ``x0``, then time its lookups at the states of its own closed loop."""
-    from benchmarks.offline_timing import reference_u
-    from benchmarks.rmpc_timing import Q1, U_MAX, R
+    from benchmarks.timing.offline import reference_u
+    from benchmarks.timing.rmpc import Q1, U_MAX, R
     from models import RigidSatellite
     from rmpc import OfflineRMPC, simulate
 
@@ -571,8 +571,8 @@ def run_timing(cfg: TimingConfig) -> dict[str, Any]:
 
 
 def _run(cfg: TimingConfig) -> dict[str, Any]:
-    from benchmarks.progress import CaseProgress
-    from benchmarks.rmpc_timing import Q1, U_MAX, R
+    from benchmarks.core.progress import CaseProgress
+    from benchmarks.timing.rmpc import Q1, U_MAX, R
     from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 
     start = time.perf_counter()
@@ -782,7 +782,7 @@ def format_markdown(report: dict[str, Any], plot_name: str | None = "timing.png"
 
 def write_report(result: dict[str, Any], out: Path) -> list[Path]:
     """Write ``timing.json``, ``timing.md``, ``timing.png`` and ``timing_samples.npz`` into ``out``."""
-    from benchmarks.timing_plots import plot_distributions
+    from benchmarks.timing.plots import plot_distributions
 
     out.mkdir(parents=True, exist_ok=True)
     report = result["report"]

@@ -13,7 +13,7 @@ a case is stored at most once; ``run`` says which invocation of the sweep finish
 Examples
 --------
 >>> import tempfile, os
->>> from benchmarks.store import CaseStore
+>>> from benchmarks.core.store import CaseStore
 >>> with tempfile.TemporaryDirectory() as tmp:
 ...     with CaseStore(os.path.join(tmp, "s.sqlite")) as store:
 ...         run = store.begin_run("example")

@@ -1,0 +1,1 @@
+"""Plant families of the benchmarks (see :mod:`benchmarks.core.family`)."""

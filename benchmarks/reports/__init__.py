@@ -1,0 +1,1 @@
+"""Tables (Markdown, CSV, LaTeX, JSON) and figures shared by the suites and sweeps."""
