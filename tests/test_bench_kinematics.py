@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.core.scenario import Scenario, initial_attitude, run_scenario
+from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.families.rigid.family import initial_attitude
 from toolkit_common.errors import ConfigError
 
 

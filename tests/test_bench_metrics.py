@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from benchmarks.core.metrics import compute_metrics, iae, ise, overshoot, settling_time
-from benchmarks.reports.tables import metric_table, to_csv, to_json, to_latex, to_markdown
 from benchmarks.core.scenario import Scenario
+from benchmarks.reports.tables import metric_table, to_csv, to_json, to_latex, to_markdown
 from rmpc import StepInfo, Trajectory
 from toolkit_common.errors import ConfigError
 

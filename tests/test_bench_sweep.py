@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.core import runner
 from benchmarks.cli import main
+from benchmarks.core import runner
 from benchmarks.core.store import STORE_NAME
 from benchmarks.core.sweep import expand, left_out, load_sweep, parse_sweep
 from models import PAPER_P_INERTIA

@@ -1,4 +1,4 @@
-"""Run one scenario: build plant, controller, limiter and disturbance, simulate, measure.
+"""Run one scenario through its plant family (build, simulate, measure) and make its record.
 
 :func:`run_case` is the function worker processes (or Dask workers) execute; it never raises
 for a failing case but returns the error, so a sweep can record it and go on.
@@ -12,10 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.families.rigid.controllers import build_controller
-from benchmarks.families.rigid.defaults import SETTLING_BAND
-from benchmarks.core.metrics import AXES, compute_metrics
-from benchmarks.core.scenario import Scenario, initial_attitude
+from benchmarks.core.scenario import Scenario
 
 __all__ = ["run_case", "simulate_scenario"]
 
@@ -55,55 +52,12 @@ def simulate_scenario(
         slowed the case down).
     trace : dict of ndarray or None
     """
-    from models import ReactionWheelActuator, RigidSatellite, TorqueLimiter
-    from rmpc import StepDisturbance, simulate
-
     start, cpu_start = time.perf_counter(), time.process_time()
-    sat = RigidSatellite.paper_p()
-    x0 = np.concatenate((initial_attitude(scenario.initial_attitude, scenario.ic_scale), np.zeros(3)))
-    if scenario.kinematics == "cover":
-        middle = np.concatenate((0.5 * x0[:3], np.zeros(3)))
-        half = 0.5 * np.abs(x0[:3]) + np.radians(scenario.cover_margin)
-        poly = sat.polytope(middle, scenario.dt, scenario.spread, scenario.mode, attitude_range=half)
-    else:
-        poly = sat.polytope(x0, scenario.dt, scenario.spread, scenario.mode)
-    built = build_controller(poly, scenario)
-    true_sat = sat if scenario.true_inertia is None else RigidSatellite(list(scenario.true_inertia))
-    limiter = TorqueLimiter(scenario.u_max) if built.needs_limiter else None
-    disturbance = None
-    if scenario.disturbance != 0.0:
-        magnitude = np.array(
-            [scenario.disturbance if ax in scenario.disturbance_axes else 0.0 for ax in AXES]
-        )
-        disturbance = StepDisturbance(magnitude, t_start=scenario.disturbance_start)
-    actuator = ReactionWheelActuator() if scenario.actuator == "reaction_wheel" else None
-    if scenario.plant == "nonlinear":
-        plant, true_plant, dt = true_sat, None, scenario.dt
-    else:
-        plant, dt = poly, None
-        true_plant = None if scenario.true_inertia is None else true_sat.discretize(x0, scenario.dt)
-    traj = simulate(
-        built.controller,
-        plant,
-        x0,
-        duration=scenario.duration,
-        dt=dt,
-        true_plant=true_plant,
-        limiter=limiter,
-        disturbance=disturbance,
-        actuator=actuator,
-    )
-    settings = scenario.to_dict()
-    settings.update(
-        {
-            "x0": x0.tolist(),
-            "true_inertia_used": np.diag(true_sat.inertia).tolist(),
-            "linearization_point": x0.tolist(),
-            "limiter_in_loop": limiter is not None,
-            "settling_band": SETTLING_BAND,
-            "n_vertices": poly.n_vertices,
-        }
-    )
+    family = scenario.plant_family
+    settings = family.effective_settings(scenario.controller, scenario.settings)
+    result = family.simulate(scenario, settings, keep_trace)
+    record_settings = scenario.to_dict()
+    record_settings.update(result.settings)
     record = {
         "experiment": experiment if experiment is not None else scenario.case_id,
         "case_id": scenario.case_id,
@@ -112,21 +66,12 @@ def simulate_scenario(
         "plant": scenario.plant,
         "saturation": scenario.saturation,
         "status": "done",
-        "settings": settings,
-        "metrics": compute_metrics(traj, scenario.u_max, SETTLING_BAND),
+        "settings": record_settings,
+        "metrics": result.metrics,
         "wall_time_s": time.perf_counter() - start,
         "cpu_time_s": time.process_time() - cpu_start,
     }
-    trace = None
-    if keep_trace:
-        trace = {
-            "t": traj.t,
-            "x": traj.x,
-            "u_cmd": traj.u_cmd,
-            "u_applied": traj.u_applied,
-            "d": traj.d,
-            "gamma": traj.gamma,
-        }
+    trace = result.trace if keep_trace else None
     return _json_safe(record), trace
 
 

@@ -1,16 +1,18 @@
-"""A benchmark scenario: plant, uncertainty, saturation, initial condition, disturbance, controller.
+"""A benchmark scenario: the plant family, its fields, the controller and its settings.
 
-A :class:`Scenario` is a frozen, validated description of one closed-loop run; its
-:attr:`Scenario.case_id` is a stable hash of :meth:`Scenario.to_dict`, so the same case gets
-the same id in every sweep and every run. :func:`run_scenario` simulates it and returns the
-record that ``results.json`` holds.
+A :class:`Scenario` is an immutable, validated description of one closed-loop run. Its fields
+are the core's (``family``, ``controller``, ``settings``) and those of its plant family
+(:mod:`benchmarks.core.family`; paper P's rigid satellite by default, whose fields are listed in
+:mod:`benchmarks.families.rigid.family`). :attr:`Scenario.case_id` is a stable hash of
+:meth:`Scenario.to_dict`, so the same case gets the same id in every sweep and every run.
+:func:`run_scenario` simulates it and returns the record that ``results.json`` holds.
 
 Examples
 --------
 >>> from benchmarks.core.scenario import Scenario
 >>> sc = Scenario.from_dict({"controller": "LQR", "saturation": "limiter", "duration": 1.0})
->>> sc.plant, sc.spread, sc.settings["R_diag"]
-('nonlinear', 0.3, (0.01, 0.01, 0.01))
+>>> sc.family, sc.plant, sc.spread, sc.settings["R_diag"]
+('rigid', 'nonlinear', 0.3, (0.01, 0.01, 0.01))
 >>> len(sc.case_id)
 16
 """
@@ -19,102 +21,107 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any
 
-from benchmarks.families.rigid import defaults
-from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, effective_settings
-from benchmarks.core.metrics import AXES
-from models import PAPER_P_INITIAL_STATE
+from benchmarks.core.family import PlantFamily, get_family
 from toolkit_common.errors import ConfigError
 
-__all__ = ["Scenario", "initial_attitude", "run_scenario", "unsupported"]
+__all__ = ["CORE_FIELDS", "DEFAULT_FAMILY", "Scenario", "run_scenario"]
 
-PLANTS = ("linear", "nonlinear")
-SATURATIONS = ("none", "limiter", "constraint")
-MODES = ("scalar", "box")
-ACTUATORS = ("none", "reaction_wheel")
-KINEMATICS = ("single", "cover", "scheduled")
+#: The family of a scenario that does not name one: paper P's rigid satellite.
+DEFAULT_FAMILY = "rigid"
+#: The fields every scenario has, whatever its family.
+CORE_FIELDS = ("family", "controller", "settings")
+#: The controller of a scenario that does not name one.
+DEFAULT_CONTROLLER = "RMPC"
 
 
-@dataclass(frozen=True)
 class Scenario:
     """One closed-loop run of the benchmark (every field has a default).
 
+    Build it with :meth:`from_dict`, which validates every field. The family's fields are
+    attributes (``scenario.spread``, ``scenario.plant``, ...).
+
     Attributes
     ----------
-    plant : {"nonlinear", "linear"}
-        The simulated satellite: the nonlinear model, or the discretised linearisation at the
-        initial state (the controller's model) with the true inertia.
-    controller : {"RMPC", "GIPC", "CRMPC", "OfflineRMPC", "LQR"}
-        A name of :data:`benchmarks.families.rigid.controllers.CONTROLLERS`.
+    family : str
+        A registered plant family (default ``"rigid"``, paper P's satellite).
+    controller : str
+        A controller of the family (default ``"RMPC"``).
     settings : mapping
-        The controller's settings: its defaults (:data:`benchmarks.families.rigid.defaults.CONTROLLER_DEFAULTS`)
-        updated by what the scenario gives; after validation it holds every setting.
-    spread : float
-        Relative inertia uncertainty of the controller's polytope, in ``[0, 1)`` (default 0.3).
-    mode : {"scalar", "box"}
-        Polytope of one inertia factor (2 vertices) or one factor per axis (8 vertices).
-    true_inertia : (3,) tuple of float or None
-        Principal inertias of the simulated satellite (kg m^2); ``None``: paper P's.
-    saturation : {"constraint", "limiter", "none"}
-        How the torque limit is handled (see :mod:`benchmarks.families.rigid.controllers`).
-    u_max : float
-        Torque limit per axis (N m), > 0 (default 1).
-    ic_scale : float
-        Factor on the initial attitude (E6: 1.3); the controller's model is linearised at the
-        scaled initial state.
-    initial_attitude : (3,) tuple of float or None
-        Initial roll, pitch, yaw in degrees (zero rates); ``None``: paper P's. ``ic_scale``
-        multiplies it too.
-    kinematics : {"single", "cover", "scheduled"}
-        How the robust MPC's polytope treats the nonlinear kinematics. ``"single"`` (paper P):
-        the inertia polytope linearised at the initial attitude. ``"cover"``: the polytope also
-        covers every attitude of the box from zero to the initial attitude, widened by
-        ``cover_margin`` on each side (``RigidSatellite.polytope(..., attitude_range=...)``).
-        ``"scheduled"``: RMPC only, the polytope rebuilt at the measured attitude every step
-        (:class:`rmpc.ScheduledRMPC`).
-    cover_margin : float
-        Widening of the covering box on each side (deg, >= 0; default 5).
-    disturbance : float
-        Step disturbance torque (N m) on each of ``disturbance_axes``; 0 for none.
-    disturbance_start : float
-        Time of the step (s), >= 0.
-    disturbance_axes : tuple of {"roll", "pitch", "yaw"}
-        Body axes the disturbance acts on (x, y, z).
-    actuator : {"none", "reaction_wheel"}
-        Paper P's reaction-wheel dynamics between command and torque, or none.
-    duration : float
-        Simulated time (s), > 0.
-    dt : float
-        Sample time (s), > 0.
+        The controller's settings: its defaults updated by what the scenario gives; after
+        validation it holds every setting.
     """
 
-    plant: str = "nonlinear"
-    controller: str = "RMPC"
-    settings: Mapping[str, Any] = field(default_factory=dict)
-    spread: float = defaults.SPREAD
-    mode: str = defaults.MODE
-    true_inertia: tuple[float, float, float] | None = None
-    saturation: str = "constraint"
-    u_max: float = defaults.U_MAX
-    ic_scale: float = 1.0
-    initial_attitude: tuple[float, float, float] | None = None
-    kinematics: str = "single"
-    cover_margin: float = 5.0
-    disturbance: float = 0.0
-    disturbance_start: float = defaults.DISTURBANCE_START
-    disturbance_axes: tuple[str, ...] = defaults.DISTURBANCE_AXES
-    actuator: str = "none"
-    duration: float = defaults.DURATION
-    dt: float = defaults.DT
+    __slots__ = ("_controller", "_family", "_settings", "_values")
+
+    def __init__(self, family: str, controller: str, settings: Mapping[str, Any], values: Mapping[str, Any]):
+        self._family = family
+        self._controller = controller
+        self._settings = MappingProxyType(dict(settings))
+        self._values = MappingProxyType(dict(values))
+
+    # -- fields -----------------------------------------------------------------------
+    @property
+    def family(self) -> str:
+        """The plant family's name."""
+        return self._family
+
+    @property
+    def controller(self) -> str:
+        """The controller's name."""
+        return self._controller
+
+    @property
+    def settings(self) -> Mapping[str, Any]:
+        """Every setting of the controller (read-only)."""
+        return self._settings
+
+    @property
+    def plant_family(self) -> PlantFamily:
+        """The :class:`~benchmarks.core.family.PlantFamily` object."""
+        return get_family(self._family)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        try:
+            return self._values[name]
+        except KeyError:
+            raise AttributeError(f"a {self._family!r} scenario has no field {name!r}") from None
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in self.__slots__ and not hasattr(self, name):
+            object.__setattr__(self, name, value)
+            return
+        raise AttributeError("a Scenario is immutable: build a new one with Scenario.from_dict")
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Scenario) and self.to_dict() == other.to_dict()
+
+    def __hash__(self) -> int:
+        return hash(self.case_id)
+
+    def __repr__(self) -> str:
+        return f"Scenario({self.label()!r}, case_id={self.case_id!r})"
 
     @classmethod
-    def field_names(cls) -> tuple[str, ...]:
-        """Names of the scenario fields, in declaration order."""
-        return tuple(f.name for f in fields(cls))
+    def field_names(cls, family: str = DEFAULT_FAMILY) -> tuple[str, ...]:
+        """Names of the scenario fields of ``family``: the core's and the family's."""
+        return (*CORE_FIELDS, *get_family(family).fields)
+
+    @classmethod
+    def default(cls, key: str, family: str = DEFAULT_FAMILY) -> Any:
+        """The default of field ``key`` in ``family``."""
+        if key == "family":
+            return DEFAULT_FAMILY
+        if key == "controller":
+            return DEFAULT_CONTROLLER
+        if key == "settings":
+            return {}
+        return get_family(family).fields[key].default
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], where: str = "", lenient_settings: bool = False) -> Scenario:
@@ -127,8 +134,8 @@ class Scenario:
         where : str
             Dotted prefix naming ``data`` in error messages (e.g. ``"base"``).
         lenient_settings : bool
-            Drop settings that belong to another controller (sweeps over several controllers
-            share one settings table); see :func:`benchmarks.families.rigid.controllers.effective_settings`.
+            Drop settings that belong to another controller of the family (sweeps over several
+            controllers share one settings table).
 
         Raises
         ------
@@ -141,39 +148,40 @@ class Scenario:
 
         if not isinstance(data, Mapping):
             raise ConfigError(where or "scenario", "a table of scenario fields", type(data).__name__)
-        known = cls.field_names()
+        family_name = data.get("family", DEFAULT_FAMILY)
+        if not isinstance(family_name, str):
+            raise ConfigError(name("family"), "the name of a plant family", repr(family_name))
+        family = get_family(family_name, name("family"))
+        known = cls.field_names(family_name)
         for key in data:
             if key not in known:
                 raise ConfigError(
                     name(str(key)), "a scenario field (" + ", ".join(known) + ")", "an unknown field"
                 )
-        d = {**{f.name: f.default for f in fields(cls) if f.name != "settings"}, **data}
-        out: dict[str, Any] = {key: cls.check_field(key, d[key], name(key)) for key in d if key != "settings"}
+        controller = data.get("controller", DEFAULT_CONTROLLER)
+        if not isinstance(controller, str) or controller not in family.controllers:
+            choices = ", ".join(repr(c) for c in family.controllers)
+            raise ConfigError(name("controller"), "one of " + choices, repr(controller))
+        values = {
+            key: spec.check(data[key], name(key)) if key in data else spec.default
+            for key, spec in family.fields.items()
+        }
         overrides = data.get("settings", {})
         if not isinstance(overrides, Mapping):
             raise ConfigError(name("settings"), "a table of controller settings", repr(overrides))
-        out["settings"] = effective_settings(out["controller"], overrides, name("settings"), lenient_settings)
-        problem = unsupported(out["controller"], out["saturation"])
+        settings = family.effective_settings(controller, overrides, name("settings"), lenient_settings)
+        problem = family.unsupported(controller, values["saturation"])
         if problem is not None:
             raise ConfigError(name("saturation"), problem, "'constraint'")
-        if out["kinematics"] == "scheduled" and out["controller"] != "RMPC":
-            expected = "'single' or 'cover' for " + out["controller"]
-            raise ConfigError(name("kinematics"), expected, "'scheduled'")
-        attitude = initial_attitude(out["initial_attitude"], out["ic_scale"])
-        if abs(attitude[1]) >= 0.5 * math.pi - 1e-3:
+        family.check(values, controller, name)
+        if values["duration"] < values["dt"]:
             raise ConfigError(
-                name("ic_scale") if out["initial_attitude"] is None else name("initial_attitude"),
-                "an initial pitch below 90 deg (3-2-1 Euler angles are singular there)",
-                f"pitch {math.degrees(attitude[1]):.1f} deg",
+                name("duration"), f"at least one sample (dt = {values['dt']:g} s)", repr(values["duration"])
             )
-        if out["duration"] < out["dt"]:
-            raise ConfigError(
-                name("duration"), f"at least one sample (dt = {out['dt']:g} s)", repr(out["duration"])
-            )
-        return cls(**out)
+        return cls(family_name, controller, settings, values)
 
     @classmethod
-    def check_field(cls, key: str, value: Any, where: str) -> Any:
+    def check_field(cls, key: str, value: Any, where: str, family: str = DEFAULT_FAMILY) -> Any:
         """Check one field's value on its own (no other field involved); return it normalised.
 
         Examples
@@ -181,25 +189,32 @@ class Scenario:
         >>> Scenario.check_field("u_max", 2, "grid.u_max")
         2.0
         """
-        if key not in _FIELD_CHECKS:
-            known = ", ".join(cls.field_names())
+        fam = get_family(family)
+        if key == "family":
+            get_family(value, where)
+            return value
+        if key == "controller":
+            if not isinstance(value, str) or value not in fam.controllers:
+                raise ConfigError(where, "one of " + ", ".join(repr(c) for c in fam.controllers), repr(value))
+            return value
+        if key not in fam.fields:
+            known = ", ".join(cls.field_names(family))
             raise ConfigError(where, f"a scenario field ({known})", "an unknown field")
-        return _FIELD_CHECKS[key](value, where)
+        return fam.fields[key].check(value, where)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-ready values of every field (the inverse of :meth:`from_dict`)."""
-        out: dict[str, Any] = {}
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "settings":
-                value = {k: list(v) if isinstance(v, tuple) else v for k, v in sorted(value.items())}
-            elif isinstance(value, tuple):
-                value = list(value)
-            out[f.name] = value
-        return out
+        """Plain JSON-ready values of every field (the inverse of :meth:`from_dict`).
 
-    def __hash__(self) -> int:
-        return hash(self.case_id)
+        The default family is not written, so the records of paper P's satellite keep the
+        fields (and the case ids) they had before families existed.
+        """
+        out: dict[str, Any] = {} if self._family == DEFAULT_FAMILY else {"family": self._family}
+        items = list(self._values.items())
+        first, rest = items[:1], items[1:]
+        settings = {k: list(v) if isinstance(v, tuple) else v for k, v in sorted(self._settings.items())}
+        for key, value in [*first, ("controller", self._controller), ("settings", settings), *rest]:
+            out[key] = list(value) if isinstance(value, tuple) else value
+        return out
 
     @property
     def case_id(self) -> str:
@@ -209,124 +224,10 @@ class Scenario:
 
     def label(self) -> str:
         """A short human-readable description for tables and progress."""
-        parts = [self.controller, self.plant, self.saturation]
-        if self.disturbance:
-            parts.append(f"d={self.disturbance:g}")
-        if self.ic_scale != 1.0:
-            parts.append(f"ic x{self.ic_scale:g}")
-        if self.initial_attitude is not None:
-            parts.append("ic " + "/".join(f"{v:g}" for v in self.initial_attitude) + " deg")
-        if self.kinematics != "single":
-            parts.append(self.kinematics)
-        return " ".join(parts)
-
-
-def initial_attitude(attitude_deg: Any, ic_scale: float) -> tuple[float, float, float]:
-    """The initial roll, pitch, yaw (rad): ``attitude_deg`` (or paper P's) times ``ic_scale``."""
-    if attitude_deg is None:
-        base = PAPER_P_INITIAL_STATE[:3]
-    else:
-        base = tuple(math.radians(v) for v in attitude_deg)
-    return (base[0] * ic_scale, base[1] * ic_scale, base[2] * ic_scale)
-
-
-def _choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
-    if not isinstance(value, str) or value not in choices:
-        raise ConfigError(where, "one of " + ", ".join(repr(c) for c in choices), repr(value))
-    return value
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ConfigError(where, "a finite number", repr(value))
-    return float(value)
-
-
-def _real(
-    value: Any,
-    where: str,
-    low: float | None = None,
-    high: float | None = None,
-    low_open: bool = False,
-    high_open: bool = False,
-) -> float:
-    x = _number(value, where)
-    bad_low = low is not None and (x < low or (low_open and x == low))
-    bad_high = high is not None and (x > high or (high_open and x == high))
-    if bad_low or bad_high:
-        lo = "" if low is None else f"{'>' if low_open else '>='} {low:g}"
-        hi = "" if high is None else f"{'<' if high_open else '<='} {high:g}"
-        raise ConfigError(where, "a number " + " and ".join(p for p in (lo, hi) if p), repr(value))
-    return x
-
-
-def _inertia(value: Any, where: str) -> tuple[float, float, float] | None:
-    if value is None:
-        return None
-    ok = isinstance(value, list | tuple) and len(value) == 3
-    if ok:
-        nums = [_number(v, where) for v in value]
-        ok = all(v > 0 for v in nums)
-    if not ok:
-        raise ConfigError(where, "three principal inertias > 0 (kg m^2)", repr(value))
-    return (nums[0], nums[1], nums[2])
-
-
-def _axes(value: Any, where: str) -> tuple[str, ...]:
-    ok = isinstance(value, list | tuple) and len(value) > 0 and len(set(value)) == len(value)
-    if not ok or not all(isinstance(v, str) and v in AXES for v in value):
-        raise ConfigError(
-            where, "a non-empty list of distinct axes among 'roll', 'pitch', 'yaw'", repr(value)
-        )
-    return tuple(value)
-
-
-def _ic_scale(value: Any, where: str) -> float:
-    return _real(value, where, low=0.0, low_open=True)
-
-
-def _attitude_deg(value: Any, where: str) -> tuple[float, float, float] | None:
-    if value is None:
-        return None
-    ok = isinstance(value, list | tuple) and len(value) == 3
-    if ok:
-        nums = [_number(v, where) for v in value]
-    if not ok:
-        raise ConfigError(where, "three angles in degrees (roll, pitch, yaw)", repr(value))
-    return (nums[0], nums[1], nums[2])
-
-
-def _positive(value: Any, where: str) -> float:
-    return _real(value, where, low=0.0, low_open=True)
-
-
-#: The check of each field on its own (cross-field checks are in :meth:`Scenario.from_dict`).
-_FIELD_CHECKS: dict[str, Callable[[Any, str], Any]] = {
-    "plant": lambda v, w: _choice(v, w, PLANTS),
-    "controller": lambda v, w: _choice(v, w, tuple(CONTROLLERS)),
-    "spread": lambda v, w: _real(v, w, low=0.0, high=1.0, high_open=True),
-    "mode": lambda v, w: _choice(v, w, MODES),
-    "true_inertia": _inertia,
-    "saturation": lambda v, w: _choice(v, w, SATURATIONS),
-    "u_max": _positive,
-    "ic_scale": _ic_scale,
-    "initial_attitude": _attitude_deg,
-    "kinematics": lambda v, w: _choice(v, w, KINEMATICS),
-    "cover_margin": lambda v, w: _real(v, w, low=0.0, high=45.0),
-    "disturbance": _real,
-    "disturbance_start": lambda v, w: _real(v, w, low=0.0),
-    "disturbance_axes": _axes,
-    "actuator": lambda v, w: _choice(v, w, ACTUATORS),
-    "duration": _positive,
-    "dt": _positive,
-}
-
-
-def unsupported(controller: str, saturation: str) -> str | None:
-    """Why ``controller`` cannot run with ``saturation`` (``None`` if it can)."""
-    if saturation == "constraint" and controller not in CONSTRAINED:
-        return f"'none' or 'limiter' for {controller} (it has no constraint)"
-    return None
+        fam = get_family(self._family)
+        if fam.label is not None:
+            return fam.label(self)
+        return " ".join([self._controller, self.plant, self.saturation])
 
 
 def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:

@@ -45,16 +45,14 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.families.rigid.controllers import check_setting
-from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS
 from benchmarks.core.execute import ExecOutcome, Task, execute
 from benchmarks.core.executors import make_executor
+from benchmarks.core.family import PlantFamily, get_family
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.progress import CaseProgress
-from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
-from benchmarks.core.scenario import Scenario, unsupported
+from benchmarks.core.scenario import DEFAULT_FAMILY, Scenario
 from benchmarks.core.store import STORE_NAME, CaseStore
-from models import PAPER_P_INERTIA
+from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
 from toolkit_common.errors import ConfigError
 
 __all__ = [
@@ -158,47 +156,58 @@ def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSp
     base = data.get("base", {})
     if not isinstance(base, Mapping):
         raise ConfigError("base", "a table of scenario fields", repr(base))
+    family_name = base.get("family", DEFAULT_FAMILY)
+    family = get_family(family_name, "base.family")
     for key, value in base.items():
         if key != "settings":
-            Scenario.check_field(str(key), value, f"base.{key}")
+            Scenario.check_field(str(key), value, f"base.{key}", family_name)
         elif not isinstance(value, Mapping):
             raise ConfigError("base.settings", "a table of controller settings", repr(value))
         else:
             for name_, setting in value.items():
-                check_setting(str(name_), setting, f"base.settings.{name_}")
+                family.check_setting(str(name_), setting, f"base.settings.{name_}")
     grid_table = data.get("grid", {})
     if not isinstance(grid_table, Mapping):
         raise ConfigError("grid", "a table of field = [values]", repr(grid_table))
     grid = _flatten_grid(grid_table)
-    known = Scenario.field_names()
+    known = Scenario.field_names(family_name)
     for key, values in grid.items():
         top = key.split(".", 1)[0]
+        if top == "family":
+            expected = "the family in [base] (its fields differ)"
+            raise ConfigError("grid.family", expected, "a grid over families")
         if top not in known or (top == "settings") != (key != top):
             raise ConfigError(f"grid.{key}", "a scenario field or settings.<name>", "an unknown field")
         if not isinstance(values, list) or not values:
             raise ConfigError(f"grid.{key}", "a non-empty list of values", repr(values))
         for value in values:
             if top == "settings":
-                check_setting(key.split(".", 1)[1], value, f"grid.{key}")
+                family.check_setting(key.split(".", 1)[1], value, f"grid.{key}")
             else:
-                Scenario.check_field(key, value, f"grid.{key}")
+                Scenario.check_field(key, value, f"grid.{key}", family_name)
     mc = data.get("montecarlo")
     if mc is not None:
-        mc = _check_montecarlo(mc, base, grid)
+        mc = _check_montecarlo(mc, base, grid, family)
     spec = SweepSpec(name=name, description=description, base=dict(base), grid=grid, montecarlo=mc)
     _check_settings_used(spec)
     _grid_points(spec)  # the combinations: raises on one that is impossible
     return spec
 
 
+def _family(spec: SweepSpec) -> PlantFamily:
+    return get_family(spec.base.get("family", DEFAULT_FAMILY), "base.family")
+
+
 def _check_settings_used(spec: SweepSpec) -> None:
     """Every setting given must belong to a controller the sweep runs (else it is a mistake)."""
-    controllers = set(spec.grid.get("controller", [spec.base.get("controller", Scenario.controller)]))
+    family = _family(spec)
+    default = spec.base.get("controller", Scenario.default("controller"))
+    controllers = set(spec.grid.get("controller", [default]))
     given = [(f"base.settings.{k}", k) for k in spec.base.get("settings", {})]
     given += [(f"grid.{k}", k.split(".", 1)[1]) for k in spec.grid if k.startswith("settings.")]
     for where, key in given:
-        if not any(key in CONTROLLER_DEFAULTS[c] for c in controllers):
-            owners = [c for c, d in CONTROLLER_DEFAULTS.items() if key in d]
+        if not any(key in family.controllers[c].defaults for c in controllers if c in family.controllers):
+            owners = [c for c, d in family.controllers.items() if key in d.defaults]
             raise ConfigError(
                 where,
                 f"a setting of a controller the sweep runs ({', '.join(sorted(controllers))})",
@@ -206,7 +215,9 @@ def _check_settings_used(spec: SweepSpec) -> None:
             )
 
 
-def _check_montecarlo(mc: Any, base: Mapping[str, Any], grid: Mapping[str, Any]) -> dict[str, int]:
+def _check_montecarlo(
+    mc: Any, base: Mapping[str, Any], grid: Mapping[str, Any], family: PlantFamily
+) -> dict[str, int]:
     if not isinstance(mc, Mapping):
         raise ConfigError("montecarlo", "a table with n and seed", repr(mc))
     for key in mc:
@@ -217,10 +228,12 @@ def _check_montecarlo(mc: Any, base: Mapping[str, Any], grid: Mapping[str, Any])
         raise ConfigError("montecarlo.n", "a positive integer number of draws", repr(n))
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError("montecarlo.seed", "an integer >= 0", repr(seed))
-    if "true_inertia" in base or "true_inertia" in grid:
-        raise ConfigError(
-            "montecarlo", "no true_inertia in [base] or [grid] (the draws set it)", "true_inertia given"
-        )
+    if family.montecarlo is None:
+        raise ConfigError("montecarlo", f"no draws (family {family.name!r} has none)", "a [montecarlo] table")
+    for key in family.montecarlo.sets:
+        if key in base or key in grid:
+            expected = f"no {key} in [base] or [grid] (the draws set it)"
+            raise ConfigError("montecarlo", expected, f"{key} given")
     return {"n": n, "seed": seed}
 
 
@@ -238,9 +251,10 @@ def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:
         data: dict[str, Any] = dict(spec.base)
         for key, value in zip(keys, combo, strict=True):
             data = _with(data, key, value)
-        controller = data.get("controller", Scenario.controller)
-        saturation = data.get("saturation", Scenario.saturation)
-        problem = unsupported(controller, saturation)
+        family = _family(spec)
+        controller = data.get("controller", Scenario.default("controller"))
+        saturation = data.get("saturation", family.fields["saturation"].default)
+        problem = family.unsupported(controller, saturation)
         if problem is not None:
             dropped.append(f"{controller} with saturation = {saturation!r}")
             if first_problem is None:
@@ -264,22 +278,17 @@ def expand(spec: SweepSpec) -> list[Scenario]:
     """
     points, _ = _grid_points(spec)
     draws = None
-    if spec.montecarlo is not None:
+    family = _family(spec)
+    if spec.montecarlo is not None and family.montecarlo is not None:
         rng = np.random.default_rng(spec.montecarlo["seed"])
-        draws = rng.uniform(-1.0, 1.0, size=(spec.montecarlo["n"], 3))
+        draws = rng.uniform(-1.0, 1.0, size=(spec.montecarlo["n"], family.montecarlo.dims))
     out: list[Scenario] = []
     seen: set[str] = set()
     for scenario in points:
         variants = [scenario]
-        if draws is not None:
-            variants = []
-            for u in draws:
-                factors = np.full(3, u[0]) if scenario.mode == "scalar" else u
-                inertia = [
-                    float(j * (1.0 + scenario.spread * f))
-                    for j, f in zip(PAPER_P_INERTIA, factors, strict=True)
-                ]
-                variants.append(Scenario.from_dict({**scenario.to_dict(), "true_inertia": inertia}))
+        if draws is not None and family.montecarlo is not None:
+            apply = family.montecarlo.apply
+            variants = [Scenario.from_dict({**scenario.to_dict(), **apply(scenario, u)}) for u in draws]
         for sc in variants:
             if sc.case_id not in seen:
                 seen.add(sc.case_id)

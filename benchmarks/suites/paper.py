@@ -28,13 +28,13 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.families.rigid import defaults
 from benchmarks.core.execute import ExecOutcome, Task, execute
 from benchmarks.core.executors import make_executor
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.progress import CaseProgress
-from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from benchmarks.core.scenario import Scenario
+from benchmarks.families.rigid import defaults
+from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
 

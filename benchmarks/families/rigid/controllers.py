@@ -18,23 +18,14 @@ defaults of :data:`benchmarks.families.rigid.defaults.CONTROLLER_DEFAULTS` updat
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS, SETTING_CHOICES
+from benchmarks.core.family import BuiltController
 from toolkit_common.errors import ConfigError
 
-__all__ = ["CONTROLLERS", "BuiltController", "build_controller", "check_setting", "effective_settings"]
-
-
-@dataclass(frozen=True)
-class BuiltController:
-    """A controller ready for :func:`rmpc.simulate` and whether it needs a limiter in the loop."""
-
-    controller: Any
-    needs_limiter: bool
+__all__ = ["CONSTRAINED", "CONTROLLERS", "settings_check"]
 
 
 def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -158,96 +149,12 @@ CONTROLLERS: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltControlle
     "LQR": _lqr,
 }
 
-#: Settings that may be 0 (0 turns the adaptation off; keeps re-solving down to the origin).
-_ZERO_ALLOWED = frozenset({"adaptation_gain", "mit_gain", "hold_radius"})
-
 #: Controllers that can enforce the torque limit themselves (``saturation = "constraint"``).
 CONSTRAINED = ("RMPC", "GIPC", "CRMPC", "CRMPC-MIT", "OfflineRMPC")
 
 
-def _check_value(default: Any, value: Any, where: str) -> Any:
-    """Check one setting against the type of its default; return it normalised."""
-    if isinstance(default, bool):
-        if not isinstance(value, bool):
-            raise ConfigError(where, "true or false", repr(value))
-        return value
-    if isinstance(default, int):
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ConfigError(where, "a positive integer", repr(value))
-        return value
-    if isinstance(default, float):
-        zero_ok = where.rsplit(".", 1)[-1] in _ZERO_ALLOWED
-        number = not isinstance(value, bool) and isinstance(value, int | float) and np.isfinite(value)
-        if not number or value < 0 or (value == 0 and not zero_ok):
-            raise ConfigError(where, "a number >= 0" if zero_ok else "a number > 0", repr(value))
-        return float(value)
-    if isinstance(default, tuple):
-        ok = (
-            isinstance(value, list | tuple)
-            and len(value) == len(default)
-            and all(
-                isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) and v >= 0
-                for v in value
-            )
-        )
-        if not ok:
-            raise ConfigError(where, f"a list of {len(default)} numbers >= 0", repr(value))
-        return tuple(float(v) for v in value)
-    choices = SETTING_CHOICES.get(where.rsplit(".", 1)[-1])
-    if not isinstance(value, str) or (choices is not None and value not in choices):
-        expected = "a string" if choices is None else "one of " + ", ".join(repr(c) for c in choices)
-        raise ConfigError(where, expected, repr(value))
-    return value
-
-
-def check_setting(key: str, value: Any, where: str) -> Any:
-    """Check one setting's value against the controller(s) that have it; return it normalised.
-
-    Raises
-    ------
-    ConfigError
-        When no controller has a setting of that name, or the value is of the wrong kind.
-    """
-    owners = [defaults for defaults in CONTROLLER_DEFAULTS.values() if key in defaults]
-    if not owners:
-        names = sorted({k for d in CONTROLLER_DEFAULTS.values() for k in d})
-        raise ConfigError(where, f"a controller setting ({', '.join(names)})", "an unknown name")
-    return _check_value(owners[0][key], value, where)
-
-
-def effective_settings(
-    controller: str, overrides: Mapping[str, Any], where: str = "settings", lenient: bool = False
-) -> dict[str, Any]:
-    """The controller's defaults updated by ``overrides``, each checked; unknown names raise.
-
-    Parameters
-    ----------
-    controller : str
-        A name of :data:`CONTROLLERS`.
-    overrides : mapping
-        Setting names to values (a scenario's ``settings``).
-    where : str
-        Dotted prefix of the settings for error messages.
-    lenient : bool
-        Drop (instead of refusing) a setting of another controller of the registry, so one
-        settings table can serve a sweep over several controllers. A name no controller has
-        is an error either way.
-
-    Raises
-    ------
-    ConfigError
-        On an unknown setting name or a value of the wrong kind, naming ``where.<name>``.
-    """
-    defaults = CONTROLLER_DEFAULTS[controller]
-    out = dict(defaults)
-    for key, value in overrides.items():
-        if key not in defaults:
-            if lenient and any(key in other for other in CONTROLLER_DEFAULTS.values()):
-                continue
-            raise ConfigError(
-                f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
-            )
-        out[key] = _check_value(defaults[key], value, f"{where}.{key}")
+def settings_check(controller: str, out: dict[str, Any], where: str) -> None:
+    """Checks between the settings of one controller (each value is already checked on its own)."""
     if controller in ("RMPC", "CRMPC", "CRMPC-MIT") and out["resolve_threshold"] > 1.0:
         raise ConfigError(f"{where}.resolve_threshold", "a level in (0, 1]", repr(out["resolve_threshold"]))
     if "theta_fraction" in out and out["theta_fraction"] >= 1.0:
@@ -259,10 +166,3 @@ def effective_settings(
         raise ConfigError(f"{where}.shrink", "a number in (0, 1)", repr(out["shrink"]))
     if controller == "GIPC" and out["Nc"] > out["Np"]:
         raise ConfigError(f"{where}.Nc", f"an integer <= Np = {out['Np']}", repr(out["Nc"]))
-    return out
-
-
-def build_controller(poly: Any, scenario: Any) -> BuiltController:
-    """Build the scenario's controller on ``poly`` with its effective settings."""
-    settings = effective_settings(scenario.controller, scenario.settings)
-    return CONTROLLERS[scenario.controller](poly, scenario, settings)

@@ -1,0 +1,364 @@
+"""Plant families: what the harness core needs to know about a kind of plant, and their registry.
+
+A :class:`PlantFamily` brings everything that is particular to one kind of plant (paper P's
+rigid satellite, the four-wheel satellite with faults, ...): its scenario fields with their
+defaults and checks, its controllers with their settings, the checks that involve several
+fields, how one case is built, simulated and measured, and (optionally) what a Monte-Carlo draw
+changes. The core (scenarios, sweeps, runner, store, executors) only talks to this interface,
+so a new family is a new sub-package of :mod:`benchmarks.families` that calls
+:func:`register_family`, or a user's own object registered the same way: nothing in the core
+is edited.
+
+Every family has at least the fields ``plant``, ``saturation``, ``duration`` and ``dt`` (the
+record of a case names its plant and saturation, and the runner needs the run length). The
+scenario fields ``family``, ``controller`` and ``settings`` are the core's.
+
+Examples
+--------
+>>> from benchmarks.core.family import family_names, get_family
+>>> "rigid" in family_names()
+True
+>>> get_family("rigid").fields["plant"].default
+'nonlinear'
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from toolkit_common.errors import ConfigError
+
+__all__ = [
+    "REQUIRED_FIELDS",
+    "BuiltController",
+    "CaseResult",
+    "ControllerSpec",
+    "Field",
+    "MonteCarlo",
+    "PlantFamily",
+    "check_choice",
+    "check_number",
+    "check_real",
+    "family_names",
+    "get_family",
+    "register_family",
+]
+
+#: Fields every family must declare.
+REQUIRED_FIELDS = ("plant", "saturation", "duration", "dt")
+
+
+@dataclass(frozen=True)
+class Field:
+    """One scenario field of a family: its default and the check of a value on its own.
+
+    ``check(value, where) -> normalised value`` raises :class:`ConfigError` naming ``where``.
+    """
+
+    default: Any
+    check: Callable[[Any, str], Any]
+    doc: str = ""
+
+
+@dataclass(frozen=True)
+class BuiltController:
+    """A controller ready for :func:`rmpc.simulate` and whether it needs a limiter in the loop."""
+
+    controller: Any
+    needs_limiter: bool
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """A controller of a family.
+
+    Attributes
+    ----------
+    build : callable
+        ``build(model, scenario, settings) -> BuiltController``; ``model`` is what the family's
+        :attr:`PlantFamily.simulate` hands over (e.g. the controller's polytope).
+    defaults : mapping
+        Every setting with its default; the type of the default is the type a value must have
+        (bool, positive int, float >= 0, tuple of floats, or a string among
+        :attr:`PlantFamily.setting_choices`).
+    constrained : bool
+        Whether it can enforce the input limit itself (``saturation = "constraint"``).
+    """
+
+    build: Callable[[Any, Any, Mapping[str, Any]], BuiltController]
+    defaults: Mapping[str, Any]
+    constrained: bool = True
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    """What a family's simulation of one case returns to the runner.
+
+    Attributes
+    ----------
+    settings : dict
+        What the record's ``settings`` adds to the scenario's fields (initial state, the model
+        the controller used, ...).
+    metrics : dict
+        The record's ``metrics``.
+    trace : dict of ndarray
+        The time series of the run (for figures); kept only when asked for.
+    """
+
+    settings: dict[str, Any]
+    metrics: dict[str, Any]
+    trace: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class MonteCarlo:
+    """What one seeded Monte-Carlo draw changes in a scenario.
+
+    Attributes
+    ----------
+    dims : int
+        Size of a draw ``u``, uniform in ``[-1, 1]^dims``.
+    sets : tuple of str
+        The fields a draw sets (a sweep may not set them in ``[base]`` or ``[grid]``).
+    apply : callable
+        ``apply(scenario, u) -> {field: value}``.
+    """
+
+    dims: int
+    sets: tuple[str, ...]
+    apply: Callable[[Any, np.ndarray], Mapping[str, Any]]
+
+
+def _no_cross_check(values: dict[str, Any], controller: str, name: Callable[[str], str]) -> None:
+    return None
+
+
+@dataclass(frozen=True)
+class PlantFamily:
+    """A kind of plant the harness can run (see the module notes).
+
+    Attributes
+    ----------
+    name : str
+        The value of the scenario field ``family``.
+    description : str
+        One line for ``--help`` and reports.
+    fields : mapping of str to Field
+        The family's scenario fields, in the order records list them; must include
+        :data:`REQUIRED_FIELDS`.
+    controllers : mapping of str to ControllerSpec
+        The controllers this family runs.
+    simulate : callable
+        ``simulate(scenario, settings, keep_trace) -> CaseResult``: build the plant and the
+        controller (through :meth:`build_controller`), run, measure. ``settings`` are the
+        effective controller settings.
+    check : callable, optional
+        ``check(values, controller, name)``: checks that involve several fields (``values``
+        field name -> normalised value; ``name(field)`` gives the dotted name for errors).
+    label : callable, optional
+        ``label(scenario) -> str``, a short description for tables and progress.
+    setting_choices : mapping, optional
+        Allowed values of string-valued settings.
+    zero_allowed : frozenset of str
+        Float settings that may be 0.
+    settings_check : callable, optional
+        ``settings_check(controller, settings, where)``: checks between settings.
+    montecarlo : MonteCarlo, optional
+        What a sweep's ``[montecarlo]`` draw changes; ``None``: the family has no draws.
+    """
+
+    name: str
+    description: str
+    fields: Mapping[str, Field]
+    controllers: Mapping[str, ControllerSpec]
+    simulate: Callable[[Any, Mapping[str, Any], bool], CaseResult]
+    check: Callable[[dict[str, Any], str, Callable[[str], str]], None] = _no_cross_check
+    label: Callable[[Any], str] | None = None
+    setting_choices: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    zero_allowed: frozenset[str] = frozenset()
+    settings_check: Callable[[str, dict[str, Any], str], None] | None = None
+    montecarlo: MonteCarlo | None = None
+
+    # -- settings ---------------------------------------------------------------------
+    def _check_value(self, default: Any, value: Any, where: str) -> Any:
+        if isinstance(default, bool):
+            if not isinstance(value, bool):
+                raise ConfigError(where, "true or false", repr(value))
+            return value
+        if isinstance(default, int):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ConfigError(where, "a positive integer", repr(value))
+            return value
+        if isinstance(default, float):
+            zero_ok = where.rsplit(".", 1)[-1] in self.zero_allowed
+            number = not isinstance(value, bool) and isinstance(value, int | float) and np.isfinite(value)
+            if not number or value < 0 or (value == 0 and not zero_ok):
+                raise ConfigError(where, "a number >= 0" if zero_ok else "a number > 0", repr(value))
+            return float(value)
+        if isinstance(default, tuple):
+            ok = (
+                isinstance(value, list | tuple)
+                and len(value) == len(default)
+                and all(
+                    isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) and v >= 0
+                    for v in value
+                )
+            )
+            if not ok:
+                raise ConfigError(where, f"a list of {len(default)} numbers >= 0", repr(value))
+            return tuple(float(v) for v in value)
+        choices = self.setting_choices.get(where.rsplit(".", 1)[-1])
+        if not isinstance(value, str) or (choices is not None and value not in choices):
+            expected = "a string" if choices is None else "one of " + ", ".join(repr(c) for c in choices)
+            raise ConfigError(where, expected, repr(value))
+        return value
+
+    def setting_names(self) -> list[str]:
+        """Every setting name of every controller of the family, sorted."""
+        return sorted({k for spec in self.controllers.values() for k in spec.defaults})
+
+    def check_setting(self, key: str, value: Any, where: str) -> Any:
+        """Check one setting's value against the controller(s) that have it; return it normalised."""
+        owners = [spec.defaults for spec in self.controllers.values() if key in spec.defaults]
+        if not owners:
+            expected = f"a controller setting ({', '.join(self.setting_names())})"
+            raise ConfigError(where, expected, "an unknown name")
+        return self._check_value(owners[0][key], value, where)
+
+    def effective_settings(
+        self, controller: str, overrides: Mapping[str, Any], where: str = "settings", lenient: bool = False
+    ) -> dict[str, Any]:
+        """The controller's defaults updated by ``overrides``, each checked.
+
+        With ``lenient`` a setting of another controller of the family is dropped instead of
+        refused (one settings table can then serve a sweep over several controllers); a name no
+        controller has is an error either way.
+        """
+        defaults = self.controllers[controller].defaults
+        out = dict(defaults)
+        for key, value in overrides.items():
+            if key not in defaults:
+                if lenient and any(key in spec.defaults for spec in self.controllers.values()):
+                    continue
+                raise ConfigError(
+                    f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
+                )
+            out[key] = self._check_value(defaults[key], value, f"{where}.{key}")
+        if self.settings_check is not None:
+            self.settings_check(controller, out, where)
+        return out
+
+    def unsupported(self, controller: str, saturation: str) -> str | None:
+        """Why ``controller`` cannot run with ``saturation`` (``None`` if it can)."""
+        spec = self.controllers.get(controller)
+        if saturation == "constraint" and spec is not None and not spec.constrained:
+            return f"'none' or 'limiter' for {controller} (it has no constraint)"
+        return None
+
+    def build_controller(self, model: Any, scenario: Any) -> BuiltController:
+        """Build the scenario's controller on ``model`` with its effective settings."""
+        settings = self.effective_settings(scenario.controller, scenario.settings)
+        return self.controllers[scenario.controller].build(model, scenario, settings)
+
+
+class _Registry:
+    """The families by name (one instance, filled by :func:`register_family`)."""
+
+    def __init__(self) -> None:
+        self._families: dict[str, PlantFamily] = {}
+        self._loaded = False
+
+    def _load_builtin(self) -> None:
+        if not self._loaded:
+            self._loaded = True
+            import benchmarks.families  # noqa: F401  (registers the shipped families)
+
+    def add(self, family: PlantFamily, replace: bool) -> None:
+        if not isinstance(family, PlantFamily):
+            raise ConfigError("family", "a benchmarks.core.family.PlantFamily", type(family).__name__)
+        missing = [f for f in REQUIRED_FIELDS if f not in family.fields]
+        if missing:
+            raise ConfigError(
+                f"family {family.name!r}",
+                "the fields " + ", ".join(REQUIRED_FIELDS),
+                "no " + ", ".join(missing),
+            )
+        clash = {"family", "controller", "settings"} & set(family.fields)
+        if clash:
+            raise ConfigError(f"family {family.name!r}", "no core field among its fields", ", ".join(clash))
+        if family.name in self._families and not replace and self._families[family.name] is not family:
+            raise ConfigError("family", "a name not registered yet", repr(family.name))
+        self._families[family.name] = family
+
+    def get(self, name: str) -> PlantFamily:
+        self._load_builtin()
+        return self._families[name]
+
+    def names(self) -> tuple[str, ...]:
+        self._load_builtin()
+        return tuple(self._families)
+
+
+_REGISTRY = _Registry()
+
+
+def register_family(family: PlantFamily, replace: bool = False) -> PlantFamily:
+    """Make ``family`` available to scenarios (``family = "<name>"``), sweeps and suites.
+
+    Registering another family under a name already taken raises unless ``replace``.
+    """
+    _REGISTRY.add(family, replace)
+    return family
+
+
+def get_family(name: str, where: str = "family") -> PlantFamily:
+    """The registered family ``name``; a :class:`ConfigError` naming ``where`` otherwise."""
+    try:
+        return _REGISTRY.get(name)
+    except (KeyError, TypeError):
+        names = ", ".join(repr(n) for n in _REGISTRY.names())
+        raise ConfigError(where, f"one of {names}", repr(name)) from None
+
+
+def family_names() -> tuple[str, ...]:
+    """The names of the registered families."""
+    return _REGISTRY.names()
+
+
+# -- field checks families share ---------------------------------------------------------
+def check_choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``choices``; a :class:`ConfigError` naming ``where`` otherwise."""
+    if not isinstance(value, str) or value not in choices:
+        raise ConfigError(where, "one of " + ", ".join(repr(c) for c in choices), repr(value))
+    return value
+
+
+def check_number(value: Any, where: str) -> float:
+    """``value`` as a float if it is a finite number (not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ConfigError(where, "a finite number", repr(value))
+    return float(value)
+
+
+def check_real(
+    value: Any,
+    where: str,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    high_open: bool = False,
+) -> float:
+    """A finite number inside the given bounds (open or closed)."""
+    x = check_number(value, where)
+    bad_low = low is not None and (x < low or (low_open and x == low))
+    bad_high = high is not None and (x > high or (high_open and x == high))
+    if bad_low or bad_high:
+        lo = "" if low is None else f"{'>' if low_open else '>='} {low:g}"
+        hi = "" if high is None else f"{'<' if high_open else '<='} {high:g}"
+        raise ConfigError(where, "a number " + " and ".join(p for p in (lo, hi) if p), repr(value))
+    return x
