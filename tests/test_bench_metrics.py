@@ -167,3 +167,16 @@ def test_docstring_examples_run(module):
     mod = importlib.import_module(f"benchmarks.{module}")
     result = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
     assert result.failed == 0 and result.attempted > 0
+
+
+def test_recovery_after_an_event():
+    from benchmarks.core.metrics import recovery
+
+    t = np.linspace(0.0, 10.0, 101)
+    e = np.where(t < 2.0, 0.0, np.exp(-(t - 2.0)))  # jumps to 1 at t = 2, decays
+    out = recovery(t, np.column_stack([e, 0.5 * e]), t_on=2.0, band=1e-2)
+    assert out["peak_error"] == 1.0
+    # exp(-s) <= 1e-2 from s = ln(100) = 4.605..., the first sample after it is 4.7
+    assert out["recovery_time"] == pytest.approx(4.7)
+    assert recovery(t, e, t_on=2.0, band=1e-6)["recovery_time"] is None
+    assert recovery(t, e, t_on=20.0, band=1e-2)["peak_error"] is None

@@ -39,6 +39,7 @@ __all__ = [
     "iae",
     "ise",
     "overshoot",
+    "recovery",
     "settling_time",
 ]
 
@@ -105,6 +106,55 @@ def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
     if last == mag.size - 1:
         return None
     return float(t[last + 1])
+
+
+def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = None) -> dict[str, Any]:
+    """How a run recovers from an event at ``t_on`` (a disturbance step, a fault).
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Sample times (s).
+    e : (N,) or (N, k) array_like
+        The error; with several columns the largest ``|e_i|`` counts.
+    t_on : float
+        Time of the event (s).
+    band : float
+        Absolute error band of "recovered" (same unit as ``e``).
+    t_off : float, optional
+        End of the window (default: the end of the run).
+
+    Returns
+    -------
+    dict
+        ``peak_error`` (largest error in the window), ``recovery_time`` (time from ``t_on``
+        after which the error stays within ``band`` until the window's end; ``None`` if it is
+        outside the band at the end), ``band``.
+
+    Examples
+    --------
+    >>> out = recovery([0, 1, 2, 3, 4], [0.0, 0.5, 0.2, 0.01, 0.0], t_on=1.0, band=0.05)
+    >>> out["peak_error"], out["recovery_time"]
+    (0.5, 2.0)
+    """
+    t = np.asarray(t, dtype=float)
+    mag = np.abs(np.asarray(e, dtype=float))
+    if mag.ndim == 2:
+        mag = mag.max(axis=1)
+    end = t[-1] if t_off is None else float(t_off)
+    inside = (t >= t_on) & (t <= end)
+    if not np.any(inside):
+        return {"peak_error": None, "recovery_time": None, "band": float(band)}
+    idx = np.flatnonzero(inside)
+    window = mag[idx]
+    outside = np.flatnonzero(window > band)
+    if outside.size == 0:
+        rec: float | None = 0.0
+    elif outside[-1] == window.size - 1:
+        rec = None
+    else:
+        rec = float(t[idx[outside[-1] + 1]] - t_on)
+    return {"peak_error": float(window.max()), "recovery_time": rec, "band": float(band)}
 
 
 def overshoot(e: Any) -> float | None:

@@ -82,6 +82,16 @@ def _final(rec: dict) -> float:
     return max(float(v) for v in rec["metrics"]["final_abs_err"].values())
 
 
+def _recovered(rec: dict) -> str:
+    """ ", recovered after X s (peak Y rad)" from the record's recovery metric, if it has one."""
+    rv = rec["metrics"].get("recovery")
+    if not rv or rv.get("peak_error") is None:
+        return ""
+    t_rec = rv["recovery_time"]
+    when = "not within the run" if t_rec is None else f"{t_rec:.2f} s after the onset"
+    return f" (within {rv['band']:g} rad {when}, peak {rv['peak_error']:.3g} rad)"
+
+
 def _axes_text(values: dict[str, float]) -> str:
     return "/".join(f"{values[a]:.1f}" for a in AXES)
 
@@ -169,7 +179,8 @@ def _e4(records: Sequence[dict]) -> Claim:
     f_r, f_c = _final(rmpc), _final(crmpc)
     ok_r, ok_c = f_r > REJECTED_ERROR, f_c < REJECTED_ERROR
     evidence = (
-        f"final error (worst axis) RMPC {f_r:.3g} rad, CRMPC {f_c:.3g} rad (rejected < {REJECTED_ERROR:g})"
+        f"final error (worst axis) RMPC {f_r:.3g} rad, CRMPC {f_c:.3g} rad{_recovered(crmpc)} "
+        f"(rejected < {REJECTED_ERROR:g})"
     )
     if ok_r and ok_c:
         return Claim("E4", claim, "reproduced", evidence)
@@ -193,7 +204,7 @@ def _e5(records: Sequence[dict]) -> Claim:
     evidence = (
         f"largest applied torque GIPC {g_peak:.3f} N m (time on the limit "
         f"{float(gipc['metrics']['saturated_fraction']):.1%}), CRMPC {c_peak:.3f} N m without a limiter "
-        f"in the loop; CRMPC final error {_final(crmpc):.3g} rad"
+        f"in the loop; CRMPC final error {_final(crmpc):.3g} rad{_recovered(crmpc)}"
     )
     crmpc_ok = c_inside and c_rejects
     limited = _find(records, "E5", "GIPC", "nonlinear", "limiter")

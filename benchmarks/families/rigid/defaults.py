@@ -61,6 +61,7 @@ __all__ = [
     "E5_TRUE_INERTIA_FACTOR",
     "E6_IC_SCALE",
     "MODE",
+    "RECOVERY_BAND",
     "SETTLING_BAND",
     "SHORT_DURATION_SCALE",
     "SPREAD",
@@ -91,6 +92,8 @@ E5_TRUE_INERTIA_FACTOR: float = 1.7
 E6_IC_SCALE: float = 1.3
 #: Settling band, fraction of the initial error.
 SETTLING_BAND: float = 0.02
+#: After a disturbance step the attitude has recovered once every axis stays within this (rad).
+RECOVERY_BAND: float = 1e-3
 #: Duration factor of ``rmpc bench paper --short`` (30 s runs become 2.25 s).
 SHORT_DURATION_SCALE: float = 0.075
 
@@ -194,6 +197,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
         ("disturbance axes", ", ".join(DISTURBANCE_AXES), "toolkit"),
         ("duration per run (s)", f"{DURATION:g}", "toolkit"),
         ("settling band", f"{100 * SETTLING_BAND:g} % of the initial error", "toolkit"),
+        ("recovery band (after a disturbance step)", f"{RECOVERY_BAND:g} rad on every axis", "toolkit"),
         (
             "GIPC |u| <= u_max, |du| <= du_max",
             f"{U_MAX:g}, {CONTROLLER_DEFAULTS['GIPC']['du_max']:g}",

@@ -63,7 +63,7 @@ from benchmarks.core.family import (
     check_number,
     check_real,
 )
-from benchmarks.core.metrics import AXES, compute_metrics
+from benchmarks.core.metrics import AXES, compute_metrics, recovery
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
@@ -232,7 +232,11 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         if keep_trace
         else {}
     )
-    return CaseResult(extra, compute_metrics(traj, scenario.u_max, defaults.SETTLING_BAND), trace)
+    metrics = compute_metrics(traj, scenario.u_max, defaults.SETTLING_BAND)
+    if scenario.disturbance != 0.0:
+        onset, band = scenario.disturbance_start, defaults.RECOVERY_BAND
+        metrics["recovery"] = recovery(traj.t, traj.x[:, :3], onset, band)
+    return CaseResult(extra, metrics, trace)
 
 
 RIGID = PlantFamily(
