@@ -163,6 +163,10 @@ class MITRule:
         return f"MITRule(n_params={self.n_params}, gain={self.gain:g}, dt={self.dt:g}, {kind})"
 
 
+#: Relative eigenvalue below which ``B' P B`` counts as singular (inputs that B maps onto each other).
+RANK_TOL = 1e-10
+
+
 class LyapunovRule:
     """Lyapunov-based adaptation of an input-disturbance estimate (MRAS with a stability proof).
 
@@ -187,7 +191,10 @@ class LyapunovRule:
 
         theta(k) = Proj[ theta(k-1) + Ts g (B_delta' P B_delta)^-1 B_delta' P e(k) ]
 
-    and the projection clips ``|theta_i| <= bound_i``.
+    and the projection clips ``|theta_i| <= bound_i``. With more inputs than ``B`` has rank
+    (four reaction wheels for three axes), ``B' P B`` is singular and its pseudo-inverse is used:
+    the rate is the minimum-norm one, in the range of ``B'``; a combination of inputs that ``B``
+    maps to zero cannot be estimated and is not moved.
 
     Parameters
     ----------
@@ -259,7 +266,13 @@ class LyapunovRule:
 
     def _rate(self, e: np.ndarray, b: np.ndarray, p: np.ndarray) -> np.ndarray:
         pb = p @ b
-        return self.gain * np.linalg.solve(b.T @ pb, pb.T @ e)
+        gram = b.T @ pb
+        eig = np.linalg.eigvalsh(gram)
+        if eig[0] > RANK_TOL * eig[-1]:
+            return self.gain * np.linalg.solve(gram, pb.T @ e)
+        # More inputs than B has rank (e.g. four wheels for three axes): the minimum-norm rate,
+        # in the range of B'; components of theta that B maps to zero are left where they are.
+        return self.gain * (np.linalg.pinv(gram, rcond=RANK_TOL, hermitian=True) @ (pb.T @ e))
 
     def update(self, error: Any, b_delta: Any, p_mat: Any) -> np.ndarray:
         """One forward-Euler step of the law, projected; returns the new estimate."""

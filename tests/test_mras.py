@@ -170,3 +170,21 @@ def test_bad_arguments_name_the_argument(make: object, argument: str) -> None:
 def test_bad_types_name_the_argument() -> None:
     with pytest.raises(ArgumentTypeError, match=r"^gain: expected a real number"):
         MITRule(1, gain="fast", dt=0.1)  # type: ignore[arg-type]
+
+
+def test_lyapunov_rule_over_actuated_uses_the_minimum_norm_rate():
+    """Four inputs through a rank-3 input matrix (paper W's wheels): no singular solve."""
+    from rmpc.mras import LyapunovRule
+
+    d = np.array([[1.0, 0, 0, 1], [0, 1.0, 0, 1], [0, 0, 1.0, 1]]) / np.array([1, 1, 1, np.sqrt(3)])
+    b = np.vstack([np.zeros((3, 4)), d])
+    rng = np.random.default_rng(4)
+    m = rng.standard_normal((6, 6))
+    p = m @ m.T + 6 * np.eye(6)
+    e = rng.standard_normal(6)
+    rule = LyapunovRule(4, gain=100.0, dt=0.01)
+    rate = rule.rate(e, b, p)
+    expected = 100.0 * np.linalg.pinv(b.T @ p @ b) @ b.T @ p @ e
+    np.testing.assert_allclose(rate, expected, rtol=1e-9, atol=1e-12)
+    null = np.linalg.svd(d)[2][-1]  # the wheel combination D maps to zero
+    assert abs(null @ rate) < 1e-9 * np.linalg.norm(rate)
