@@ -153,10 +153,11 @@ class CRMPC:
     wind into a limit cycle; the MIT rule has no such argument and, with its open-loop
     reference model reset every 2 s, falls into a 2 s limit cycle at 1.7 times the nominal
     inertia. Measured on paper P's satellite, E5 settings (nonlinear plant, ``spread = 0.7``,
-    0.5 N m on each axis from 10 s, ``R = 0.01 I``, re-solving at every sample): at true
-    inertias of 0.3, 0.5, 0.7, 1.0, 1.3 and 1.7 times the nominal the attitude error stays
-    below 1e-3 rad from 1.4-2.1 s after the onset, peaks at 4-5e-3 rad, and the applied
-    torque stays below 0.77 N m (``docs/crmpc.rst``).
+    0.5 N m from 10 s on all three axes or on one, ``R = 0.01 I``, re-solving at every sample;
+    ``rmpc bench sweep --config paper_claims``): at true inertias of 0.3, 0.5, 0.7, 1.0, 1.3 and
+    1.7 times the nominal the attitude error stays below 1e-3 rad from 0.6-1.4 s after the
+    onset, peaks at 2-5e-3 rad, and the applied torque stays at 0.67-0.86 N m, never on the
+    limit (``docs/crmpc.rst``).
 
     Examples
     --------

@@ -159,7 +159,9 @@ def test_tables_in_every_format_hold_the_same_values():
     assert obj["max settling (s)"] is None  # yaw did not settle
 
 
-@pytest.mark.parametrize("module", ["metrics", "report", "scenario", "store", "paper", "sweep"])
+@pytest.mark.parametrize(
+    "module", ["core.metrics", "reports.tables", "core.scenario", "core.store", "suites.paper", "core.sweep"]
+)
 def test_docstring_examples_run(module):
     import doctest
     import importlib

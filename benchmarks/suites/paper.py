@@ -337,7 +337,7 @@ def _markdown(
         "## Settings",
         "",
         "Every value paper P leaves out is the toolkit's choice "
-        "(`benchmarks/defaults.py`; each is a scenario field or controller setting).",
+        "(`benchmarks/families/rigid/defaults.py`; each is a scenario field or controller setting).",
         "",
     ]
     lines += [to_markdown(["setting", "value", "source"], [list(r) for r in settings_rows()]), ""]

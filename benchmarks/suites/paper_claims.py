@@ -17,7 +17,9 @@ from benchmarks.core.metrics import AXES
 __all__ = [
     "CLOSE_RELATIVE",
     "FAR_PAST_FACTOR",
+    "LIMIT_TOL",
     "REJECTED_ERROR",
+    "STABLE_ERROR",
     "Claim",
     "assess_claims",
     "claims_markdown",
@@ -300,7 +302,7 @@ def claims_markdown(claims: Sequence[Claim]) -> list[str]:
         "## Paper P's claims",
         "",
         "Each comparative claim of paper P (SPEC section 3), tested on this run's records "
-        "(`benchmarks/paper_claims.py` holds the thresholds). The sweep "
+        "(`benchmarks/suites/paper_claims.py` holds the thresholds). The sweep "
         "`rmpc bench sweep --config paper_claims` repeats E4/E5 over the true inertia from 0.3 to "
         "1.7 x paper P's and over the disturbance axes.",
         "",

@@ -75,7 +75,7 @@ def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -
         r,
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
-        theta_bound=s["theta_fraction"] * scenario.u_max if budget != "none" else None,
+        theta_bound=s["theta_fraction"] * scenario.u_max,  # the projection is anti-windup in every mode
         torque_budget=budget,
         rmpc_options={"resolve_threshold": s["resolve_threshold"]},
         **rule,

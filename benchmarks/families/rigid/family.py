@@ -180,8 +180,10 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 
     sat = RigidSatellite.paper_p()
     x0 = np.concatenate((initial_attitude(scenario.initial_attitude, scenario.ic_scale), np.zeros(3)))
+    x_lin = x0
     if scenario.kinematics == "cover":
         middle = np.concatenate((0.5 * x0[:3], np.zeros(3)))
+        x_lin = middle
         half = 0.5 * np.abs(x0[:3]) + np.radians(scenario.cover_margin)
         poly = sat.polytope(middle, scenario.dt, scenario.spread, scenario.mode, attitude_range=half)
     else:
@@ -200,7 +202,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         plant, true_plant, dt = true_sat, None, scenario.dt
     else:
         plant, dt = poly, None
-        true_plant = None if scenario.true_inertia is None else true_sat.discretize(x0, scenario.dt)
+        true_plant = None if scenario.true_inertia is None else true_sat.discretize(x_lin, scenario.dt)
     traj = simulate(
         built.controller,
         plant,
@@ -215,7 +217,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     extra = {
         "x0": x0.tolist(),
         "true_inertia_used": np.diag(true_sat.inertia).tolist(),
-        "linearization_point": x0.tolist(),
+        "linearization_point": x_lin.tolist(),  # of the nominal model (the linear plant without true_inertia)
         "limiter_in_loop": limiter is not None,
         "settling_band": defaults.SETTLING_BAND,
         "n_vertices": poly.n_vertices,
