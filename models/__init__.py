@@ -23,6 +23,8 @@ from models.satellite import (
     STATE_NAMES,
     RigidSatellite,
 )
+from models.wheel_satellite import WheelSatellite
+from models.wheels import WheelArray
 
 __all__ = [
     "INPUT_NAMES",
@@ -36,6 +38,8 @@ __all__ = [
     "ReactionWheelActuator",
     "RigidSatellite",
     "TorqueLimiter",
+    "WheelArray",
+    "WheelSatellite",
     "kinematics_matrix",
     "zoh",
 ]
