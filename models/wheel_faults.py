@@ -3,15 +3,15 @@
 Each fault acts on one wheel in the per-wheel form ``u_j = lambda_j(t) nu_j + b_j(t)`` (seed
 3.2), ``nu_j`` the command reaching the wheel and ``u_j`` its torque before the limits:
 
-=================  ===========================  =================================================
-kind               final ``(lambda, b(t))``     paper W
-=================  ===========================  =================================================
-``"stuck"``        ``(0, value)``               constant torque ``c`` (0.05 N m in S1, else 0.03)
-``"sinusoidal"``   ``(0, value sin(w t + p))``  ``0.03 sin(0.2 t)``, ``t`` the absolute time
-``"outage"``       ``(0, 0)``                   the wheel gives nothing
-``"effectiveness"````(lambda, 0)``              loss of effectiveness (Remark 1)
-``"bias"``         ``(1, value)``               additive fault (Remark 1, additive reading)
-=================  ===========================  =================================================
+===================  ===========================  =================================================
+kind                 final ``(lambda, b(t))``     paper W
+===================  ===========================  =================================================
+``"stuck"``          ``(0, value)``               constant torque ``c`` (0.05 N m in S1, else 0.03)
+``"sinusoidal"``     ``(0, value sin(w t + p))``  ``0.03 sin(0.2 t)``, ``t`` the absolute time
+``"outage"``         ``(0, 0)``                   the wheel gives nothing
+``"effectiveness"``  ``(lambda, 0)``              loss of effectiveness (Remark 1)
+``"bias"``           ``(1, value)``               additive fault (Remark 1, additive reading)
+===================  ===========================  =================================================
 
 A fault holds on its window ``t_on <= t < t_off``; after ``t_off`` the wheel obeys again
 (**likely**: paper W gives only windows) and keeps the momentum it has. The onset is abrupt
