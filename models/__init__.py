@@ -23,6 +23,12 @@ from models.satellite import (
     STATE_NAMES,
     RigidSatellite,
 )
+from models.wheel_faults import FaultSchedule, RankWindow, WheelFault, rank_deficient_windows
+from models.wheel_noise import AttitudeNoiseSensor, WheelDisturbance
+from models.wheel_satellite import WheelSatellite
+from models.wheel_scenarios import WheelScenario, paper_w_scenario
+from models.wheel_stage import WheelInputStage
+from models.wheels import WheelArray
 
 __all__ = [
     "INPUT_NAMES",
@@ -31,11 +37,22 @@ __all__ = [
     "PAPER_P_SAMPLE_TIME",
     "PAPER_P_TORQUE_LIMIT",
     "STATE_NAMES",
+    "AttitudeNoiseSensor",
+    "FaultSchedule",
     "FlexibleSatellite",
     "PolytopicModel",
+    "RankWindow",
     "ReactionWheelActuator",
     "RigidSatellite",
     "TorqueLimiter",
+    "WheelArray",
+    "WheelDisturbance",
+    "WheelFault",
+    "WheelInputStage",
+    "WheelSatellite",
+    "WheelScenario",
     "kinematics_matrix",
+    "paper_w_scenario",
+    "rank_deficient_windows",
     "zoh",
 ]

@@ -3,6 +3,7 @@
 Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`).
 """
 
+from rmpc.adaptive_backstepping import AdaptiveBacksteppingFTC
 from rmpc.controller import Controller, StepInfo
 from rmpc.crmpc import CRMPC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
@@ -19,6 +20,7 @@ __all__ = [
     "GIPC",
     "LQR",
     "RMPC",
+    "AdaptiveBacksteppingFTC",
     "ConstantDisturbance",
     "Controller",
     "MappedController",
