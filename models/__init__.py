@@ -13,6 +13,8 @@ from models.actuators import ReactionWheelActuator, TorqueLimiter
 from models.discretize import zoh
 from models.flexible import FlexibleSatellite
 from models.kinematics import kinematics_matrix
+from models.mrp_satellite import MRPSatellite
+from models.mrp_scenarios import PaperMScenario, paper_m_scenario
 from models.polytope import PolytopicModel
 from models.satellite import (
     INPUT_NAMES,
@@ -23,6 +25,7 @@ from models.satellite import (
     STATE_NAMES,
     RigidSatellite,
 )
+from models.spinning_disk import SpinningDisk
 
 __all__ = [
     "INPUT_NAMES",
@@ -32,10 +35,14 @@ __all__ = [
     "PAPER_P_TORQUE_LIMIT",
     "STATE_NAMES",
     "FlexibleSatellite",
+    "MRPSatellite",
+    "PaperMScenario",
     "PolytopicModel",
     "ReactionWheelActuator",
     "RigidSatellite",
+    "SpinningDisk",
     "TorqueLimiter",
     "kinematics_matrix",
+    "paper_m_scenario",
     "zoh",
 ]
