@@ -3,11 +3,13 @@
 Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`).
 """
 
+from rmpc.command_filter import CommandFilter
 from rmpc.controller import Controller, StepInfo
 from rmpc.crmpc import CRMPC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
 from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
+from rmpc.neso import NESO
 from rmpc.offline_rmpc import OfflineRMPC
 from rmpc.robust_mpc import RMPC
 from rmpc.scheduled_rmpc import ScheduledRMPC
@@ -18,7 +20,9 @@ __all__ = [
     "CRMPC",
     "GIPC",
     "LQR",
+    "NESO",
     "RMPC",
+    "CommandFilter",
     "ConstantDisturbance",
     "Controller",
     "MappedController",
