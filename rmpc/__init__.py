@@ -3,25 +3,30 @@
 Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`).
 """
 
+from rmpc.cf_backstepping import CFBackstepping
 from rmpc.command_filter import CommandFilter
 from rmpc.controller import Controller, StepInfo
 from rmpc.crmpc import CRMPC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
 from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
+from rmpc.mab import MAB
 from rmpc.neso import NESO
 from rmpc.offline_rmpc import OfflineRMPC
 from rmpc.robust_mpc import RMPC
 from rmpc.scheduled_rmpc import ScheduledRMPC
 from rmpc.simulate import Trajectory, simulate
+from rmpc.tuning_function_ab import TuningFunctionAB
 from rmpc.wrappers import MappedController
 
 __all__ = [
     "CRMPC",
     "GIPC",
     "LQR",
+    "MAB",
     "NESO",
     "RMPC",
+    "CFBackstepping",
     "CommandFilter",
     "ConstantDisturbance",
     "Controller",
@@ -32,5 +37,6 @@ __all__ = [
     "StepDisturbance",
     "StepInfo",
     "Trajectory",
+    "TuningFunctionAB",
     "simulate",
 ]
