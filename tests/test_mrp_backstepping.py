@@ -157,8 +157,6 @@ def m2_sampled(m2):
     for dt in (0.01, 0.05):
         sc = paper_m_scenario("M2", duration=60.0, dt=dt)
         for name, cls in CONTROLLERS.items():
-            if dt == 0.05 and name == "TFAB":
-                continue
             ctrl = cls(sc.model(), target=sc.sigma_ref, dt=dt)
             plant = NonlinearPlant(sc.true_satellite(), dt, method="RK4", substep=0.01)
             out[name, dt] = simulate(ctrl, plant, sc.initial_state(), duration=sc.duration,
