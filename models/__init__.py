@@ -13,6 +13,8 @@ from models.actuators import ReactionWheelActuator, TorqueLimiter
 from models.discretize import zoh
 from models.flexible import FlexibleSatellite
 from models.kinematics import kinematics_matrix
+from models.mrp_satellite import MRPSatellite
+from models.mrp_scenarios import PaperMScenario, paper_m_scenario
 from models.polytope import PolytopicModel
 from models.satellite import (
     INPUT_NAMES,
@@ -23,6 +25,7 @@ from models.satellite import (
     STATE_NAMES,
     RigidSatellite,
 )
+from models.spinning_disk import SpinningDisk
 from models.wheel_faults import FaultSchedule, RankWindow, WheelFault, rank_deficient_windows
 from models.wheel_noise import AttitudeNoiseSensor, WheelDisturbance
 from models.wheel_satellite import WheelSatellite
@@ -40,10 +43,13 @@ __all__ = [
     "AttitudeNoiseSensor",
     "FaultSchedule",
     "FlexibleSatellite",
+    "MRPSatellite",
+    "PaperMScenario",
     "PolytopicModel",
     "RankWindow",
     "ReactionWheelActuator",
     "RigidSatellite",
+    "SpinningDisk",
     "TorqueLimiter",
     "WheelArray",
     "WheelDisturbance",
@@ -52,6 +58,7 @@ __all__ = [
     "WheelSatellite",
     "WheelScenario",
     "kinematics_matrix",
+    "paper_m_scenario",
     "paper_w_scenario",
     "rank_deficient_windows",
     "zoh",
