@@ -20,19 +20,15 @@ E6    initial attitude x 1.3: RMPC and GIPC                                  lin
 from __future__ import annotations
 
 import json
-import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from benchmarks.core.execute import ExecOutcome, Task, execute
-from benchmarks.core.executors import make_executor
 from benchmarks.core.machine import machine_info, package_versions
-from benchmarks.core.progress import CaseProgress
 from benchmarks.core.scenario import Scenario
+from benchmarks.core.suite import SuiteCase, SuiteOutcome, run_suite_cases
 from benchmarks.families.rigid import defaults
 from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from models import PAPER_P_INERTIA
@@ -53,17 +49,10 @@ EXPERIMENTS: dict[str, str] = {
 }
 
 
-@dataclass(frozen=True)
-class PaperCase:
-    """One run of the suite: the experiment it belongs to and its scenario."""
-
-    experiment: str
-    scenario: Scenario
-
-    @property
-    def key(self) -> str:
-        sc = self.scenario
-        return f"{self.experiment}_{sc.controller}_{sc.plant}_{sc.saturation}"
+#: One run of the suite: the experiment it belongs to and its scenario.
+PaperCase = SuiteCase
+#: What :func:`run_paper` did: records, failures, files, wall time, interruption.
+PaperOutcome = SuiteOutcome
 
 
 def paper_cases(duration_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[PaperCase]:
@@ -133,17 +122,6 @@ def _cost(case: PaperCase) -> float:
     return weight * sc.duration
 
 
-@dataclass
-class PaperOutcome:
-    """What :func:`run_paper` did: records, failures, files, wall time, interruption."""
-
-    records: list[dict[str, Any]] = field(default_factory=list)
-    failures: list[dict[str, Any]] = field(default_factory=list)
-    files: list[Path] = field(default_factory=list)
-    wall_time_s: float = 0.0
-    execution: ExecOutcome | None = None
-
-
 def run_paper(
     out: str | Path,
     workers: int | None = None,
@@ -170,49 +148,9 @@ def run_paper(
         Force the progress bar on or off (default: on when stderr is a terminal).
     """
     cases = paper_cases(duration_scale, experiments)
-    executor = make_executor(workers, scheduler)  # a bad --scheduler fails before anything is written
+    outcome, runs = run_suite_cases(cases, out, "rmpc bench paper", workers, scheduler, progress, _cost)
     out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        executor.close()
-        raise
-    start = time.perf_counter()
-    results: dict[str, dict[str, Any]] = {}
-    ordered = sorted(cases, key=_cost, reverse=True)
-    tasks = [
-        Task(c.key, {"scenario": c.scenario.to_dict(), "experiment": c.experiment, "trace": True})
-        for c in ordered
-    ]
-    with CaseProgress(len(tasks), "rmpc bench paper", progress) as bar:
-
-        def on_result(task: Task, result: dict[str, Any]) -> None:
-            results[task.key] = result
-            bar.advance(task.key, ok=bool(result.get("ok")))
-
-        execution = execute(tasks, executor, on_result)
-    outcome = PaperOutcome(wall_time_s=time.perf_counter() - start, execution=execution)
-    runs = []
-    for case in cases:
-        res = results.get(case.key)
-        if res is None:
-            continue
-        if res["ok"]:
-            outcome.records.append(res["record"])
-            runs.append((case, res["record"], res["trace"]))
-        else:
-            outcome.failures.append(
-                {
-                    "experiment": case.experiment,
-                    "key": case.key,
-                    "error": res["error"],
-                    "traceback": res.get("traceback", ""),
-                    "scenario": case.scenario.to_dict(),
-                }
-            )
-    outcome.files = _write(
-        out, cases, runs, outcome, workers, scheduler, duration_scale, executor.description
-    )
+    outcome.files = _write(out, cases, runs, outcome, workers, scheduler, duration_scale, outcome.executor)
     return outcome
 
 

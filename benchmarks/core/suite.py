@@ -1,0 +1,132 @@
+"""Run the cases of a benchmark suite in parallel and collect records, traces and failures.
+
+A suite (``rmpc bench paper``, ``rmpc bench faults``, ...) is a list of
+:class:`SuiteCase` (an experiment name and a scenario); :func:`run_suite_cases` runs them on
+local workers or Dask with a progress bar, longest first, and hands back what each produced;
+the suite writes its own report from that.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from benchmarks.core.execute import ExecOutcome, Task, execute
+from benchmarks.core.executors import make_executor
+from benchmarks.core.progress import CaseProgress
+from benchmarks.core.scenario import Scenario
+
+__all__ = ["SuiteCase", "SuiteOutcome", "run_suite_cases"]
+
+
+@dataclass(frozen=True)
+class SuiteCase:
+    """One run of a suite: the experiment it belongs to, its scenario and a short tag.
+
+    ``key`` (file names, progress) is ``<experiment>_<tag>`` when a tag is given, else
+    ``<experiment>_<controller>_<plant>_<saturation>``.
+    """
+
+    experiment: str
+    scenario: Scenario
+    tag: str = ""
+
+    @property
+    def key(self) -> str:
+        if self.tag:
+            return f"{self.experiment}_{self.tag}"
+        sc = self.scenario
+        return f"{self.experiment}_{sc.controller}_{sc.plant}_{sc.saturation}"
+
+
+@dataclass
+class SuiteOutcome:
+    """What a suite run did: records, failures, files, wall time, interruption."""
+
+    records: list[dict[str, Any]] = field(default_factory=list)
+    failures: list[dict[str, Any]] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+    wall_time_s: float = 0.0
+    execution: ExecOutcome | None = None
+    executor: str = ""
+
+
+def run_suite_cases(
+    cases: Sequence[Any],
+    out: str | Path,
+    title: str,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool | None = None,
+    cost: Callable[[Any], float] | None = None,
+) -> tuple[SuiteOutcome, list[tuple[Any, dict, dict]]]:
+    """Run ``cases`` (each with ``experiment``, ``scenario`` and ``key``) and collect the results.
+
+    Parameters
+    ----------
+    cases : sequence
+        The suite's cases (:class:`SuiteCase` or alike).
+    out : str or Path
+        The output directory, created here (before anything runs, after the executor is made,
+        so a bad scheduler address fails first).
+    title : str
+        The progress bar's title.
+    workers, scheduler, progress
+        As for ``rmpc bench paper``.
+    cost : callable, optional
+        A relative cost per case: the long cases start first.
+
+    Returns
+    -------
+    outcome : SuiteOutcome
+        Records in the order of ``cases`` and failures (``experiment``, ``key``, ``error``,
+        ``traceback``, ``scenario``).
+    runs : list of (case, record, trace)
+        The cases that finished, with their time series.
+    """
+    executor = make_executor(workers, scheduler)
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        executor.close()
+        raise
+    start = time.perf_counter()
+    results: dict[str, dict[str, Any]] = {}
+    ordered = sorted(cases, key=cost, reverse=True) if cost is not None else list(cases)
+    tasks = [
+        Task(c.key, {"scenario": c.scenario.to_dict(), "experiment": c.experiment, "trace": True})
+        for c in ordered
+    ]
+    with CaseProgress(len(tasks), title, progress) as bar:
+
+        def on_result(task: Task, result: dict[str, Any]) -> None:
+            results[task.key] = result
+            bar.advance(task.key, ok=bool(result.get("ok")))
+
+        execution = execute(tasks, executor, on_result)
+    outcome = SuiteOutcome(
+        wall_time_s=time.perf_counter() - start, execution=execution, executor=executor.description
+    )
+    runs = []
+    for case in cases:
+        res = results.get(case.key)
+        if res is None:
+            continue
+        if res["ok"]:
+            outcome.records.append(res["record"])
+            runs.append((case, res["record"], res["trace"]))
+        else:
+            outcome.failures.append(
+                {
+                    "experiment": case.experiment,
+                    "key": case.key,
+                    "error": res["error"],
+                    "traceback": res.get("traceback", ""),
+                    "scenario": case.scenario.to_dict(),
+                }
+            )
+    return outcome, runs
