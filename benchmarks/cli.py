@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -86,6 +87,35 @@ def _cmd_bench_paper(args: argparse.Namespace) -> int:
     return 1 if failed or (ex is not None and ex.unfinished) else 0
 
 
+def _report_suite(name: str, outcome: Any, out: str) -> int:
+    ex = outcome.execution
+    done, failed = len(outcome.records), len(outcome.failures)
+    print(
+        f"rmpc bench {name}: {done} cases done, {failed} failed in {outcome.wall_time_s:.1f} s; "
+        f"results in {out}/results.md"
+    )
+    for failure in outcome.failures:
+        print(f"  failed: {failure['key']}: {failure['error']}", file=sys.stderr)
+    if ex is not None and ex.interrupted:
+        print("rmpc: interrupted; the files hold the cases that finished", file=sys.stderr)
+        return 130
+    return 1 if failed or (ex is not None and ex.unfinished) else 0
+
+
+def _cmd_bench_faults(args: argparse.Namespace) -> int:
+    from benchmarks.suites.faults import SHORT_TIME_SCALE, run_faults
+
+    outcome = run_faults(
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        time_scale=SHORT_TIME_SCALE if args.short else 1.0,
+        experiments=args.experiments,
+        progress=None if not args.no_progress else False,
+    )
+    return _report_suite("faults", outcome, args.out)
+
+
 def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
     from benchmarks.core.sweep import run_sweep
 
@@ -129,9 +159,10 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     bench = sub.add_parser(
         "bench",
         help="benchmark suites and sweeps",
-        description="Run the benchmark suite of paper P or a sweep of scenarios.",
+        description="Run a benchmark suite (paper P's experiments, paper W's fault scenarios) or a sweep "
+        "of scenarios.",
     )
-    bsub = bench.add_subparsers(dest="bench_command", required=True, metavar="{paper,sweep}")
+    bsub = bench.add_subparsers(dest="bench_command", required=True, metavar="{paper,faults,sweep}")
     workers_help = "worker processes on this machine (default: one per CPU; 0: run in this process)"
     paper = bsub.add_parser(
         "paper",
@@ -166,6 +197,28 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     )
     paper.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     paper.set_defaults(func=_cmd_bench_paper)
+
+    faults = bsub.add_parser(
+        "faults",
+        help="paper W's wheel-fault scenarios S1-S4 (W1-W4)",
+        description="Run W1-W4 (paper W's S1-S4 on the four-wheel satellite: ABFTC, RMPC, CRMPC, GIPC) and "
+        "write results.json, results.md (tables, paper W's reported results next to the measured ones, "
+        "its inconsistencies, every setting chosen), results.csv, run.json, figures/W*.png and "
+        "traces/*.npz into DIR. Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted.",
+    )
+    faults.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    faults.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
+    faults.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
+    faults.add_argument(
+        "--short",
+        action="store_true",
+        help="a smoke run (run lengths and fault windows x 0.1) to check the set-up; no measurement",
+    )
+    faults.add_argument(
+        "--experiments", type=_experiments, default=None, metavar="W1,...", help="run only these experiments"
+    )
+    faults.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    faults.set_defaults(func=_cmd_bench_faults)
 
     sweep = bsub.add_parser(
         "sweep",

@@ -10,7 +10,8 @@ so a new family is a new sub-package of :mod:`benchmarks.families` that calls
 is edited.
 
 Every family has at least the fields ``plant``, ``saturation``, ``duration`` and ``dt`` (the
-record of a case names its plant and saturation, and the runner needs the run length). The
+record of a case names its plant and saturation; a ``duration`` of ``None`` lets the family pick
+the run length, e.g. from a paper's scenario). The
 scenario fields ``family``, ``controller`` and ``settings`` are the core's.
 
 Examples
@@ -170,6 +171,10 @@ class PlantFamily:
         ``settings_check(controller, settings, where)``: checks between settings.
     montecarlo : MonteCarlo, optional
         What a sweep's ``[montecarlo]`` draw changes; ``None``: the family has no draws.
+    controller_defaults : callable, optional
+        ``controller_defaults(controller) -> {field: default}``: defaults that depend on the
+        controller (e.g. ``saturation = "limiter"`` for a controller without a constraint),
+        used where the scenario does not set the field.
     """
 
     name: str
@@ -183,6 +188,15 @@ class PlantFamily:
     zero_allowed: frozenset[str] = frozenset()
     settings_check: Callable[[str, dict[str, Any], str], None] | None = None
     montecarlo: MonteCarlo | None = None
+    controller_defaults: Callable[[str], Mapping[str, Any]] | None = None
+
+    def default(self, key: str, controller: str) -> Any:
+        """The default of field ``key`` for ``controller``."""
+        if self.controller_defaults is not None:
+            own = self.controller_defaults(controller)
+            if key in own:
+                return own[key]
+        return self.fields[key].default
 
     # -- settings ---------------------------------------------------------------------
     def _check_value(self, default: Any, value: Any, where: str) -> Any:

@@ -163,7 +163,7 @@ class Scenario:
             choices = ", ".join(repr(c) for c in family.controllers)
             raise ConfigError(name("controller"), "one of " + choices, repr(controller))
         values = {
-            key: spec.check(data[key], name(key)) if key in data else spec.default
+            key: spec.check(data[key], name(key)) if key in data else family.default(key, controller)
             for key, spec in family.fields.items()
         }
         overrides = data.get("settings", {})
@@ -174,7 +174,7 @@ class Scenario:
         if problem is not None:
             raise ConfigError(name("saturation"), problem, "'constraint'")
         family.check(values, controller, name)
-        if values["duration"] < values["dt"]:
+        if values["duration"] is not None and values["duration"] < values["dt"]:
             raise ConfigError(
                 name("duration"), f"at least one sample (dt = {values['dt']:g} s)", repr(values["duration"])
             )

@@ -253,7 +253,7 @@ def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:
             data = _with(data, key, value)
         family = _family(spec)
         controller = data.get("controller", Scenario.default("controller"))
-        saturation = data.get("saturation", family.fields["saturation"].default)
+        saturation = data.get("saturation", family.default("saturation", controller))
         problem = family.unsupported(controller, saturation)
         if problem is not None:
             dropped.append(f"{controller} with saturation = {saturation!r}")

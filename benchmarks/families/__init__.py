@@ -1,6 +1,7 @@
 """The plant families the harness ships, one sub-package each, registered on import.
 
-- :mod:`benchmarks.families.rigid`: paper P's rigid satellite (``family = "rigid"``, the default).
+- :mod:`benchmarks.families.rigid`: paper P's rigid satellite (``family = "rigid"``, the default);
+- :mod:`benchmarks.families.wheel`: paper W's four-wheel satellite with wheel faults (``"wheel"``).
 
 A new family is a sub-package with a :class:`~benchmarks.core.family.PlantFamily` object,
 registered below with :func:`~benchmarks.core.family.register_family`; a user's own family can
@@ -9,7 +10,9 @@ be registered the same way from their code, before the scenarios that name it ar
 
 from benchmarks.core.family import register_family
 from benchmarks.families.rigid.family import RIGID
+from benchmarks.families.wheel.family import WHEEL
 
 register_family(RIGID)
+register_family(WHEEL)
 
-__all__ = ["RIGID"]
+__all__ = ["RIGID", "WHEEL"]

@@ -1,0 +1,86 @@
+"""Figures of the wheel-fault suite: attitude, wheel torques (commanded and applied, with the
+limits) and wheel momenta per controller, with the fault windows shaded."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["plot_fault_case_group"]
+
+
+def _shade(ax: Any, windows: Sequence[tuple[float, float]], t_end: float) -> None:
+    for t0, t1 in windows:
+        ax.axvspan(t0, min(t1, t_end), color="tab:red", alpha=0.12, lw=0)
+
+
+def plot_fault_case_group(
+    items: Sequence[tuple[dict, dict]],
+    windows: Sequence[tuple[float, float]],
+    path: Path,
+    title: str,
+    torque_max: float,
+    momentum_max: float,
+) -> Path:
+    """One column per run (controller): attitude (deg), wheel torques, wheel momenta.
+
+    Parameters
+    ----------
+    items : sequence of (record, trace)
+        The runs; traces hold ``t``, ``x`` (``[eta, w, h]``), ``u_cmd``, ``u_applied``.
+    windows : sequence of (t_on, t_off)
+        Fault windows, shaded in every panel.
+    path : Path
+        The PNG to write.
+    title : str
+        The figure's title.
+    torque_max, momentum_max : float
+        The wheel limits, drawn as dotted lines.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = max(len(items), 1)
+    fig, axes = plt.subplots(3, n, figsize=(4.2 * n, 8.0), sharex="col", squeeze=False)
+    colors = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
+    for col, (rec, trace) in enumerate(items):
+        t, x = np.asarray(trace["t"]), np.asarray(trace["x"])
+        u_cmd, u_app = np.asarray(trace["u_cmd"]), np.asarray(trace["u_applied"])
+        t_u = t[: u_app.shape[0]]
+        ax_a, ax_u, ax_h = axes[0, col], axes[1, col], axes[2, col]
+        eta = np.degrees(x[:, :3].copy())
+        eta[:, 2] = (eta[:, 2] + 180.0) % 360.0 - 180.0
+        for i, name in enumerate(("roll", "pitch", "yaw")):
+            ax_a.plot(t, eta[:, i], label=name, lw=1.0)
+        ax_a.set_title(rec.get("label", rec.get("controller", "")), fontsize=9)
+        for j in range(u_app.shape[1]):
+            c = colors[j % len(colors)]
+            ax_u.plot(t_u, u_app[:, j], color=c, lw=0.9, label=f"wheel {j + 1}")
+            ax_u.plot(t_u, np.clip(u_cmd[:, j], -3 * torque_max, 3 * torque_max), color=c, lw=0.6, ls="--")
+        for ax, lim in ((ax_u, torque_max), (ax_h, momentum_max)):
+            ax.axhline(lim, color="k", ls=":", lw=0.8)
+            ax.axhline(-lim, color="k", ls=":", lw=0.8)
+        h = x[:, 6:]
+        for j in range(h.shape[1]):
+            ax_h.plot(t, h[:, j], color=colors[j % len(colors)], lw=0.9)
+        for ax in (ax_a, ax_u, ax_h):
+            _shade(ax, windows, float(t[-1]))
+            ax.grid(alpha=0.3)
+        ax_h.set_xlabel("t (s)")
+        if col == 0:
+            ax_a.set_ylabel("attitude (deg)")
+            ax_u.set_ylabel("wheel torque (N m)\napplied, commanded dashed")
+            ax_h.set_ylabel("wheel momentum (N m s)")
+            ax_a.legend(fontsize=7, loc="upper right")
+            ax_u.legend(fontsize=7, loc="upper right")
+    note = " (fault windows shaded; dotted: limits; commands clipped at 3x for display)"
+    fig.suptitle(title + note, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

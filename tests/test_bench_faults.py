@@ -1,0 +1,99 @@
+"""The wheel family of the harness and ``rmpc bench faults`` (issue 13, parts 5 and 6)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from benchmarks.cli import main
+from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.sweep import expand, load_sweep
+from benchmarks.families.wheel.family import case_faults
+from benchmarks.suites.faults import fault_cases
+from toolkit_common.errors import ConfigError
+
+
+def test_wheel_scenarios_take_the_paper_scenario_and_controller_defaults():
+    sc = Scenario.from_dict({"family": "wheel", "controller": "ABFTC", "scenario": "S3"})
+    assert sc.saturation == "limiter"  # ABFTC has no constraint
+    assert Scenario.from_dict({"family": "wheel", "controller": "RMPC"}).saturation == "constraint"
+    kinds = [(f.wheel, f.kind) for f in case_faults(sc)]
+    assert kinds == [(4, "outage"), (1, "sinusoidal"), (2, "stuck")]
+    assert sc.to_dict()["family"] == "wheel"
+    assert len(fault_cases()) == 20
+
+
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"fault_kind": "stuck", "fault_wheel": 5}, "fault_wheel"),
+        ({"fault_kind": "stuck", "fault_onset": 61.0}, "fault_onset"),
+        ({"fault_kind": "effectiveness", "fault_value": 1.5}, "fault_value"),
+        ({"fault_kind": "melted"}, "fault_kind"),
+        ({"u_max": -0.1}, "u_max"),
+        ({"controller": "ABFTC", "saturation": "constraint"}, "saturation"),
+        ({"spread": 0.3}, "spread"),  # a rigid-family field
+    ],
+)
+def test_bad_wheel_fields_name_the_field(data, field):
+    with pytest.raises(ConfigError, match=field):
+        Scenario.from_dict({"family": "wheel", "controller": "RMPC", **data})
+
+
+def test_unknown_family_is_named():
+    with pytest.raises(ConfigError, match="family"):
+        Scenario.from_dict({"family": "spacecraft"})
+
+
+def test_a_single_fault_case_runs_and_logs_the_clipped_wheels():
+    sc = Scenario.from_dict(
+        {
+            "family": "wheel", "controller": "ABFTC", "scenario": "S1", "duration": 4.0,
+            "fault_kind": "stuck", "fault_wheel": 3, "fault_onset": 1.0, "fault_value": 0.05,
+        }
+    )
+    rec = run_scenario(sc)
+    faults = rec["metrics"]["faults"]
+    assert rec["plant"] == "nonlinear" and rec["saturation"] == "limiter"
+    assert faults["max_abs_u"] <= 0.123 + 1e-12 < faults["max_abs_u_cmd"]  # the plant clips
+    assert faults["sat_fraction"]["any"] > 0.0
+    assert [e["wheel"] for e in faults["recovery_time"]] == [3]
+    assert math.isfinite(rec["metrics"]["sum_abs_err"]["roll"])
+
+
+def test_shipped_faults_sweep_expands_over_kind_wheel_onset_and_controller():
+    spec = load_sweep("faults")
+    cases = expand(spec)
+    assert {c.family for c in cases} == {"wheel"}
+    assert {c.controller for c in cases} == {"ABFTC", "RMPC", "CRMPC", "GIPC"}
+    assert {c.fault_kind for c in cases} >= {"stuck", "outage", "sinusoidal"}
+    assert {c.saturation for c in cases if c.controller == "ABFTC"} == {"limiter"}
+    assert len({c.case_id for c in cases}) == len(cases)
+
+
+def test_bench_faults_short_writes_every_file(tmp_path, capsys):
+    out = tmp_path / "faults"
+    status = main(["bench", "faults", "--out", str(out), "--short", "--workers", "0",
+                   "--experiments", "W1", "--no-progress"])
+    stdout = capsys.readouterr().out
+    assert status == 0, stdout
+    assert "4 cases done, 0 failed" in stdout
+    for name in ("results.json", "results.md", "results.csv", "run.json", "figures/W1.png"):
+        assert (out / name).stat().st_size > 0, name
+    records = json.loads((out / "results.json").read_text())
+    assert {r["controller"] for r in records} == {"ABFTC", "RMPC", "CRMPC", "GIPC"}
+    for rec in records:
+        for key in ("sum_abs_err", "final_abs_err", "max_abs_u", "solve_time_p50"):
+            assert key in rec["metrics"]
+        assert rec["metrics"]["faults"]["max_abs_u"] <= 0.123 + 1e-12
+    md = (out / "results.md").read_text()
+    for section in ("## W1", "## Paper W's reported results", "## Inconsistencies in paper W", "## Settings"):
+        assert section in md
+    assert "13x" in md and "smoke run" in md
+
+
+def test_a_run_shorter_than_the_scenario_faults_is_refused():
+    with pytest.raises(ConfigError, match="duration"):
+        Scenario.from_dict({"family": "wheel", "scenario": "S2", "duration": 10.0})
