@@ -56,7 +56,7 @@ def test_a_single_fault_case_runs_and_logs_the_clipped_wheels():
     )
     rec = run_scenario(sc)
     faults = rec["metrics"]["faults"]
-    assert rec["plant"] == "nonlinear" and rec["saturation"] == "limiter"
+    assert rec["plant"] == "wheel" and rec["saturation"] == "limiter"  # API.md: plant names the family
     assert faults["max_abs_u"] <= 0.123 + 1e-12 < faults["max_abs_u_cmd"]  # the plant clips
     assert faults["sat_fraction"]["any"] > 0.0
     assert [e["wheel"] for e in faults["recovery_time"]] == [3]

@@ -363,7 +363,8 @@ def _markdown(
         f"Machine: {m['platform']}, {m['cpu_count']} CPUs, load average {m['load_average']} at the end; "
         "package versions in `run.json`.",
         "",
-        "Nonlinear four-wheel satellite, RK4 at 5 ms inside the 40 ms hold; every wheel's torque "
+        "Nonlinear four-wheel satellite (records: `plant` = \"wheel\"), RK4 at 5 ms inside the 40 ms hold; "
+        "every wheel's torque "
         f"({defaults.U_MAX:g} N m) and momentum limits act in the plant. Recovery: time from a fault "
         f"event until every angle stays within {defaults.RECOVERY_DEG:g} deg until the next event. "
         "`step` times are the controller's wall time per 40 ms period.",
