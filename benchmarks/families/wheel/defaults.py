@@ -51,7 +51,7 @@ CONTROLLER_DEFAULTS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
                 "Q_diag": _Q_DIAG,
                 "R_diag": _R_DIAG,
                 "input_constraint": "peak",
-                "adaptation_gain": 100.0,
+                "adaptation_gain": 25.0,
                 "theta_fraction": 0.8,
                 "torque_budget": "current",
                 "backend": "ipm",
@@ -102,7 +102,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
         ),
         (
             "CRMPC adaptation",
-            "Lyapunov rule, g = 100 1/s^2, |theta_j| <= 0.8 u_max, 'current' budget",
+            "Lyapunov rule, g = 25 1/s^2 (Ts g = 1), |theta_j| <= 0.8 u_max, 'current' budget",
             "toolkit",
         ),
         ("GIPC Np, Nc, Qy, R_du, du_max", "100 (4 s), 4, 1, 0.3, 0.01 N m", "toolkit"),
