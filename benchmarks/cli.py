@@ -116,6 +116,20 @@ def _cmd_bench_faults(args: argparse.Namespace) -> int:
     return _report_suite("faults", outcome, args.out)
 
 
+def _cmd_bench_mrp(args: argparse.Namespace) -> int:
+    from benchmarks.suites.mrp import SHORT_TIME_SCALE, run_mrp
+
+    outcome = run_mrp(
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        time_scale=SHORT_TIME_SCALE if args.short else 1.0,
+        experiments=args.experiments,
+        progress=None if not args.no_progress else False,
+    )
+    return _report_suite("mrp", outcome, args.out)
+
+
 def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
     from benchmarks.core.sweep import run_sweep
 
@@ -162,7 +176,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         description="Run a benchmark suite (paper P's experiments, paper W's fault scenarios) or a sweep "
         "of scenarios.",
     )
-    bsub = bench.add_subparsers(dest="bench_command", required=True, metavar="{paper,faults,sweep}")
+    bsub = bench.add_subparsers(dest="bench_command", required=True, metavar="{paper,faults,mrp,sweep}")
     workers_help = "worker processes on this machine (default: one per CPU; 0: run in this process)"
     paper = bsub.add_parser(
         "paper",
@@ -219,6 +233,24 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     )
     faults.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     faults.set_defaults(func=_cmd_bench_faults)
+
+    mrp = bsub.add_parser(
+        "mrp",
+        help="paper M's MRP satellite scenarios M1-M3",
+        description="Run M1-M3 (paper M's MRP satellite with the spinning disk: BS, MAB, TFAB, RMPC, CRMPC) "
+        "and write results.json, results.md (tables, paper M's reported results next to the measured ones, "
+        "its inconsistencies, every setting chosen), results.csv, run.json, figures/M*.png and traces/*.npz "
+        "into DIR. Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted.",
+    )
+    mrp.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    mrp.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
+    mrp.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
+    mrp.add_argument("--short", action="store_true", help="a smoke run (run lengths x 0.05); no measurement")
+    mrp.add_argument(
+        "--experiments", type=_experiments, default=None, metavar="M1,...", help="run only these experiments"
+    )
+    mrp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    mrp.set_defaults(func=_cmd_bench_mrp)
 
     sweep = bsub.add_parser(
         "sweep",

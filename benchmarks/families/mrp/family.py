@@ -1,0 +1,206 @@
+"""Paper M's MRP satellite as a plant family: scenario fields, one case simulated, metrics.
+
+The fields (all with defaults; :mod:`benchmarks.families.mrp.defaults` holds what paper M
+leaves out):
+
+plant : {"mrp"}
+    The plant family's name (API.md): the rigid satellite in MRPs relative to the orbital
+    frame, RK4 at the control step, the shadow-set switch after every step.
+scenario : {"M1", "M2", "M3"}
+    Paper M's scenario (:func:`models.paper_m_scenario`): M1 nominal, M2 the spinning disk, M3
+    the disk with an inertia error and a torque limit.
+saturation : {"none", "limiter", "constraint"}
+    How the torque limit ``u_max`` is met (:mod:`benchmarks.families.mrp.controllers`).
+u_max : float
+    Per-axis torque limit (N m, default 1; used unless ``saturation = "none"``).
+inertia_scale : float or None
+    The plant's inertia ``inertia_scale * J0``; ``None``: the scenario's (M3: 1.3).
+spread : float
+    Relative inertia uncertainty of the robust MPC's polytope, in ``[0, 1)`` (default 0.3).
+kinematics : {"cover", "single"}
+    The robust MPC's polytope: ``"cover"`` (default) also covers the kinematics over the box of
+    attitude errors from the initial one to zero (5 deg margin); ``"single"``: linearised at the
+    target only.
+duration : float or None
+    Run length (s); ``None``: the scenario's 100 s. The steady window is its second half.
+time_scale : float
+    Factor on the scenario's run length (``rmpc bench mrp --short``; no measurement).
+dt : float
+    Control step (s, default 0.01).
+plant_step : float
+    RK4 step of the plant (s, default 0.01; at most ``dt``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from benchmarks.core.family import CaseResult, ControllerSpec, Field, PlantFamily, check_choice, check_real
+from benchmarks.families.mrp import defaults
+from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
+from toolkit_common.errors import ConfigError
+
+__all__ = ["MRP", "simulate_case"]
+
+COVER_MARGIN_DEG = 5.0
+
+
+def _positive(value: Any, where: str) -> float:
+    return check_real(value, where, low=0.0, low_open=True)
+
+
+def _optional_positive(value: Any, where: str) -> float | None:
+    return None if value is None else _positive(value, where)
+
+
+FIELDS: Mapping[str, Field] = {
+    "plant": Field("mrp", lambda v, w: check_choice(v, w, ("mrp",))),
+    "scenario": Field("M2", lambda v, w: check_choice(v, w, ("M1", "M2", "M3"))),
+    "saturation": Field("none", lambda v, w: check_choice(v, w, ("none", "limiter", "constraint"))),
+    "u_max": Field(defaults.U_MAX, _positive),
+    "inertia_scale": Field(None, _optional_positive),
+    "spread": Field(0.3, lambda v, w: check_real(v, w, low=0.0, high=1.0, high_open=True)),
+    "kinematics": Field("cover", lambda v, w: check_choice(v, w, ("cover", "single"))),
+    "duration": Field(None, _optional_positive),
+    "time_scale": Field(1.0, lambda v, w: check_real(v, w, low=0.0, high=1.0, low_open=True)),
+    "dt": Field(0.01, _positive),
+    "plant_step": Field(0.01, _positive),
+}
+
+
+def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) -> None:
+    if values["saturation"] == "constraint" and controller not in CONSTRAINED:
+        return  # the core's unsupported() names it
+    if values["plant_step"] > values["dt"]:
+        raise ConfigError(name("plant_step"), f"at most dt = {values['dt']:g} s", repr(values["plant_step"]))
+    if values["duration"] is not None and values["duration"] < values["dt"]:
+        expected = f"at least one sample (dt = {values['dt']:g} s)"
+        raise ConfigError(name("duration"), expected, repr(values["duration"]))
+
+
+def _label(scenario: Any) -> str:
+    parts = [scenario.controller, scenario.scenario, scenario.saturation]
+    if scenario.inertia_scale is not None:
+        parts.append(f"J x{scenario.inertia_scale:g}")
+    return " ".join(parts)
+
+
+def paper_scenario(scenario: Any) -> Any:
+    """The :class:`models.mrp_scenarios.PaperMScenario` of a case (its length, step, inertia)."""
+    from models import paper_m_scenario
+
+    base = paper_m_scenario(scenario.scenario)
+    duration = scenario.duration if scenario.duration is not None else base.duration * scenario.time_scale
+    overrides: dict[str, Any] = {"duration": duration, "dt": scenario.dt}
+    if scenario.inertia_scale is not None:
+        overrides["inertia_scale"] = scenario.inertia_scale
+    return paper_m_scenario(scenario.scenario, **overrides)
+
+
+def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+    """Build paper M's satellite, the disk, the controller (and the RMPC polytope); run; measure."""
+    from models import RigidSatellite, TorqueLimiter
+    from models.mrp import RMPCStateMap, mrp_error_angle
+    from rmpc import simulate
+    from rmpc.plants import NonlinearPlant
+
+    case = paper_scenario(scenario)
+    model = case.model()
+    state_map = RMPCStateMap(case.sigma_ref, model.mean_motion)
+    x0 = case.initial_state()
+    poly = None
+    if scenario.controller in ("RMPC", "CRMPC"):
+        rigid = RigidSatellite(np.diag(model.inertia).tolist())
+        if scenario.kinematics == "cover":
+            half = np.abs(state_map(x0)[:3]) + math.radians(COVER_MARGIN_DEG)
+            half[2] = 0.0  # yaw does not enter the kinematics matrix
+            poly = rigid.polytope(np.zeros(6), scenario.dt, scenario.spread, attitude_range=half)
+        else:
+            poly = rigid.polytope(np.zeros(6), scenario.dt, scenario.spread)
+    built = CONTROLLERS[scenario.controller](
+        MRPModel(model, case.sigma_ref, poly, state_map), scenario, settings
+    )
+    limiter = TorqueLimiter(scenario.u_max) if built.needs_limiter else None
+    plant = NonlinearPlant(case.true_satellite(), scenario.dt, method="RK4", substep=scenario.plant_step)
+    traj = simulate(
+        built.controller, plant, x0, duration=case.duration, disturbance=case.disturbance(), limiter=limiter
+    )
+    phi = np.degrees([mrp_error_angle(x[:3], case.sigma_ref) for x in traj.x])
+    lo, hi = case.steady_window
+    window = (traj.t >= lo) & (traj.t <= hi)
+    err = np.array([state_map(x)[:3] for x in traj.x])
+    metrics: dict[str, Any] = {
+        "final_abs_err": {ax: float(abs(err[-1, i])) for i, ax in enumerate(("roll", "pitch", "yaw"))},
+        "sum_abs_err": {ax: float(np.abs(err[:, i]).sum()) for i, ax in enumerate(("roll", "pitch", "yaw"))},
+        "err_angle_initial_deg": float(phi[0]),
+        "err_angle_ss_max_deg": float(phi[window].max()) if window.any() else None,
+        "err_angle_rms_deg": float(np.sqrt(np.mean(phi[window] ** 2))) if window.any() else None,
+        "err_angle_final_deg": float(phi[-1]),
+        "max_abs_u": float(np.abs(traj.u_applied).max()),
+        "max_abs_u_time": float(traj.t[int(np.abs(traj.u_applied).max(axis=1).argmax())]),
+        "max_abs_u_cmd": float(np.abs(traj.u_cmd).max()),
+    }
+    metrics.update(_timing(traj))
+    estimate = [info.extra.get("torque_estimate") if info is not None else None for info in traj.info]
+    if traj.d.size and all(e is not None for e in estimate):
+        est = np.asarray(estimate, dtype=float)
+        late = traj.t[:-1] >= lo
+        metrics["td_est_err_max"] = float(np.abs(est[late] - traj.d[late]).max()) if late.any() else None
+    extra = {
+        "duration_used": case.duration,
+        "steady_window": [lo, hi],
+        "inertia_scale_used": case.inertia_scale,
+        "disk": case.disk,
+        "initial_error_deg": case.initial_error_deg,
+        "n_vertices": None if poly is None else poly.n_vertices,
+        "limiter_in_loop": limiter is not None,
+        "notes": list(case.settings()["notes"]),
+    }
+    trace: dict[str, np.ndarray] = {}
+    if keep_trace:
+        trace = {
+            "t": traj.t,
+            "x": traj.x,
+            "u_cmd": traj.u_cmd,
+            "u_applied": traj.u_applied,
+            "d": traj.d,
+            "error_angle_deg": phi,
+        }
+        if "td_est_err_max" in metrics:
+            trace["torque_estimate"] = np.asarray(estimate, dtype=float)
+    return CaseResult(extra, metrics, trace)
+
+
+def _timing(traj: Any) -> dict[str, Any]:
+    step = np.asarray(traj.step_time, dtype=float)
+    solve = np.asarray(traj.solve_time, dtype=float)
+    solved = solve[solve > 0]
+    return {
+        "step_time_p50": float(np.percentile(step, 50)),
+        "step_time_p95": float(np.percentile(step, 95)),
+        "solve_time_p50": float(np.percentile(solve, 50)),
+        "solve_time_solves_p50": float(np.percentile(solved, 50)) if solved.size else None,
+        "solve_time_solves_p95": float(np.percentile(solved, 95)) if solved.size else None,
+        "status_counts": traj.status_counts(),
+    }
+
+
+MRP = PlantFamily(
+    name="mrp",
+    description="paper M's rigid satellite in MRPs on its orbit, with the spinning disk (M1-M3)",
+    fields=FIELDS,
+    controllers={
+        name: ControllerSpec(build, defaults.CONTROLLER_DEFAULTS[name], name in CONSTRAINED)
+        for name, build in CONTROLLERS.items()
+    },
+    simulate=simulate_case,
+    check=_check,
+    label=_label,
+    setting_choices=defaults.SETTING_CHOICES,
+    zero_allowed=frozenset({"adaptation_gain"}),
+    settings_check=settings_check,
+)

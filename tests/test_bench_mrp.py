@@ -1,0 +1,84 @@
+"""The mrp family of the harness and ``rmpc bench mrp`` (issue 14, parts 3 and 4)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from benchmarks.cli import main
+from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.sweep import expand, load_sweep
+from benchmarks.suites.mrp import mrp_cases
+from toolkit_common.errors import ConfigError
+
+
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"scenario": "M4"}, "scenario"),
+        ({"plant_step": 0.1, "dt": 0.05}, "plant_step"),
+        ({"controller": "BS", "saturation": "constraint"}, "saturation"),
+        ({"spread": 1.0}, "spread"),
+        ({"u_max": 0.0}, "u_max"),
+        ({"fault_kind": "stuck"}, "fault_kind"),  # a wheel-family field
+    ],
+)
+def test_bad_mrp_fields_name_the_field(data, field):
+    with pytest.raises(ConfigError, match=field):
+        Scenario.from_dict({"family": "mrp", "controller": "RMPC", **data})
+
+
+def test_suite_cases_use_one_period_and_the_m3_limits():
+    cases = mrp_cases()
+    assert len(cases) == 20
+    assert {c.scenario.dt for c in cases} == {0.05}
+    m3 = [c.scenario for c in cases if c.experiment == "M3"]
+    assert {(s.controller, s.saturation) for s in m3} >= {("RMPC", "constraint"), ("MAB", "limiter")}
+    assert {s.inertia_scale for s in m3} == {1.3, 0.7}
+
+
+def test_rmpc_on_the_mrp_plant_covers_the_initial_error_and_keeps_its_bound():
+    sc = Scenario.from_dict(
+        {"family": "mrp", "controller": "RMPC", "scenario": "M3", "saturation": "constraint",
+         "duration": 3.0, "dt": 0.05}
+    )
+    rec = run_scenario(sc)
+    m = rec["metrics"]
+    assert rec["plant"] == "mrp"
+    assert rec["settings"]["n_vertices"] == 18  # 2 inertia corners x 9 kinematics matrices
+    assert m["max_abs_u"] <= 1.0 + 1e-6
+    assert m["status_counts"].get("optimal", 0) == 60
+    assert m["err_angle_final_deg"] < m["err_angle_initial_deg"]
+
+
+def test_mab_reports_its_disturbance_estimate_error():
+    rec = run_scenario(Scenario.from_dict({"family": "mrp", "controller": "MAB", "scenario": "M2",
+                                           "duration": 4.0, "dt": 0.05}))
+    assert rec["metrics"]["td_est_err_max"] is not None
+    assert rec["metrics"]["td_est_err_max"] < 0.05  # the disk's torque is about 0.06 N m at most
+
+
+def test_shipped_gain_sweep_expands():
+    cases = expand(load_sweep("mrp_gains"))
+    assert len(cases) == 19
+    bandwidths = {c.settings["observer_bandwidth"] for c in cases if c.controller == "MAB"}
+    assert bandwidths == {5.0, 10.0, 20.0, 40.0}
+
+
+def test_bench_mrp_short_writes_every_file(tmp_path, capsys):
+    out = tmp_path / "mrp"
+    status = main(["bench", "mrp", "--out", str(out), "--short", "--workers", "0", "--experiments", "M1",
+                   "--no-progress"])
+    stdout = capsys.readouterr().out
+    assert status == 0, stdout
+    assert "5 cases done, 0 failed" in stdout
+    records = json.loads((out / "results.json").read_text())
+    assert {r["controller"] for r in records} == {"BS", "MAB", "TFAB", "RMPC", "CRMPC"}
+    for rec in records:
+        for key in ("final_abs_err", "max_abs_u", "solve_time_p50", "err_angle_ss_max_deg"):
+            assert key in rec["metrics"], key
+    md = (out / "results.md").read_text()
+    for section in ("## M1", "## Paper M's reported results", "## Settings", "(a) paper M's disk"):
+        assert section in md
+    assert (out / "figures" / "M1.png").stat().st_size > 0
