@@ -644,8 +644,7 @@ class FlexibleSatellite:
         >>> import numpy as np
         >>> from models import FlexibleSatellite
         >>> g = FlexibleSatellite.di_gennaro().single_axis_tf(axis=0)
-        >>> sat = FlexibleSatellite.di_gennaro()
-        >>> round(abs(g(1e-4j)) * 350.0 * 1e-8, 6)   # J_aa s^2 G(s) -> 1 as s -> 0
+        >>> round(float(abs(g(1e-4j))) * 350.0 * 1e-8, 6)   # J_aa s^2 G(s) -> 1 as s -> 0
         1.0
         """
         if isinstance(axis, bool) or not isinstance(axis, int | np.integer) or not 0 <= axis <= 2:

@@ -92,7 +92,7 @@ def flexible_factor(
     >>> import numpy as np
     >>> from models.flexible_tf import flexible_factor
     >>> g = flexible_factor([3.0], [3.3], 0.01, 0.01)   # paper S's SISO pair
-    >>> round(abs(g(0.0)), 12), round(abs(g(1e4j)), 4)
+    >>> round(float(abs(g(0.0))), 12), round(float(abs(g(1e4j))), 4)
     (1.0, 1.21)
     """
     w_c = as_vector(np.atleast_1d(constrained), "constrained")
