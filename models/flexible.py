@@ -26,6 +26,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from models.actuators import TorqueLimiter
 from models.discretize import zoh
 from models.flexible_linear import ParameterPoint, linear_matrices
 from models.flexible_polytope import (
@@ -41,7 +42,7 @@ from models.kinematics import kinematics_matrix
 from models.polytope import PolytopicModel
 from models.quaternion import cross3, quat_error, quat_to_dcm, quat_to_euler321, unit_quaternion
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_choice, check_pd
+from toolkit_common.validation import as_matrix, as_vector, check_choice, check_pd, check_positive
 
 __all__ = [
     "DI_GENNARO_COUPLING",
@@ -71,6 +72,10 @@ DI_GENNARO_INERTIA: tuple[tuple[float, float, float], ...] = (
     (3.0, 270.0, 10.0),
     (4.0, 10.0, 190.0),
 )
+
+
+#: Stand-in for "no limit" in a :class:`TorqueLimiter` (it needs finite values).
+_NO_LIMIT = 1e300
 
 
 def _real_array(value: Any, name: str) -> np.ndarray:
@@ -237,6 +242,31 @@ class FlexibleSatellite:
             modal_mass=self._mass[:k, :k], pzt_matrix=self._gamma_a[:k],
             panel_disturbance=self._panel_disturbance,
         )
+
+    def input_limiter(self, u_max: Any = 2.0, v_max: Any = None) -> TorqueLimiter:
+        """The saturation of the input ``[u; v]``: hub torques per axis, PZT commands optional.
+
+        Paper V bounds the hub torque (**certain** that a bound exists, value lost); the
+        toolkit clips each axis to ``u_max = 2 N m`` (**assumed**) and the PZT commands to
+        ``v_max`` (default none, **assumed**). Pass the result as ``limiter=`` to
+        :func:`rmpc.simulate`, which logs the commanded and the applied inputs.
+
+        Examples
+        --------
+        >>> from models import FlexibleSatellite
+        >>> lim = FlexibleSatellite.di_gennaro().input_limiter(2.0)
+        >>> lim([3.0, -1.0, -2.5, 100.0, 0.0, 0.0, 0.0]).tolist()
+        [2.0, -1.0, -2.0, 100.0, 0.0, 0.0, 0.0]
+        """
+        hub = np.broadcast_to(np.asarray(check_positive(u_max, "u_max") if np.ndim(u_max) == 0 else
+                                         as_vector(u_max, "u_max", 3), dtype=float), (3,))
+        if v_max is None:
+            pzt = np.full(self.n_pzt, _NO_LIMIT)
+        elif np.ndim(v_max) == 0:
+            pzt = np.full(self.n_pzt, check_positive(v_max, "v_max"))
+        else:
+            pzt = as_vector(v_max, "v_max", self.n_pzt)
+        return TorqueLimiter(np.concatenate((hub, pzt)))
 
     # -- sizes and names -----------------------------------------------------------------
     @property

@@ -8,12 +8,16 @@ from rmpc.cf_backstepping import CFBackstepping
 from rmpc.command_filter import CommandFilter
 from rmpc.controller import Controller, StepInfo
 from rmpc.crmpc import CRMPC
+from rmpc.csmc import CSMC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
+from rmpc.flexible_hybrid import FlexibleHybrid
 from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
 from rmpc.mab import MAB
+from rmpc.mtsmc import MTSMC
 from rmpc.neso import NESO
 from rmpc.offline_rmpc import OfflineRMPC
+from rmpc.robust_avc import RobustAVC
 from rmpc.robust_mpc import RMPC
 from rmpc.scheduled_rmpc import ScheduledRMPC
 from rmpc.simulate import Trajectory, simulate
@@ -22,9 +26,11 @@ from rmpc.wrappers import MappedController
 
 __all__ = [
     "CRMPC",
+    "CSMC",
     "GIPC",
     "LQR",
     "MAB",
+    "MTSMC",
     "NESO",
     "RMPC",
     "AdaptiveBacksteppingFTC",
@@ -32,8 +38,10 @@ __all__ = [
     "CommandFilter",
     "ConstantDisturbance",
     "Controller",
+    "FlexibleHybrid",
     "MappedController",
     "OfflineRMPC",
+    "RobustAVC",
     "ScheduledRMPC",
     "SineDisturbance",
     "StepDisturbance",
