@@ -4,6 +4,8 @@ Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Contr
 """
 
 from rmpc.adaptive_backstepping import AdaptiveBacksteppingFTC
+from rmpc.adaptive_smc import AdaptiveSMC
+from rmpc.attitude_pd import AttitudePD
 from rmpc.cf_backstepping import CFBackstepping
 from rmpc.command_filter import CommandFilter
 from rmpc.controller import Controller, StepInfo
@@ -11,6 +13,7 @@ from rmpc.crmpc import CRMPC
 from rmpc.csmc import CSMC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
 from rmpc.flexible_hybrid import FlexibleHybrid
+from rmpc.flexible_lqr import flexible_lqr
 from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
 from rmpc.mab import MAB
@@ -34,6 +37,8 @@ __all__ = [
     "NESO",
     "RMPC",
     "AdaptiveBacksteppingFTC",
+    "AdaptiveSMC",
+    "AttitudePD",
     "CFBackstepping",
     "CommandFilter",
     "ConstantDisturbance",
@@ -48,5 +53,6 @@ __all__ = [
     "StepInfo",
     "Trajectory",
     "TuningFunctionAB",
+    "flexible_lqr",
     "simulate",
 ]
