@@ -13,9 +13,9 @@ from rmpc.crmpc import CRMPC
 from rmpc.csmc import CSMC
 from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
 from rmpc.flexible_hybrid import FlexibleHybrid
-from rmpc.flexible_lqr import flexible_lqr
 from rmpc.gipc import GIPC
 from rmpc.lqr import LQR
+from rmpc.lqr_flexible import flexible_lqr
 from rmpc.mab import MAB
 from rmpc.mtsmc import MTSMC
 from rmpc.neso import NESO

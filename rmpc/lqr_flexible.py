@@ -55,7 +55,7 @@ def flexible_lqr(
     Examples
     --------
     >>> from models import FlexibleSatellite
-    >>> from rmpc.flexible_lqr import flexible_lqr
+    >>> from rmpc import flexible_lqr
     >>> ctrl = flexible_lqr(FlexibleSatellite.di_gennaro())
     >>> ctrl.name, ctrl.controller.F.shape
     ('LQR', (3, 14))
