@@ -25,7 +25,20 @@ from models.quaternion import quat_from_axis_angle
 from toolkit_common.errors import ArgumentTypeError
 from toolkit_common.validation import as_vector, check_positive, check_real
 
-__all__ = ["PaperVDisturbance", "VSlewScenario", "paper_v_scenario"]
+__all__ = [
+    "F2_EPSILONS",
+    "F3_INTEGRAL_GAINS",
+    "ConstantHubTorque",
+    "PaperVDisturbance",
+    "VSlewScenario",
+    "paper_v_scenario",
+    "steady_error_scenario",
+]
+
+#: F2: the boundary-layer widths ``eps`` (rad/s) of the chattering sweep (**assumed**).
+F2_EPSILONS: tuple[float, ...] = (0.002, 0.005, 0.01, 0.02, 0.05)
+#: F3: the integral gains ``k_I`` (1/s^2) of the steady-error study (seed 4.2/7.10, **assumed**).
+F3_INTEGRAL_GAINS: tuple[float, ...] = (0.0, 0.01)
 
 
 @dataclass(frozen=True)
@@ -57,6 +70,27 @@ class PaperVDisturbance:
         """The disturbance torque at ``t`` (s)."""
         phase = self.rate * t
         return self.amplitude * np.array([np.sin(phase), np.cos(phase), np.sin(phase + np.pi / 4)])
+
+
+@dataclass(frozen=True)
+class ConstantHubTorque:
+    """A constant hub disturbance torque ``d`` (N m), one value per body axis.
+
+    Examples
+    --------
+    >>> from models.flexible_scenario import ConstantHubTorque
+    >>> ConstantHubTorque()(12.0).tolist()
+    [0.05, 0.05, 0.05]
+    """
+
+    value: Any = (0.05, 0.05, 0.05)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "value", as_vector(self.value, "value", 3))
+
+    def __call__(self, t: float) -> np.ndarray:
+        """The torque (the same at every ``t``)."""
+        return self.value.copy()
 
 
 @dataclass(frozen=True)
@@ -123,3 +157,21 @@ def paper_v_scenario(**overrides: Any) -> VSlewScenario:
     (160.0, 20.0, (15,))
     """
     return VSlewScenario(**overrides)
+
+
+def steady_error_scenario(**overrides: Any) -> VSlewScenario:
+    """F3: at the target at rest under a constant 0.05 N m per axis, 250 s (seed 7.10).
+
+    Without integral action the error settles at ``2 ||d|| / (alpha_f (W_0/eps + K_s))``
+    (0.83 deg with the MTSMC defaults); with ``k_I = 0.01`` it falls below 0.1 deg by 250 s.
+
+    Examples
+    --------
+    >>> from models.flexible_scenario import steady_error_scenario
+    >>> sc = steady_error_scenario()
+    >>> sc.angle_deg, sc.duration, sc.disturbance(0.0).tolist()
+    (0.0, 250.0, [0.05, 0.05, 0.05])
+    """
+    fields: dict[str, Any] = {"angle_deg": 0.0, "duration": 250.0, "disturbance": ConstantHubTorque()}
+    fields.update(overrides)
+    return VSlewScenario(**fields)

@@ -23,7 +23,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import FlexibleSatellite
-from models.flexible_scenario import PaperVDisturbance, paper_v_scenario
+from models.flexible_scenario import PaperVDisturbance, paper_v_scenario, steady_error_scenario
 from models.quaternion import quat_from_axis_angle, rotation_angle
 from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, simulate
 from rmpc.disturbances import ConstantDisturbance
@@ -244,6 +244,14 @@ def test_steady_error_under_constant_disturbance(sat):
     assert np.rad2deg(expected) == pytest.approx(0.83, abs=0.005)
     final = rotation_angle(traj.x[-1, :4])
     assert final == pytest.approx(expected, rel=0.2)
+
+
+def test_integral_action_removes_the_steady_error(sat):
+    """k_I = 0.01 1/s^2 (theta_I = 5 deg): below 0.1 deg at 250 s (measured 0.0013 deg)."""
+    scenario = steady_error_scenario(satellite=sat)
+    traj = simulate(MTSMC(sat, k_I=0.01), NonlinearPlant(sat, DT, method="RK4"), scenario.initial_state(),
+                    scenario.duration, disturbance=scenario.disturbance)
+    assert rotation_angle(traj.x[-1, :4]) < np.deg2rad(0.1)
 
 
 # -- bad input --------------------------------------------------------------------------------
