@@ -11,6 +11,9 @@ toolkit's, **assumed**):
   samples where the limiter changed the hub torque;
 - ``ci``: chattering index ``(1/T) sum_k ||u(k+1) - u(k)||_1`` of the applied hub torque (N m/s);
 - ``effort``: ``int ||u||_1 dt`` of the applied hub torque (N m s);
+- ``hf_power_fraction``: the share of the applied hub torque's power (mean removed, all axes)
+  at frequencies above the first modal frequency ``Lambda_1`` (seed 4.4; 0 without modes or
+  torque variation);
 - ``eta_peak`` / ``eta_residual``: per mode, the largest ``|eta_i|`` over the run / over the tail;
 - ``modal_energy_residual``: the largest modal energy ``eta'' M eta'/2 + eta' K eta/2`` over the tail;
 - ``v_peak``: largest applied PZT command;
@@ -29,7 +32,7 @@ from rmpc.simulate import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_positive
 
-__all__ = ["flexible_metrics", "settling_time"]
+__all__ = ["flexible_metrics", "power_fraction_above", "settling_time"]
 
 
 def settling_time(t: np.ndarray, error: np.ndarray, threshold: float) -> float:
@@ -48,6 +51,31 @@ def settling_time(t: np.ndarray, error: np.ndarray, threshold: float) -> float:
     if above[-1] == len(error) - 1:
         return float("inf")
     return float(np.asarray(t)[above[-1]])
+
+
+def power_fraction_above(u: np.ndarray, dt: float, frequency: float) -> float:
+    """Share of the power of ``u`` (samples along axis 0, mean removed) above ``frequency`` (rad/s).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rmpc.flexible_metrics import power_fraction_above
+    >>> t = np.arange(1000) * 0.01
+    >>> u = np.sin(0.5 * 2 * np.pi * t) + 0.1 * np.sin(5.0 * 2 * np.pi * t)   # 0.5 Hz and 5 Hz
+    >>> round(power_fraction_above(u[:, None], 0.01, 2 * np.pi * 2.0), 4)   # above 2 Hz
+    0.0099
+    """
+    arr = np.asarray(u, dtype=float)
+    if arr.ndim == 1:
+        arr = arr[:, None]
+    if arr.shape[0] < 2:
+        return 0.0
+    spectrum = np.abs(np.fft.rfft(arr - arr.mean(axis=0), axis=0)) ** 2
+    total = float(spectrum.sum())
+    if total == 0.0:
+        return 0.0
+    omega = 2.0 * np.pi * np.fft.rfftfreq(arr.shape[0], dt)
+    return float(spectrum[omega > frequency].sum()) / total
 
 
 def flexible_metrics(
@@ -111,6 +139,8 @@ def flexible_metrics(
         "eta_residual": eta[in_tail].max(axis=0) if n else np.zeros(0),
         "modal_energy_residual": max(satellite.modal_energy(x) for x in traj.x[in_tail]),
         "v_peak": float(np.abs(v).max()) if v.size else 0.0,
+        "hf_power_fraction": power_fraction_above(u, traj.dt, float(satellite.frequencies[0]))
+        if n else 0.0,
     }
     if bandwidth is not None:
         out["regime"] = satellite.regime(bandwidth)

@@ -63,6 +63,7 @@ def test_input_metrics_of_a_clipped_constant_command(sat):
     assert m["ci"] == 0.0
     assert m["effort"] == pytest.approx(3.0 * 2.0, rel=1e-12)  # (2 + 1) N m over 2 s
     assert m["v_peak"] == 0.5
+    assert m["hf_power_fraction"] == 0.0  # no torque variation
     assert "regime" not in m
 
 
