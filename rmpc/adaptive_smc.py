@@ -104,30 +104,34 @@ class AdaptiveSMC:
         self._p1 = self.p1_init
         self.last = None
 
-    def law(self, x: Any, b0: float, p1: float) -> tuple[np.ndarray, np.ndarray]:
-        """The continuous-time law, a pure function: ``(u, s)`` at ``x`` for gains ``b0, p1``."""
+    def law(self, x: Any, b0: float, p1: float, v: Any = None) -> tuple[np.ndarray, np.ndarray]:
+        """The continuous-time law, a pure function: ``(u, s)`` at ``x`` for gains ``b0, p1``.
+
+        ``v`` is this sample's PZT command (its reaction on the hub is cancelled; ``None``: 0).
+        """
         q, w, eta, eta_dot = self.terms.split(x)
         err = self.terms.error(q, w)
         s = w + self.lam * err.qv
         u_eq = self.terms.sliding_torque(
-            w, eta, eta_dot, None, s, self.lam * err.qv_dot, self.K_s, 0.0, 1.0, "tanh"
+            w, eta, eta_dot, self.terms.pzt(v), s, self.lam * err.qv_dot, self.K_s, 0.0, 1.0, "tanh"
         )
         norm = float(np.linalg.norm(s))
         gain = b0 + p1 * (1.0 + float(w @ w))
         u_ad = -(s / max(norm, self.s_b)) * gain
         return u_eq + u_ad, s
 
-    def step(self, x: Any) -> np.ndarray:
-        """Return ``[u; 0 (PZT)]`` for the measured state."""
+    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+        """Return ``[u; v]`` for the measured state (``v = pzt``, this sample's PZT command, or 0)."""
         start = time.perf_counter()
-        u, s = self.law(x, self._b0, self._p1)
+        u, s = self.law(x, self._b0, self._p1, pzt)
         _, w, _, _ = self.terms.split(x)
         norm = float(np.linalg.norm(s))
         extra = {"sigma": s, "b0": self._b0, "p1": self._p1}
         self._b0 = max(0.0, self._b0 + self.dt * self.n0 * (norm - self.e0 * self._b0))
         self._p1 = max(0.0, self._p1 + self.dt * self.n1 * (norm * (1.0 + float(w @ w)) - self.e1 * self._p1))
         self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
-        return np.concatenate((u, np.zeros(self.terms.n_pzt)))
+        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
+        return np.concatenate((u, v_out))
 
     def __repr__(self) -> str:
         return f"AdaptiveSMC(lam={self.lam:g}, s_b={self.s_b:g}, dt={self.dt:g})"

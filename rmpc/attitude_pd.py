@@ -106,8 +106,12 @@ class AttitudePD:
         u = -self.K_d @ w - self.K_p @ err.qv
         return u if d_hat is None else u - np.asarray(d_hat, dtype=float)
 
-    def step(self, x: Any) -> np.ndarray:
-        """Return ``[u; 0 (PZT)]`` for the measured state."""
+    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+        """Return ``[u; v]`` for the measured state (``v = pzt``, this sample's PZT command, or 0).
+
+        The law ignores ``v`` (PD cancels nothing); it is passed through so that
+        :class:`~rmpc.FlexibleHybrid` can pair PD with vibration control.
+        """
         start = time.perf_counter()
         _, w, _, _ = self.terms.split(x)
         d_hat = self.estimate(w) if self.disturbance_observer else None
@@ -121,7 +125,8 @@ class AttitudePD:
             self._z = self._z + self.dt * z_dot
             extra["d_hat"] = d_hat
         self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
-        return np.concatenate((u, np.zeros(self.terms.n_pzt)))
+        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
+        return np.concatenate((u, v_out))
 
     def __repr__(self) -> str:
         return f"AttitudePD(name={self.name!r}, L_o={self.L_o:g}, dt={self.dt:g})"

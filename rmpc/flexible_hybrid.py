@@ -8,6 +8,7 @@ cancels the reaction of ``Gamma_a v`` on the hub), and the plant gets ``[u; v]``
 
 from __future__ import annotations
 
+import inspect
 import time
 from typing import Any
 
@@ -26,7 +27,9 @@ class FlexibleHybrid:
     ----------
     attitude : object
         The attitude law: ``step(x, pzt=v)`` returning ``[u; v]`` (:class:`~rmpc.MTSMC`,
-        :class:`~rmpc.CSMC`).
+        :class:`~rmpc.CSMC`, :class:`~rmpc.AttitudePD`, :class:`~rmpc.AdaptiveSMC`). A law whose
+        ``step`` takes no ``pzt`` (:func:`~rmpc.flexible_lqr`) is called with ``x`` alone and
+        its PZT entries are replaced by ``v``.
     vibration : object, optional
         The vibration law: ``step(x)`` returning ``[0; v]`` (:class:`~rmpc.RobustAVC`);
         ``None`` runs the attitude law alone with ``v = 0``.
@@ -34,7 +37,8 @@ class FlexibleHybrid:
     Attributes
     ----------
     name : str
-        The record name: the attitude law's class name, ``"+AVC"`` appended with vibration control.
+        The record name: the attitude law's ``name`` (or class name), ``"+AVC"`` appended with
+        vibration control (``"MTSMC"``, ``"CSMC+AVC"``, ``"PD-DOB+AVC"``, ``"LQR+AVC"``).
 
     Examples
     --------
@@ -53,9 +57,15 @@ class FlexibleHybrid:
         if vibration is not None and not callable(getattr(vibration, "step", None)):
             expected = "None or a controller with step(x)"
             raise ArgumentTypeError("vibration", expected, type(vibration).__name__)
+        try:
+            params = inspect.signature(attitude.step).parameters
+        except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
+            params = {}
+        self._takes_pzt = "pzt" in params
         self.attitude = attitude
         self.vibration = vibration
-        self.name = type(attitude).__name__ + ("" if vibration is None else "+AVC")
+        base = getattr(attitude, "name", None) or type(attitude).__name__
+        self.name = base + ("" if vibration is None else "+AVC")
         self.last: StepInfo | None = None
 
     def reset(self) -> None:
@@ -74,7 +84,12 @@ class FlexibleHybrid:
             out = np.asarray(self.vibration.step(x), dtype=float)
             v = out[3:]
             extra.update(getattr(self.vibration.last, "extra", {}) or {})
-        u = np.asarray(self.attitude.step(x, pzt=v), dtype=float)
+        if self._takes_pzt:
+            u = np.asarray(self.attitude.step(x, pzt=v), dtype=float)
+        else:
+            u = np.array(self.attitude.step(x), dtype=float)
+            if v is not None:
+                u[3:] = v
         extra.update(getattr(self.attitude.last, "extra", {}) or {})
         statuses = [getattr(c.last, "status", "ok") for c in (self.attitude, self.vibration) if c is not None]
         status = next((s for s in statuses if s != "ok"), "ok")

@@ -16,7 +16,15 @@ import pytest
 from models import FlexibleSatellite
 from models.flexible_scenario import PaperVDisturbance
 from models.quaternion import quat_from_axis_angle, rotation_angle
-from rmpc import AdaptiveSMC, AttitudePD, ConstantDisturbance, flexible_lqr, simulate
+from rmpc import (
+    AdaptiveSMC,
+    AttitudePD,
+    ConstantDisturbance,
+    FlexibleHybrid,
+    RobustAVC,
+    flexible_lqr,
+    simulate,
+)
 from rmpc.plants import NonlinearPlant
 from toolkit_common.errors import InvalidArgumentError
 
@@ -101,3 +109,22 @@ def test_lqr_closed_loop_stable_and_matches_the_linear_prediction(sat):
 def test_baseline_bad_arguments(sat, make, name):
     with pytest.raises(InvalidArgumentError, match=name):
         make(sat)
+
+
+@pytest.mark.parametrize(
+    ("make", "name"),
+    [
+        (lambda s: AttitudePD(s, disturbance_observer=True), "PD-DOB+AVC"),
+        (lambda s: AdaptiveSMC(s), "ASMC+AVC"),
+        (lambda s: flexible_lqr(s), "LQR+AVC"),
+    ],
+)
+def test_baselines_pair_with_avc(sat, make, name):
+    """The hybrid passes AVC's command through every baseline (LQR's step takes no pzt)."""
+    ctrl = FlexibleHybrid(make(sat), RobustAVC(sat))
+    x = sat.state(quat_from_axis_angle([0.0, 1.0, 0.0], 0.1), modal=[0.01, -0.005, 0.0, 0.002],
+                  modal_rates=[0.0, 0.01, 0.0, 0.0])
+    u = ctrl.step(x)
+    avc = RobustAVC(sat)
+    np.testing.assert_array_equal(u[3:], avc.step(x)[3:])
+    assert ctrl.name == name and np.any(u[3:] != 0.0)
