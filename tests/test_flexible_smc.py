@@ -165,6 +165,17 @@ def test_adaptive_alpha_stays_in_range_and_grows_while_the_error_shrinks(sat):
     assert traj.info[-1].extra["angle"] < traj.info[0].extra["angle"]
 
 
+def test_adaptive_switching_gain_respects_its_relative_rate_bound(sat):
+    """W_s' = g_w (||sigma||_1 - e_w W_s) with |W_s'| <= rho_w W_s (paper V eqs. 13-14's bound)."""
+    ctrl = MTSMC(sat, g_w=50.0, e_w=0.01, rho_w=0.1)  # unclipped decay 0.5 W_s: the bound acts
+    traj = _run(sat, ctrl, _slew_state(sat), horizon=10.0, disturbance=_paper_v_disturbance())
+    w_s = np.array([info.extra["W_s"] for info in traj.info])
+    rates = np.diff(w_s) / DT
+    assert np.all(np.abs(rates) <= ctrl.rho_w * w_s[:-1] * (1 + 1e-12))
+    assert np.any(np.isclose(np.abs(rates), ctrl.rho_w * w_s[:-1], rtol=1e-9))
+    assert w_s[-1] < w_s[0] and np.all(w_s > 0.0)
+
+
 # -- check 8: chattering ----------------------------------------------------------------------
 def test_chattering_ordering(sat):
     """CI(sign) > 50 CI(tanh), CI(MTSMC) < CI(CSMC tanh) at equal gains, CI(tanh) falls with eps.
