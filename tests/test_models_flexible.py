@@ -48,7 +48,7 @@ def test_rigid_limit_equals_rigid_satellite(sat: FlexibleSatellite) -> None:
     x_op = np.array([0.1, -0.2, 0.3, 0.0, 0.0, 0.0])
     for rigid_like in (sat.with_modes(0), FlexibleSatellite(sat.inertia, sat.frequencies, sat.damping,
                                                            np.zeros((4, 3)))):
-        a, b = rigid_like.linearize(np.concatenate((x_op, np.zeros(rigid_like.n_states - 6))))
+        a, b = rigid_like.linearize(np.concatenate((x_op, np.zeros(rigid_like.n_linear_states - 6))))
         a_r, b_r = RigidSatellite(sat.inertia).linearize(x_op)
         np.testing.assert_allclose(a[:6, :6], a_r, atol=1e-12)
         np.testing.assert_allclose(b[:6], b_r, atol=1e-12)

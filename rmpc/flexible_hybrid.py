@@ -1,0 +1,100 @@
+"""An attitude law and a vibration law run together on a flexible satellite (paper V's hybrid).
+
+Paper V runs its attitude SMC and its PZT vibration control (AVC) at the same time; seed
+``papers-S-V-flexible.md`` section 4.5 fixes the order (**assumed**): each sample the vibration
+law computes the PZT command ``v`` first, then the attitude law its hub torque given ``v`` (it
+cancels the reaction of ``Gamma_a v`` on the hub), and the plant gets ``[u; v]``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import time
+from typing import Any
+
+import numpy as np
+
+from rmpc.controller import StepInfo
+from toolkit_common.errors import ArgumentTypeError
+
+__all__ = ["FlexibleHybrid"]
+
+
+class FlexibleHybrid:
+    """Attitude control plus (optional) PZT vibration control, one ``step(x)``.
+
+    Parameters
+    ----------
+    attitude : object
+        The attitude law: ``step(x, pzt=v)`` returning ``[u; v]`` (:class:`~rmpc.MTSMC`,
+        :class:`~rmpc.CSMC`, :class:`~rmpc.AttitudePD`, :class:`~rmpc.AdaptiveSMC`). A law whose
+        ``step`` takes no ``pzt`` (:func:`~rmpc.flexible_lqr`) is called with ``x`` alone and
+        its PZT entries are replaced by ``v``.
+    vibration : object, optional
+        The vibration law: ``step(x)`` returning ``[0; v]`` (:class:`~rmpc.RobustAVC`);
+        ``None`` runs the attitude law alone with ``v = 0``.
+
+    Attributes
+    ----------
+    name : str
+        The record name: the attitude law's ``name`` (or class name), ``"+AVC"`` appended with
+        vibration control (``"MTSMC"``, ``"CSMC+AVC"``, ``"PD-DOB+AVC"``, ``"LQR+AVC"``).
+
+    Examples
+    --------
+    >>> from models import FlexibleSatellite
+    >>> from rmpc import CSMC, FlexibleHybrid, RobustAVC
+    >>> sat = FlexibleSatellite.di_gennaro()
+    >>> ctrl = FlexibleHybrid(CSMC(sat, switch="tanh"), RobustAVC(sat))
+    >>> ctrl.name, ctrl.step(sat.state(modal=[0.01, 0, 0, 0])).shape
+    ('CSMC+AVC', (7,))
+    """
+
+    def __init__(self, attitude: Any, vibration: Any = None) -> None:
+        if not callable(getattr(attitude, "step", None)):
+            expected = "a controller with step(x, pzt=None)"
+            raise ArgumentTypeError("attitude", expected, type(attitude).__name__)
+        if vibration is not None and not callable(getattr(vibration, "step", None)):
+            expected = "None or a controller with step(x)"
+            raise ArgumentTypeError("vibration", expected, type(vibration).__name__)
+        try:
+            params = inspect.signature(attitude.step).parameters
+        except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
+            params = {}
+        self._takes_pzt = "pzt" in params
+        self.attitude = attitude
+        self.vibration = vibration
+        base = getattr(attitude, "name", None) or type(attitude).__name__
+        self.name = base + ("" if vibration is None else "+AVC")
+        self.last: StepInfo | None = None
+
+    def reset(self) -> None:
+        """Reset both laws."""
+        self.attitude.reset()
+        if self.vibration is not None:
+            self.vibration.reset()
+        self.last = None
+
+    def step(self, x: Any) -> np.ndarray:
+        """Return ``[u; v]``: ``v`` from the vibration law, then ``u`` given ``v``."""
+        start = time.perf_counter()
+        v = None
+        extra: dict[str, Any] = {}
+        if self.vibration is not None:
+            out = np.asarray(self.vibration.step(x), dtype=float)
+            v = out[3:]
+            extra.update(getattr(self.vibration.last, "extra", {}) or {})
+        if self._takes_pzt:
+            u = np.asarray(self.attitude.step(x, pzt=v), dtype=float)
+        else:
+            u = np.array(self.attitude.step(x), dtype=float)
+            if v is not None:
+                u[3:] = v
+        extra.update(getattr(self.attitude.last, "extra", {}) or {})
+        statuses = [getattr(c.last, "status", "ok") for c in (self.attitude, self.vibration) if c is not None]
+        status = next((s for s in statuses if s != "ok"), "ok")
+        self.last = StepInfo(status=status, solve_time=time.perf_counter() - start, extra=extra)
+        return u
+
+    def __repr__(self) -> str:
+        return f"FlexibleHybrid(attitude={self.attitude!r}, vibration={self.vibration!r})"
