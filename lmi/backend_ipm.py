@@ -20,6 +20,7 @@ from lmi.affine import smat_matrix, svec_indices
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.data import KothareData
 from lmi.ipm import BlockLMISolver
+from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import scale_data, state_scaling
 from lmi.status import INACCURATE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
 from toolkit_common.errors import InvalidArgumentError
@@ -127,7 +128,17 @@ class IPMKothare(ClarabelKothare):
             self._scaled_blocks.append((j, parts))
         self._warm_start = merged.pop("warm_start")
         self._fallback = merged.pop("fallback")
-        self._solver = BlockLMISolver(self._q, blocks, **merged)
+        self._solver = BlockLMISolver(self._q, blocks, factors=self._block_factors(len(blocks)),
+                                      **merged)
+
+    def _block_factors(self, count: int) -> list:
+        """The cost blocks' factored coefficients (:mod:`lmi.kothare_factors`), ``None`` for the
+        state, bound and diagonal blocks (their coefficients are used as they are)."""
+        n, m = self.data.n, self.data.m
+        o_y = 1 + self._n_q
+        o_w = o_y + self._n_y + self._n_x + self._n_z if self._n_w else None
+        cost = cost_block_factors(self.data, VariableLayout.of(n, m, 1, o_y, o_w))
+        return [None, *cost, *([None] * (count - 1 - len(cost)))]
 
     def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> None:
         n = self.data.n
