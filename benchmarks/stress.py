@@ -21,6 +21,10 @@ peak or ellipsoid input bound and a state ``x``. Two kinds:
     controller keeps the cost finite and the Kothare LMIs have no solution. Here ``A_0`` is
     the vertex-mean model itself (it is one of the vertices).
 
+:func:`run_stress` (``python -m benchmarks.stress``) solves the set with the IPM back-end (with
+and without its Clarabel fallback) and with cvxpy + Clarabel at tight tolerances, and flags any
+answer that contradicts what is known by construction.
+
 The generator is deterministic in its seed (``numpy.random.default_rng``) and imports only
 numpy and scipy, so both the tests and the benchmarks use it.
 """
@@ -226,3 +230,81 @@ def stress_set(sizes: Sequence[int] = (6, 10, 14), vertex_counts: Sequence[int] 
                 for seed in seeds:
                     constraint = "peak" if seed % 2 == 0 else "ellipsoid"
                     yield make_problem(n, m, count, kind, seed, constraint)
+
+
+# -- the benchmark ---------------------------------------------------------------------------------
+def run_stress(problems: Sequence[StressProblem], tight: float = 1e-9) -> list[dict]:
+    """Solve every problem with the IPM back-end (defaults: Clarabel fallback on), the IPM alone
+    and cvxpy + Clarabel at ``tight`` tolerances; one record per problem (statuses, times,
+    iterations, gamma's relative difference when both are optimal, and whether each answer
+    contradicts what is known by construction: ``"optimal"`` on an infeasible problem, or
+    ``"infeasible"`` on one with a witness)."""
+    import time
+    import warnings
+
+    from lmi import KothareProblem
+
+    tol = {"tol_feas": tight, "tol_gap_abs": tight, "tol_gap_rel": tight}
+    paths = (("ipm", {"backend": "ipm"}),
+             ("ipm-alone", {"backend": "ipm", "solver_options": {"fallback": False}}),
+             ("cvxpy:CLARABEL", {"backend": "cvxpy", "solver": "CLARABEL", "solver_options": tol}))
+    out = []
+    for prob in problems:
+        rec: dict = {"label": prob.label, "kind": prob.kind, "n_states": prob.n_states,
+                     "vertices": prob.n_vertices, "input_constraint": prob.input_constraint}
+        gammas = {}
+        for name, opts in paths:
+            start = time.perf_counter()
+            with warnings.catch_warnings():  # cvxpy's "may be inaccurate": the status says it
+                warnings.filterwarnings("ignore", message="Solution may be inaccurate", category=UserWarning)
+                sol = KothareProblem(**prob.kothare_kwargs(), **opts).solve(prob.x)
+            rec[name] = {"status": sol.status, "solver_status": sol.solver_status,
+                         "time_s": time.perf_counter() - start, "iterations": sol.iterations}
+            rec[name]["contradiction"] = (sol.status == "optimal" and prob.kind == "infeasible") or (
+                sol.status == "infeasible" and prob.kind == "feasible")
+            gammas[name] = sol.gamma if sol.ok else float("nan")
+        ref = gammas["cvxpy:CLARABEL"]
+        both = np.isfinite(ref * gammas["ipm"])
+        rec["rel_diff_gamma_ipm"] = float(abs(gammas["ipm"] / ref - 1.0)) if both else None
+        out.append(rec)
+    return out
+
+
+def format_stress(records: Sequence[dict]) -> str:
+    """A Markdown table: one row per problem."""
+    lines = ["| problem | ipm | ipm alone | cvxpy + Clarabel | ipm ms | ipm-alone ms | cvxpy ms "
+             "| rel diff gamma |", "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in records:
+        cells = [f"{r[p]['status']}{' (!)' if r[p]['contradiction'] else ''}"
+                 for p in ("ipm", "ipm-alone", "cvxpy:CLARABEL")]
+        times = [f"{1e3 * r[p]['time_s']:.0f}" for p in ("ipm", "ipm-alone", "cvxpy:CLARABEL")]
+        diff = "n/a" if r["rel_diff_gamma_ipm"] is None else f"{r['rel_diff_gamma_ipm']:.1e}"
+        lines.append(f"| {r['label']} | {' | '.join(cells)} | {' | '.join(times)} | {diff} |")
+    lines.append("")
+    lines.append("(!) contradicts what is known by construction.")
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m benchmarks.stress [--sizes 6 10 14] [--vertices 2 8] [--seeds 0 1 2] [--out FILE]``."""
+    import argparse
+    import json
+    import os
+
+    parser = argparse.ArgumentParser(description="the seeded stress set: IPM against cvxpy + Clarabel")
+    parser.add_argument("--sizes", nargs="+", type=int, default=[6, 10, 14])
+    parser.add_argument("--vertices", nargs="+", type=int, default=[2, 8])
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
+    parser.add_argument("--out", help="write the records as JSON to this file")
+    args = parser.parse_args(argv)
+    records = run_stress(list(stress_set(args.sizes, args.vertices, args.seeds)))
+    print(format_stress(records))
+    print(f"load average {os.getloadavg()}")
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            json.dump(records, fh, indent=2)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

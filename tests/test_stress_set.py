@@ -76,3 +76,19 @@ def test_bad_arguments_name_the_argument(kwargs, name):
     args = {"n": 4, "m": 2, "n_vertices": 2, "kind": "feasible", "seed": 0, **kwargs}
     with pytest.raises(InvalidArgumentError, match=name):
         make_problem(**args)
+
+
+def test_stress_benchmark_answers_never_contradict_the_construction():
+    """The benchmark on one feasible and one infeasible 4-state problem (~1 s): no path says
+    "optimal" on the infeasible one or "infeasible" on the feasible one, the IPM is optimal
+    on the feasible one and agrees with cvxpy + Clarabel at 1e-9 within 1e-6."""
+    from benchmarks.stress import format_stress, run_stress
+
+    records = run_stress([make_problem(4, 2, 2, "feasible", 0), make_problem(4, 2, 2, "infeasible", 0)])
+    for rec in records:
+        for path in ("ipm", "ipm-alone", "cvxpy:CLARABEL"):
+            assert not rec[path]["contradiction"], rec
+    assert records[0]["ipm"]["status"] == "optimal"
+    assert records[0]["rel_diff_gamma_ipm"] < 1e-6
+    assert records[1]["ipm"]["status"] != "optimal"
+    assert "n4-v2-infeasible-s0" in format_stress(records)
