@@ -552,7 +552,7 @@ def _check_factor(j: int, factor: Any, coef: np.ndarray | None, n: int) -> Block
     np.add.at(nmat, (var, p, q), val)
     off = p != q
     np.add.at(nmat, (var[off], q[off], p[off]), val[off])
-    rebuilt = np.einsum("ka,iab,lb->ikl", dmat, nmat, dmat)
+    rebuilt = dmat @ (nmat @ dmat.T)  # matmul: an unoptimised einsum took 5.3 s of a 7.3 s build
     err = float(np.max(np.abs(rebuilt - coef), initial=0.0))
     if err > 1e-9 * max(1.0, float(np.max(np.abs(coef), initial=0.0))):
         raise InvalidArgumentError(name, "D N_i D' equal to the block's coefficients A_i",
