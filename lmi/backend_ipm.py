@@ -96,7 +96,8 @@ class IPMKothare(ClarabelKothare):
         merged = _check_options(dict(options or {}))
         self._t = state_scaling(data) if merged.pop("state_scaling") else np.ones(data.n)
         self.original_data = data
-        super().__init__(scale_data(data, self._t) if np.any(self._t != 1.0) else data, None)
+        self._scaled = bool(np.any(self._t != 1.0))
+        super().__init__(scale_data(data, self._t) if self._scaled else data, None)
         a_dense = self._A.toarray()
         h = self._b_static
         blocks: list[tuple[np.ndarray, np.ndarray]] = []
@@ -163,10 +164,13 @@ class IPMKothare(ClarabelKothare):
         or solves it; ``solver_status`` then reads ``"ipm <word>; clarabel <word>"`` and the
         time and iterations are the sum of both.
         """
-        # the state in the scaled coordinates, normalised again (exact: the LMIs are homogeneous)
-        xs = x / self._t
-        norm = float(np.linalg.norm(xs))
-        xs, u_max, y_max = xs / norm, u_max / norm, y_max / norm
+        # the state in the scaled coordinates, normalised again (exact: the LMIs are homogeneous);
+        # unscaled, nothing is touched, so the answers are bit-identical to the unscaled solver's
+        xs, norm = x, 1.0
+        if self._scaled:
+            xs = x / self._t
+            norm = float(np.linalg.norm(xs))
+            xs, u_max, y_max = xs / norm, u_max / norm, y_max / norm
         raw = self._solve_ipm(xs, u_max, y_max)
         if raw.status == OPTIMAL or not self._fallback:
             return self._unscale(raw, norm)
@@ -180,7 +184,7 @@ class IPMKothare(ClarabelKothare):
     def _unscale(self, raw: RawResult, norm: float) -> RawResult:
         """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,
         ``gamma norm^2``."""
-        if raw.Q is None or raw.Y is None:
+        if raw.Q is None or raw.Y is None or not self._scaled:
             return raw
         t, s2 = self._t, norm**2
         return dataclasses.replace(raw, gamma=raw.gamma * s2, Q=raw.Q * np.outer(t, t) * s2,

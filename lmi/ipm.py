@@ -83,10 +83,12 @@ STALL_FACTOR = 0.5
 
 #: ``H`` is formed from the factored coefficients (:func:`lmi.ipm_kernels.scaling_and_schur_direct`)
 #: only for more variables than this, and when the operation count says it is cheaper. Below,
-#: the Schur complement is a small part of an iteration: on paper P (61 variables) both ways
-#: measured the same median per solve (3.2-3.3 ms at 2 vertices, 7.3-7.7 ms at 8), and the rows
-#: path keeps paper P's records bit-identical. On the 14-state flexible satellite (259
-#: variables, 2 vertices) the direct form took the warm median from 876 ms to 21 ms (load ~7).
+#: the Schur complement is a small part of an iteration: on paper P (61 variables with its
+#: ellipsoid input bound) both ways measured the same median per solve (3.2-3.3 ms at 2
+#: vertices, 7.3-7.7 ms at 8), and the rows path keeps paper P's records bit-identical (the
+#: direct sum rounds differently; with a peak bound paper P has 67 variables and takes the
+#: direct path). On the 14-state flexible satellite (259 variables, 2 vertices) the direct form
+#: took the warm median from 876 ms to 21 ms (load ~7).
 DIRECT_MIN_VARIABLES = 64
 
 

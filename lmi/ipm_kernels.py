@@ -174,7 +174,7 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
         k = orders[j]
         if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
             return False
-        kk = kk_out[j, :k, :k]
+        kk = np.ascontiguousarray(kk_out[j, :k, :k])  # contiguous, as computed: same rounding
         kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
         lo, hi = offsets[j], offsets[j + 1]
         size = hi - lo

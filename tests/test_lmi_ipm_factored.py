@@ -119,7 +119,7 @@ def test_a_factor_that_does_not_match_the_coefficients_is_rejected():
 def test_kothare_factors_reproduce_the_coefficients_and_the_ipm_agrees(formulation, constraint):
     """Building the IPM back-end checks every cost block's factored form against its
     coefficients; on a stress-set problem feasible by construction (10 states, 2 inputs, 3
-    vertices: 79-134 variables, so ``H`` is formed from the factors) the IPM (default
+    vertices: 76-134 variables, so ``H`` is formed from the factors) the IPM (default
     tolerances 1e-8, no fallback) then gives the ``gamma`` of Clarabel at 1e-10 within 1e-7
     relative."""
     prob = make_problem(10, 2, 3, "feasible", 0, constraint)
