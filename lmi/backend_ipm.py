@@ -20,6 +20,8 @@ from lmi.affine import smat_matrix, svec_indices
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.data import KothareData
 from lmi.ipm import BlockLMISolver
+from lmi.kothare_factors import VariableLayout, cost_block_factors
+from lmi.scaling import scale_data, state_scaling
 from lmi.status import INACCURATE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
 from toolkit_common.errors import InvalidArgumentError
 
@@ -38,7 +40,12 @@ __all__ = ["DEFAULT_IPM_OPTIONS", "IPMKothare"]
 #: ``warm_start``: start each solve from an interior iterate of the previous one (a failed warm
 #: start is retried cold, so answers never depend on it); ``max_iter`` limits a cold start,
 #: ``warm_max_iter`` a warm one. ``fallback``: a solve that does not end ``"optimal"`` is
-#: re-solved by Clarabel, which also certifies infeasibility.
+#: re-solved by Clarabel, which also certifies infeasibility. ``state_scaling``: solve in the
+#: coordinates of :func:`lmi.scaling.state_scaling` (a diagonal change of state coordinates
+#: from the nominal LQR problem; answers are mapped back, and the certificate is computed in
+#: the original coordinates). Measured on the 14-state flexible satellite (2 vertices, Ts =
+#: 0.05 s): without it every cold solve stalled ("insufficient_progress" after 18-19
+#: iterations), with it every solve converged in 19-22 iterations cold, 8-11 warm.
 DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "tol_feas": 1e-8,
     "tol_gap_abs": 1e-12,
@@ -47,6 +54,7 @@ DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "warm_start": True,
     "warm_max_iter": 25,
     "fallback": True,
+    "state_scaling": True,
 }
 _STATUS = {
     "optimal": OPTIMAL,
@@ -73,7 +81,7 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
-    for key in ("warm_start", "fallback"):
+    for key in ("warm_start", "fallback", "state_scaling"):
         if not isinstance(merged[key], bool):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
     return merged
@@ -86,7 +94,10 @@ class IPMKothare(ClarabelKothare):
 
     def __init__(self, data: KothareData, options: dict[str, Any] | None = None) -> None:
         merged = _check_options(dict(options or {}))
-        super().__init__(data, None)
+        self._t = state_scaling(data) if merged.pop("state_scaling") else np.ones(data.n)
+        self.original_data = data
+        self._scaled = bool(np.any(self._t != 1.0))
+        super().__init__(scale_data(data, self._t) if self._scaled else data, None)
         a_dense = self._A.toarray()
         h = self._b_static
         blocks: list[tuple[np.ndarray, np.ndarray]] = []
@@ -118,7 +129,17 @@ class IPMKothare(ClarabelKothare):
             self._scaled_blocks.append((j, parts))
         self._warm_start = merged.pop("warm_start")
         self._fallback = merged.pop("fallback")
-        self._solver = BlockLMISolver(self._q, blocks, **merged)
+        self._solver = BlockLMISolver(self._q, blocks, factors=self._block_factors(len(blocks)),
+                                      **merged)
+
+    def _block_factors(self, count: int) -> list:
+        """The cost blocks' factored coefficients (:mod:`lmi.kothare_factors`), ``None`` for the
+        state, bound and diagonal blocks (their coefficients are used as they are)."""
+        n, m = self.data.n, self.data.m
+        o_y = 1 + self._n_q
+        o_w = o_y + self._n_y + self._n_x + self._n_z if self._n_w else None
+        cost = cost_block_factors(self.data, VariableLayout.of(n, m, 1, o_y, o_w))
+        return [None, *cost, *([None] * (count - 1 - len(cost)))]
 
     def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> None:
         n = self.data.n
@@ -143,15 +164,31 @@ class IPMKothare(ClarabelKothare):
         or solves it; ``solver_status`` then reads ``"ipm <word>; clarabel <word>"`` and the
         time and iterations are the sum of both.
         """
-        raw = self._solve_ipm(x, u_max, y_max)
+        # the state in the scaled coordinates, normalised again (exact: the LMIs are homogeneous);
+        # unscaled, nothing is touched, so the answers are bit-identical to the unscaled solver's
+        xs, norm = x, 1.0
+        if self._scaled:
+            xs = x / self._t
+            norm = float(np.linalg.norm(xs))
+            xs, u_max, y_max = xs / norm, u_max / norm, y_max / norm
+        raw = self._solve_ipm(xs, u_max, y_max)
         if raw.status == OPTIMAL or not self._fallback:
-            return raw
-        backup = super().solve(x, u_max, y_max)
+            return self._unscale(raw, norm)
+        backup = super().solve(xs, u_max, y_max)
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
-        return dataclasses.replace(
+        return self._unscale(dataclasses.replace(
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
             iterations=iterations, solve_time=raw.solve_time + backup.solve_time,
-        )
+        ), norm)
+
+    def _unscale(self, raw: RawResult, norm: float) -> RawResult:
+        """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,
+        ``gamma norm^2``."""
+        if raw.Q is None or raw.Y is None or not self._scaled:
+            return raw
+        t, s2 = self._t, norm**2
+        return dataclasses.replace(raw, gamma=raw.gamma * s2, Q=raw.Q * np.outer(t, t) * s2,
+                                   Y=raw.Y * t[None, :] * s2)
 
     def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         start = time.perf_counter()

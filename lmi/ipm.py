@@ -24,6 +24,14 @@ Variables are equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is facto
 becomes ill-conditioned near the optimum, then through a QR factorisation of ``P`` (which does
 not square the condition number); each Newton solve is iteratively refined on the exact
 equations. Successive solves can be warm-started from an interior iterate of the previous one.
+
+Larger problems (``factors``): forming ``P`` costs ``size x n`` per block and ``P'P``
+``size x n^2``, which grows as ``n_states^6`` for the Kothare blocks. When a block's
+coefficients are given in factored form ``A_ij = D_j N_ij D_j'`` (a dictionary ``D_j`` shared by
+all variables, sparse ``N_ij``; :mod:`lmi.kothare_factors`), ``H`` is formed directly as a sum
+over pairs of entries (:func:`lmi.ipm_kernels.scaling_and_schur_direct`) and ``P`` is never
+formed; the Newton products with ``P`` use the sparse coefficients. The QR phase still forms
+``P``. See :data:`DIRECT_MIN_VARIABLES` for when this is used.
 """
 
 from __future__ import annotations
@@ -43,7 +51,14 @@ from lmi import ipm_kernels as _kernels
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["REDUCED_TOL", "STALL_WINDOW", "BlockLMISolver", "IPMResult"]
+__all__ = [
+    "DIRECT_MIN_VARIABLES", "REDUCED_TOL", "STALL_WINDOW", "BlockFactor", "BlockLMISolver", "IPMResult",
+]
+
+#: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
+#: dictionary ``D`` (``k x d``) and the entries ``N_ij[p, q] = N_ij[q, p] = value`` (``i = var``,
+#: ``p <= q``; entries that repeat a position add up).
+BlockFactor = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 _LOG = logging.getLogger(__name__)
 
@@ -65,6 +80,16 @@ QR_SWITCH = 1e-6
 #: none of the 18 optimal ones; a window of 10 lost one (it converged at iteration 28).
 STALL_WINDOW = 15
 STALL_FACTOR = 0.5
+
+#: ``H`` is formed from the factored coefficients (:func:`lmi.ipm_kernels.scaling_and_schur_direct`)
+#: only for more variables than this, and when the operation count says it is cheaper. Below,
+#: the Schur complement is a small part of an iteration: on paper P (61 variables with its
+#: ellipsoid input bound) both ways measured the same median per solve (3.2-3.3 ms at 2
+#: vertices, 7.3-7.7 ms at 8), and the rows path keeps paper P's records bit-identical (the
+#: direct sum rounds differently; with a peak bound paper P has 67 variables and takes the
+#: direct path). On the 14-state flexible satellite (259 variables, 2 vertices) the direct form
+#: took the warm median from 876 ms to 21 ms (load ~7).
+DIRECT_MIN_VARIABLES = 64
 
 
 @dataclass
@@ -146,6 +171,7 @@ class BlockLMISolver:
         warm_max_iter: int = 25,
         warm_gap: float = 1e-2,
         warm_feas: float = 1e-3,
+        factors: Sequence[BlockFactor | None] | None = None,
     ) -> None:
         self.c = as_vector(c, "c")
         n = self.n = self.c.shape[0]
@@ -177,20 +203,41 @@ class BlockLMISolver:
         self._g_mat = np.zeros((lay.size, n))  # packed scaled coefficients
         self._sparse: tuple[np.ndarray, ...] = ()  # non-zero scaled coefficients (kernels' sp_*)
         self._sparse_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
+        # factored coefficients A_ij = D_j N_ij D_j' (kernels' dict_*, fe_*; see
+        # scaling_and_schur_direct); None: D_j = I and N_ij = A_ij
+        if factors is not None and len(factors) != len(checked):
+            raise InvalidArgumentError("factors", f"one entry (or None) per block, {len(checked)}",
+                                       f"{len(factors)} entries")
+        self._factor_raw: list[BlockFactor | None] = [None] * len(checked)
+        self._fact_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
+        self._fact: tuple[np.ndarray, ...] = ()
+        self._direct = False
         for j, (const, coef) in enumerate(checked):
             self._set_checked(j, const, coef)
+            if factors is not None and factors[j] is not None:
+                self._factor_raw[j] = _check_factor(j, factors[j], coef, n)
         _load_kernels()
 
     def reset_warm_start(self) -> None:
         """Forget the stored warm-start point (the next warm solve starts cold)."""
         self._warm = None
 
-    def set_block(self, j: int, const: np.ndarray, coef: np.ndarray | None = None) -> None:
-        """Replace block ``j``'s constant (and coefficients, if given)."""
+    def set_block(self, j: int, const: np.ndarray, coef: np.ndarray | None = None,
+                  factor: BlockFactor | None = None) -> None:
+        """Replace block ``j``'s constant (and coefficients, if given, with their factored form
+        ``factor`` or none)."""
         if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < len(self.block_orders)):
             raise InvalidArgumentError("j", f"a block index in [0, {len(self.block_orders)})", repr(j))
+        if factor is not None and coef is None:
+            raise InvalidArgumentError("factor", "None unless coef is given", "a factor without coef")
         const_c, coef_c = _check_block(int(j), const, coef, self.n, self.block_orders[j])
+        checked_factor = None if factor is None else _check_factor(int(j), factor, coef_c, self.n)
         self._set_checked(int(j), const_c, coef_c)
+        if coef_c is not None:
+            if (checked_factor is None) != (self._factor_raw[int(j)] is None) or checked_factor is not None:
+                self._dirty.add(int(j))
+                self._fact_parts[int(j)] = ()
+            self._factor_raw[int(j)] = checked_factor
 
     def _set_checked(self, j: int, const: np.ndarray, coef: np.ndarray | None) -> None:
         rows = self._layout.rows(j)
@@ -218,18 +265,52 @@ class BlockLMISolver:
             self._g_mat[self._layout.rows(j)] = (upper * w).T
             pattern = upper != 0.0
             old = self._sparse_parts[j]
-            if old and np.array_equal(pattern, old[0]):  # same non-zeros (e.g. a bound scaling)
+            if (old and np.array_equal(pattern, old[0]) and self._fact_parts[j]
+                    and self._factor_raw[j] is None):  # same non-zeros (e.g. a bound scaling)
                 lo, hi = self._sparse[0][j], self._sparse[0][j + 1]
                 self._sparse[3][lo:hi] = upper[pattern]
+                flo, fhi = self._fact[2][j], self._fact[2][j + 1]
+                self._fact[6][flo:fhi] = upper[pattern] * _entry_weight(old[4][old[2]], old[5][old[2]])
                 continue
             var, entry = np.nonzero(pattern)  # ordered (variable, entry), as upper[pattern]
             pair_entries, pair_of = np.unique(entry, return_inverse=True)
             self._sparse_parts[j] = (pattern, var, pair_of, upper[pattern], iu0[pair_entries],
                                      iu1[pair_entries])
+            self._fact_parts[j] = self._factored_part(j)
             rebuild = True
         self._dirty.clear()
         if rebuild:
             self._sparse = _concatenate_sparse(self._sparse_parts)
+            self._fact = _concatenate_factors(self._fact_parts, self._kmax)
+            self._direct = self._direct_is_cheaper()
+
+    def _factored_part(self, j: int) -> tuple[np.ndarray, ...]:
+        """``(D, var, p, q, value)`` of block ``j`` with the variable scaling and the weights of
+        :func:`lmi.ipm_kernels.scaling_and_schur_direct`, sorted by variable."""
+        raw = self._factor_raw[j]
+        if raw is None:  # D = I: the sparse upper-triangle entries
+            _, var, pair_of, val, prow, pcol = self._sparse_parts[j]
+            p, q = prow[pair_of], pcol[pair_of]
+            dmat = np.eye(self.block_orders[j])
+        else:
+            dmat, var, p, q, val = raw
+            val = val * self._dscale[var]
+            order = np.argsort(var, kind="stable")
+            var, p, q, val = var[order], p[order], q[order], val[order]
+        return dmat, var, p, q, val * _entry_weight(p, q)
+
+    def _direct_is_cheaper(self) -> bool:
+        """Whether forming ``H`` from the factored coefficients costs fewer operations than
+        forming ``P`` and ``P'P``."""
+        n = self.n
+        direct, rows = 0.0, 0.0
+        for j, k in enumerate(self.block_orders):
+            dmat, var = self._fact_parts[j][0], self._fact_parts[j][1]
+            d = dmat.shape[1]
+            size = k * (k + 1) // 2
+            direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
+            rows += self._sparse_parts[j][1].shape[0] * size + size * n * n
+        return n > DIRECT_MIN_VARIABLES and direct < rows
 
     # -- the solve -----------------------------------------------------------------------
     def solve(self, warm_start: bool = False) -> IPMResult:
@@ -286,6 +367,10 @@ class BlockLMISolver:
         kk = np.zeros((len(orders), kmax, kmax))
         lam = np.zeros((len(orders), kmax))
         pt_mat = np.zeros((n, lay.size))  # P', P = the scaled coefficients, packed
+        no_pt = np.zeros((n, 0))  # P not formed: the kernels use the sparse coefficients
+        h_mat = np.zeros((n, n))
+        sp = self._sparse
+        sp_args = (sp[0], sp[1], sp[2], sp[3], sp[5], sp[6])
         s_chol = np.zeros_like(s)
         status = "max_iterations"
         pres = dres = gap = np.inf
@@ -322,19 +407,29 @@ class BlockLMISolver:
                 warm_next = (x * dscale, s, z)
             if it == max_iter:
                 break
-            if not _kernels.scaling_and_schur_rows(s_chol, z, *packing, *self._sparse, kk, lam,
-                                                   pt_mat):
-                status = "numerical_error"
-                break
-            try:
-                r_fac, use_qr = _factor(pt_mat, use_qr)
-            except (np.linalg.LinAlgError, ValueError):
-                status = "numerical_error"
-                break
+            pt_use = pt_mat
+            if self._direct and not use_qr:  # H from the factored coefficients, P not formed
+                if not _kernels.scaling_and_schur_direct(s_chol, z, orders, *self._fact, kk, lam,
+                                                         h_mat):
+                    status = "numerical_error"
+                    break
+                r_fac, use_qr = _cholesky(h_mat)
+                pt_use = no_pt
+            if not self._direct or use_qr:
+                if not _kernels.scaling_and_schur_rows(s_chol, z, *packing, *self._sparse, kk, lam,
+                                                       pt_mat):
+                    status = "numerical_error"
+                    break
+                try:
+                    r_fac, use_qr = _factor(pt_mat, use_qr)
+                except (np.linalg.LinAlgError, ValueError):
+                    status = "numerical_error"
+                    break
+                pt_use = pt_mat
             s_new, z_new, chol_new = np.zeros_like(s), np.zeros_like(z), np.zeros_like(s)
             code, x_new, theta, a_aff, sigma, alpha = _kernels.newton_step(
-                pt_mat, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
-                max(c_norm, n_gtz), *packing, s_new, z_new, chol_new)
+                pt_use, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
+                max(c_norm, n_gtz), *packing, *sp_args, s_new, z_new, chol_new)
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
             if code != 0:
@@ -411,6 +506,62 @@ def _load_kernels() -> None:
     BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
 
 
+def _entry_weight(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``sqrt(2) h`` with ``h = 1`` off the diagonal (``p != q``) and ``1/2`` on it."""
+    return np.where(p == q, 0.5, 1.0) * np.sqrt(2.0)
+
+
+def _concatenate_factors(parts: list[tuple[np.ndarray, ...]], kmax: int) -> tuple[np.ndarray, ...]:
+    """The kernels' ``dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q, fe_val``."""
+    dims = np.array([part[0].shape[1] for part in parts], dtype=np.int64)
+    dict_mat = np.zeros((len(parts), kmax, int(dims.max())))
+    for j, part in enumerate(parts):
+        dict_mat[j, : part[0].shape[0], : dims[j]] = part[0]
+    offsets = np.cumsum([0, *(part[1].shape[0] for part in parts)]).astype(np.int64)
+    return (
+        dict_mat, dims, offsets,
+        np.concatenate([part[1] for part in parts]).astype(np.int64),
+        np.concatenate([part[2] for part in parts]).astype(np.int64),
+        np.concatenate([part[3] for part in parts]).astype(np.int64),
+        np.concatenate([part[4] for part in parts]).astype(float),
+    )
+
+
+def _check_factor(j: int, factor: Any, coef: np.ndarray | None, n: int) -> BlockFactor:
+    """Validate a factored form ``(D, var, p, q, value)`` of block ``j``'s coefficients: it must
+    reproduce them (``A_ij = D N_ij D'``) to 1e-9 relative."""
+    name = f"factors[{j}]"
+    if coef is None:
+        raise InvalidArgumentError(name, "a factor only for a block given with coefficients", "no A")
+    try:
+        dmat, var, p, q, val = factor
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(name, "a tuple (D, var, p, q, value)", repr(type(factor))) from None
+    dmat = np.asarray(dmat, dtype=float)
+    k = coef.shape[1]
+    if dmat.ndim != 2 or dmat.shape[0] != k or dmat.shape[1] == 0 or not np.all(np.isfinite(dmat)):
+        raise InvalidArgumentError(f"{name} D", f"a finite ({k}, d) matrix", f"shape {dmat.shape}")
+    d = dmat.shape[1]
+    var, p, q = (np.asarray(a, dtype=np.int64).ravel() for a in (var, p, q))
+    val = np.asarray(val, dtype=float).ravel()
+    if not (var.shape == p.shape == q.shape == val.shape):
+        raise InvalidArgumentError(f"{name} entries", "var, p, q and value of equal length",
+                                   f"lengths {var.size}, {p.size}, {q.size}, {val.size}")
+    if np.any((var < 0) | (var >= n)) or np.any((p < 0) | (p > q) | (q >= d)) or not np.all(np.isfinite(val)):
+        raise InvalidArgumentError(f"{name} entries", f"0 <= var < {n}, 0 <= p <= q < {d}, finite values",
+                                   "an entry out of range")
+    nmat = np.zeros((n, d, d))
+    np.add.at(nmat, (var, p, q), val)
+    off = p != q
+    np.add.at(nmat, (var[off], q[off], p[off]), val[off])
+    rebuilt = dmat @ (nmat @ dmat.T)  # matmul: an unoptimised einsum took 5.3 s of a 7.3 s build
+    err = float(np.max(np.abs(rebuilt - coef), initial=0.0))
+    if err > 1e-9 * max(1.0, float(np.max(np.abs(coef), initial=0.0))):
+        raise InvalidArgumentError(name, "D N_i D' equal to the block's coefficients A_i",
+                                   f"a largest difference of {err:.1e}")
+    return dmat, var, p, q, val
+
+
 def _concatenate_sparse(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
     """The kernels' ``sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col`` from the
     per-block ``(pattern, var, pair, value, pair_row, pair_col)``."""
@@ -452,6 +603,17 @@ def _check_block(
         if asym > 1e-12 * max(1.0, float(np.max(np.abs(arr), initial=0.0))):
             raise InvalidArgumentError(f"{name} {label}", "symmetric matrices", f"asymmetry {asym:.1e}")
     return c_mat, a_mat
+
+
+def _cholesky(hmat: np.ndarray) -> tuple[np.ndarray | None, bool]:
+    """Upper Cholesky factor of ``H`` and ``False``, or ``(None, True)`` when a pivot relative to
+    ``sqrt(H_jj)`` falls below :data:`QR_SWITCH` or Cholesky fails (then ``P`` is formed and
+    factored by QR, see :func:`_factor`)."""
+    r_fac, info = dpotrf(hmat, lower=0, clean=1)
+    rel = np.abs(np.diag(r_fac)) / np.sqrt(np.maximum(np.diag(hmat), 1e-300))
+    if info != 0 or not np.all(np.isfinite(r_fac)) or float(np.min(rel)) < QR_SWITCH:
+        return None, True
+    return np.ascontiguousarray(r_fac), False
 
 
 def _factor(pt_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:

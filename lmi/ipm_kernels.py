@@ -32,8 +32,8 @@ import numpy as np
 from numba import njit
 
 __all__ = [
-    "cholesky_blocks", "newton_step", "pack", "residuals", "scaling_and_schur_rows",
-    "smallest_eigenvalue", "unpack",
+    "cholesky_blocks", "newton_step", "pack", "residuals", "scaling_and_schur_direct",
+    "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
 ]
 
 #: At most this many steps of iterative refinement per Newton solve (each stops early once
@@ -131,6 +131,26 @@ def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, en
 
 
 @njit(**_JIT)
+def _nt_block(s_chol, z, j, k, kk_out, lam_out):
+    """NT scaling of block ``j`` (see :func:`scaling_and_schur_rows`) into ``kk_out[j]`` and
+    ``lam_out[j]``; ``False`` if the block lost positive definiteness."""
+    ell = np.ascontiguousarray(s_chol[j, :k, :k])
+    zj = np.ascontiguousarray(z[j, :k, :k])
+    m = ell.T @ (zj @ ell)
+    m = 0.5 * (m + m.T)
+    if not np.all(np.isfinite(m)):
+        return False
+    d, qv = np.linalg.eigh(m)
+    if not d[0] > 0.0:
+        return False
+    lam = np.sqrt(d)
+    rr = (ell @ qv) / np.sqrt(lam)  # columns scaled
+    kk_out[j, :k, :k] = (rr.T @ zj) / lam.reshape(k, 1)  # rows scaled
+    lam_out[j, :k] = lam
+    return True
+
+
+@njit(**_JIT)
 def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
                            sp_pair, sp_val, pair_off, pair_row, pair_col, kk_out, lam_out, pt_out):
     """Nesterov-Todd scaling of every block and the Schur complement factor ``P'`` (``pt_out``).
@@ -152,20 +172,9 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
     n = pt_out.shape[0]
     for j in range(orders.shape[0]):
         k = orders[j]
-        ell = np.ascontiguousarray(s_chol[j, :k, :k])
-        zj = np.ascontiguousarray(z[j, :k, :k])
-        m = ell.T @ (zj @ ell)
-        m = 0.5 * (m + m.T)
-        if not np.all(np.isfinite(m)):
+        if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
             return False
-        d, qv = np.linalg.eigh(m)
-        if not d[0] > 0.0:
-            return False
-        lam = np.sqrt(d)
-        rr = (ell @ qv) / np.sqrt(lam)  # columns scaled
-        kk = (rr.T @ zj) / lam.reshape(k, 1)  # rows scaled
-        kk_out[j, :k, :k] = kk
-        lam_out[j, :k] = lam
+        kk = np.ascontiguousarray(kk_out[j, :k, :k])  # contiguous, as computed: same rounding
         kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
         lo, hi = offsets[j], offsets[j + 1]
         size = hi - lo
@@ -193,6 +202,103 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
 
 
 @njit(**_JIT)
+def scaling_and_schur_direct(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q,
+                             fe_val, kk_out, lam_out, h_out):
+    """NT scaling of every block (as :func:`scaling_and_schur_rows`) and the Schur complement
+    ``H = P'P`` itself (``h_out``, ``n x n``), formed without ``P``.
+
+    Block ``j``'s coefficients are given in factored form ``A_ij = D_j N_ij D_j'`` with a
+    dictionary ``D_j`` (``dict_mat[j, :k, :d]``, ``d = dict_dims[j]``) shared by every variable
+    and sparse symmetric ``N_ij``: entry ``e`` (``fe_off[j]:fe_off[j + 1]``, sorted by variable)
+    adds ``N_ij[p, q] = N_ij[q, p] = v`` (``p = fe_p[e] <= q = fe_q[e]``, ``i = fe_var[e]``),
+    stored as ``fe_val[e] = v sqrt(2) h`` with ``h = 1`` (``p < q``) or ``1/2`` (``p = q``).
+    With ``G = (K D)'(K D)``, ``H_ik = sum_j tr(A_ij W^-1 A_kj W^-1)`` (``W^-1 = K'K``) is a sum
+    over pairs of entries of ``fe_val fe_val' (G_pr G_qs + G_ps G_qr)``: the cost is the square
+    of the number of entries, not ``rows x n^2``. With ``D = I`` this is the sparse formula of
+    SDPA (Fujisawa, Kojima, Nakata 1997); with the Kothare blocks' dictionaries
+    (:mod:`lmi.kothare_factors`) a vertex block of order ``2n`` has about ``5 n^2 / 2`` entries.
+    Returns ``False`` if a block lost positive definiteness.
+    """
+    n = h_out.shape[0]
+    for a in range(n):
+        for b in range(n):
+            h_out[a, b] = 0.0
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
+            return False
+        d = dict_dims[j]
+        kd = np.ascontiguousarray(kk_out[j, :k, :k]) @ np.ascontiguousarray(dict_mat[j, :k, :d])
+        g = kd.T @ kd
+        for e1 in range(fe_off[j], fe_off[j + 1]):
+            i1 = fe_var[e1]
+            p, q = fe_p[e1], fe_q[e1]
+            v1 = fe_val[e1]
+            gp = g[p]
+            gq = g[q]
+            hrow = h_out[i1]
+            # the pair (e1, e1) once, pairs (e1, e2 > e1) of the same variable twice (for
+            # (e2, e1)), pairs with a later variable once (H is mirrored below)
+            hrow[i1] += v1 * v1 * (gp[p] * gq[q] + gp[q] * gq[p])
+            for e2 in range(e1 + 1, fe_off[j + 1]):
+                r, t = fe_p[e2], fe_q[e2]
+                c = v1 * fe_val[e2] * (gp[r] * gq[t] + gp[t] * gq[r])
+                i2 = fe_var[e2]
+                if i2 == i1:
+                    c *= 2.0
+                hrow[i2] += c
+    for a in range(n):
+        for b in range(a + 1, n):
+            h_out[b, a] = h_out[a, b]
+    return True
+
+
+@njit(**_JIT)
+def _pt_times(pt, v, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+              pair_row, pair_col, n):
+    """``P' v`` for a packed ``v``: ``pt @ v`` if ``P`` is formed (``pt`` has columns), else
+    ``sum_j <A_ij, K_j' V_j K_j>`` from the sparse coefficients."""
+    if pt.shape[1] > 0:
+        return pt @ v
+    out = np.zeros(n)
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        kj = np.ascontiguousarray(kk[j, :k, :k])
+        m = kj.T @ _unpack_block(v, j, k, offsets, ent_row, ent_col, ent_w) @ kj
+        for e in range(sp_off[j], sp_off[j + 1]):
+            q = sp_pair[e]
+            a, b = pair_row[q], pair_col[q]
+            if a == b:
+                out[sp_var[e]] += sp_val[e] * m[a, a]
+            else:
+                out[sp_var[e]] += sp_val[e] * (m[a, b] + m[b, a])
+    return out
+
+
+@njit(**_JIT)
+def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+             pair_row, pair_col):
+    """``P dx`` (packed): ``pt.T @ dx`` if ``P`` is formed, else the packed
+    ``K_j (sum_i dx_i A_ij) K_j'`` from the sparse coefficients."""
+    if pt.shape[1] > 0:
+        return pt.T @ dx
+    out = np.empty(offsets[-1])
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        acc = np.zeros((k, k))
+        for e in range(sp_off[j], sp_off[j + 1]):
+            q = sp_pair[e]
+            a, b = pair_row[q], pair_col[q]
+            val = sp_val[e] * dx[sp_var[e]]
+            acc[a, b] += val
+            if a != b:
+                acc[b, a] += val
+        kj = np.ascontiguousarray(kk[j, :k, :k])
+        _pack_block(kj @ acc @ kj.T, j, offsets, ent_row, ent_col, ent_w, out)
+    return out
+
+
+@njit(**_JIT)
 def _triangular_solve(r_fac, b):
     """``x`` with ``R'R x = b`` for upper triangular ``R``."""
     n = b.shape[0]
@@ -212,23 +318,27 @@ def _triangular_solve(r_fac, b):
 
 
 @njit(**_JIT)
-def _newton(pt, r_fac, rd, rpt, u, ref_scale):
+def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col, ent_w, sp):
     """Scaled Newton step ``(dx, ds~, dz~)`` for the complementarity right-hand side ``u``.
 
     Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
-    refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks.
+    refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks. ``sp`` holds the
+    sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_row, pair_col)`` used for the
+    products with ``P`` when ``P`` is not formed (see :func:`_pt_times`).
     """
+    n = rd.shape[0]
+    lay = (orders, offsets, ent_row, ent_col, ent_w)
     v = u + rpt
-    dx = _triangular_solve(r_fac, -rd - pt @ v)
-    dzt = pt.T @ dx + v
-    err = pt @ dzt + rd
+    dx = _triangular_solve(r_fac, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
+    dzt = _p_times(pt, dx, kk, *lay, *sp) + v
+    err = _pt_times(pt, dzt, kk, *lay, *sp, n) + rd
     err_norm = np.linalg.norm(err)
     for _ in range(REFINE_STEPS):
         if err_norm <= 1e-14 * ref_scale:
             break
         ddx = _triangular_solve(r_fac, -err)
-        dzt_new = dzt + pt.T @ ddx
-        err_new = pt @ dzt_new + rd
+        dzt_new = dzt + _p_times(pt, ddx, kk, *lay, *sp)
+        err_new = _pt_times(pt, dzt_new, kk, *lay, *sp, n) + rd
         new_norm = np.linalg.norm(err_new)
         if new_norm >= err_norm:
             break
@@ -357,13 +467,18 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
 
 @njit(**_JIT)
 def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
-                orders, offsets, ent_row, ent_col, ent_w, s_out, z_out, chol_out):
+                orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_row,
+                pair_col, s_out, z_out, chol_out):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
 
     The new ``S`` is recomputed from ``x`` as ``h - G x + theta r0`` (``theta`` decays by
     ``1 - alpha``), so the primal residual decays exactly; its Cholesky factors go to
     ``chol_out`` (reused by the next scaling). If rounding leaves that ``S`` not positive
     definite, the step is shortened (at most five times by 0.8).
+
+    ``pt`` is ``P'`` (``n x size``) when it was formed (QR phase), or ``n x 0`` when only ``H``
+    was (:func:`scaling_and_schur_direct`); then the products with ``P`` come from the sparse
+    coefficients ``sp_*``, ``pair_*`` (layout of :func:`scaling_and_schur_rows`).
 
     Returns ``(code, x_new, theta_new, alpha_aff, sigma, alpha)``; ``code`` 0 on success, 1 if
     the step length is not finite or <= 1e-12, 2 if no shortened step kept ``S`` positive
@@ -384,7 +499,9 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
         k = orders[j]
         for a in range(k):
             u[_diagonal_entry(offsets, j, k, a)] = -lam[j, a]
-    _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale)
+    sp = (sp_off, sp_var, sp_pair, sp_val, pair_row, pair_col)
+    _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col,
+                            ent_w, sp)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
     sigma = (1.0 - alpha_aff) ** 3
     # corrector: u = lambda^{o-1}(sigma mu e - lambda o lambda - ds_a o dz_a)
@@ -401,7 +518,8 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
             for b in range(k):
                 rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
         _pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
-    dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale)
+    dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
+                           ent_col, ent_w, sp)
     alpha = min(1.0, 0.99 * _max_step(lam, dst, dzt, orders, offsets, ent_row, ent_col, ent_w))
     if not (np.isfinite(alpha) and alpha > 1e-12):
         return 1, x, theta, alpha_aff, sigma, alpha

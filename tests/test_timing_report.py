@@ -132,3 +132,32 @@ def test_polytopes_hold_the_nominal_plant(count):
     assert np.all(b_rates.min(axis=0) <= nominal) and np.all(nominal <= b_rates.max(axis=0))
     if count == 4:  # Ixx = Iyy scaled together
         assert np.allclose(b_rates[:, 0], b_rates[:, 1])
+
+
+def test_scale_section_quick_run(tmp_path):
+    """``--problems Scale --quick``: the 6-state rigid hub of the flexible model at 2 and 8
+    vertices, 2 states each (~5 s). Every path has a record with its state dimension; the IPM
+    ends optimal on every state and agrees with Clarabel wherever Clarabel is optimal; the
+    report has the scale table and the time-against-size figure."""
+    out = tmp_path / "scale"
+    args = _parse(["--out", str(out), "--quick", "--problems", "Scale", "--no-progress"])
+    assert args.func(args) == 0
+    records = json.loads((out / "timing.json").read_text())["records"]
+    assert {(r["backend"], r["vertices"], r["n_states"]) for r in records} == {
+        (b, v, 6) for b in ("ipm", "ipm-cold", "clarabel") for v in (2, 8)}
+    for rec in records:
+        assert rec["problem"] == "Scale"
+        assert 0 < rec["p50_s"] <= rec["p95_s"] <= rec["max_s"]
+        if rec["backend"].startswith("ipm"):
+            assert rec["status_counts"] == {"optimal": 2}
+            assert rec["max_rel_err"] is None or rec["max_rel_err"] < 1e-6
+    md = (out / "timing.md").read_text()
+    assert "## Scale" in md and "timing_scale.png" in md
+    assert (out / "timing_scale.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("argv", [["--scale-sizes", "7"], ["--scale-steps", "0"],
+                                  ["--problems", "scale", "LQR"]])
+def test_scale_options_are_checked(argv):
+    with pytest.raises(InvalidArgumentError, match=argv[0]):
+        config_from_args(_parse(["--out", "x", *argv]))

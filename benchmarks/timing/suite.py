@@ -64,6 +64,10 @@ __all__ = [
 ]
 
 PROBLEMS: tuple[str, ...] = ("RMPC", "OfflineRMPC", "GIPC")
+#: Problems a run may ask for: the default three and the scale section (:mod:`benchmarks.timing.scale`,
+#: flexible satellite with 6-20 states; opt-in with ``--problems Scale``: Clarabel alone takes seconds
+#: per solve at 14-20 states).
+OPTIONAL_PROBLEMS: tuple[str, ...] = ("Scale",)
 VERTEX_COUNTS: tuple[int, ...] = (2, 4, 8)
 SPREAD = 0.3
 TIGHT = 1e-10
@@ -100,6 +104,9 @@ class TimingConfig:
     lookup_repeats: int = 5
     quick: bool = False
     progress: bool | None = None
+    scale_steps: int = 10
+    scale_sizes: tuple[int, ...] = (6, 10, 14, 20)
+    scale_scs_steps: int = 1
 
     @property
     def cheap_steps(self) -> int:
@@ -138,17 +145,37 @@ def _vertices_option(values: Any) -> tuple[int, ...]:
 
 def _problems_option(values: Any) -> tuple[str, ...]:
     items = [values] if isinstance(values, str) else list(values or [])
+    known = PROBLEMS + OPTIONAL_PROBLEMS
     if not items:
-        raise InvalidArgumentError("--problems", f"one or more of {', '.join(PROBLEMS)}", "nothing")
-    lookup = {p.lower(): p for p in PROBLEMS}
+        raise InvalidArgumentError("--problems", f"one or more of {', '.join(known)}", "nothing")
+    lookup = {p.lower(): p for p in known}
     out: list[str] = []
     for item in items:
         name = lookup.get(str(item).lower())
         if name is None:
-            raise InvalidArgumentError("--problems", f"problems among {', '.join(PROBLEMS)}", repr(item))
+            raise InvalidArgumentError("--problems", f"problems among {', '.join(known)}", repr(item))
         if name not in out:
             out.append(name)
-    return tuple(p for p in PROBLEMS if p in out)
+    return tuple(p for p in known if p in out)
+
+
+def _sizes_option(values: Any) -> tuple[int, ...]:
+    from benchmarks.timing.scale import SCALE_SIZES
+
+    items = [values] if isinstance(values, str | int) else list(values or [])
+    out: list[int] = []
+    for item in items:
+        try:
+            size = int(item)
+        except (TypeError, ValueError):
+            size = -1
+        if size not in SCALE_SIZES or isinstance(item, bool):
+            raise InvalidArgumentError("--scale-sizes", f"state dimensions among {SCALE_SIZES}", repr(item))
+        if size not in out:
+            out.append(size)
+    if not out:
+        raise InvalidArgumentError("--scale-sizes", f"one or more of {SCALE_SIZES}", "nothing")
+    return tuple(sorted(out))
 
 
 def config_from_args(args: argparse.Namespace) -> TimingConfig:
@@ -165,6 +192,11 @@ def config_from_args(args: argparse.Namespace) -> TimingConfig:
     scs = (1 if quick else 5) if scs is None else _int_option(scs, "--scs-steps", 0)
     vertices = getattr(args, "vertices", None)
     problems = getattr(args, "problems", None)
+    scale_steps = getattr(args, "scale_steps", None)
+    scale_steps = ((2 if quick else 10) if scale_steps is None
+                   else _int_option(scale_steps, "--scale-steps", 1))
+    sizes = getattr(args, "scale_sizes", None)
+    sizes = ((6,) if quick else (6, 10, 14, 20)) if sizes is None else _sizes_option(sizes)
     return TimingConfig(
         out=Path(out),
         steps=steps,
@@ -176,6 +208,9 @@ def config_from_args(args: argparse.Namespace) -> TimingConfig:
         lookup_repeats=2 if quick else 5,
         quick=quick,
         progress=False if getattr(args, "no_progress", False) else None,
+        scale_steps=scale_steps,
+        scale_sizes=sizes,
+        scale_scs_steps=0 if quick else 1,
     )
 
 
@@ -579,7 +614,8 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
     machine = machine_info()
     machine["load_average_start"] = machine.pop("load_average")
     units = (cfg.steps * len(cfg.vertices) if "RMPC" in cfg.problems else 0) + (
-        len(cfg.vertices) if "OfflineRMPC" in cfg.problems else 0) + (1 if "GIPC" in cfg.problems else 0)
+        len(cfg.vertices) if "OfflineRMPC" in cfg.problems else 0) + (1 if "GIPC" in cfg.problems else 0) + (
+        2 * len(cfg.scale_sizes) if "Scale" in cfg.problems else 0)
     records: list[dict[str, Any]] = []
     samples: dict[str, np.ndarray] = {}
     ratios, references = [], []
@@ -605,6 +641,12 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
             records += res["records"]
             samples.update(res["samples"])
             gipc_ref = res["reference"]
+        if "Scale" in cfg.problems:
+            from benchmarks.timing.scale import time_scale
+
+            res = time_scale(cfg.scale_steps, cfg.scale_sizes, scs_steps=cfg.scale_scs_steps, progress=bar)
+            records += res["records"]
+            samples.update(res["samples"])
     end_load = machine_info()["load_average"]
     machine["load_average_end"] = end_load
     report = {
@@ -619,7 +661,8 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
             "quick": cfg.quick, "spread": SPREAD, "dt": PAPER_P_SAMPLE_TIME, "Q1": np.diag(Q1).tolist(),
             "R": np.diag(R).tolist(), "u_max": U_MAX, "input_constraint": "ellipsoid (||u||_2 <= u_max)",
             "x0": RigidSatellite.initial_state().tolist(), "n_ellipsoids": cfg.n_ellipsoids,
-            "lookup_repeats": cfg.lookup_repeats,
+            "lookup_repeats": cfg.lookup_repeats, "scale_steps": cfg.scale_steps,
+            "scale_sizes": list(cfg.scale_sizes), "scale_scs_steps": cfg.scale_scs_steps,
         },
         "wall_time_s": time.perf_counter() - start,
     }
@@ -775,6 +818,11 @@ def format_markdown(report: dict[str, Any], plot_name: str | None = "timing.png"
                 f"| {_sci(r['max_rel_err'])} | {_sci(r['max_kkt_residual'])} |"
             )
         lines.append("")
+    scale = [r for r in recs if r["problem"] == "Scale"]
+    if scale:
+        from benchmarks.timing.scale import format_scale_markdown
+
+        lines += format_scale_markdown(scale, "timing_scale.png" if plot_name else None)
     if plot_name:
         lines += ["## Distributions", "", f"![per-step time distributions]({plot_name})", ""]
     return "\n".join(lines)
@@ -791,6 +839,11 @@ def write_report(result: dict[str, Any], out: Path) -> list[Path]:
     plot_distributions(report, result["samples"], paths[2])
     paths[1].write_text(format_markdown(report, paths[2].name), encoding="utf-8")
     np.savez_compressed(paths[3], **{k: v for k, v in result["samples"].items()})
+    scale = [r for r in report["records"] if r["problem"] == "Scale"]
+    if scale:
+        from benchmarks.timing.scale import plot_scale
+
+        paths.append(plot_scale(scale, out / "timing_scale.png"))
     return paths
 
 
@@ -813,6 +866,10 @@ def run_timing_command(args: argparse.Namespace) -> int:
     for q in report["rebuild_over_fast"]:
         ratio = q["rebuild_over_fast"]
         print(f"  {q['vertices']} vertices: rebuild-per-step / fast path (p50) = {ratio:.1f}x")
+    for r in report["records"]:
+        if r["problem"] == "Scale" and r["backend"] == "ipm":
+            print(f"  scale {r['n_states']} states, {r['vertices']} vertices: ipm p50 "
+                  f"{1e3 * r['p50_s']:.1f} ms, {r['status_counts']}")
     return 0
 
 
@@ -835,7 +892,12 @@ def add_timing_parser(subparsers: Any) -> None:
     parser.add_argument("--vertices", nargs="+", default=None, metavar="V",
                         help="polytope vertex counts among 2 4 8 (default all three)")
     parser.add_argument("--problems", nargs="+", default=None, metavar="P",
-                        help="problems among RMPC OfflineRMPC GIPC (default all three)")
+                        help="problems among RMPC OfflineRMPC GIPC Scale (default the first three; Scale: "
+                        "the flexible satellite at 6-20 states, see benchmarks.timing.scale)")
+    parser.add_argument("--scale-steps", default=None, metavar="N",
+                        help="Scale: closed-loop states per size and vertex count (default 10; --quick: 2)")
+    parser.add_argument("--scale-sizes", nargs="+", default=None, metavar="n",
+                        help="Scale: state dimensions among 6 10 14 20 (default all; --quick: 6)")
     parser.add_argument("--quick", action="store_true",
                         help="a small run (3 states, 5 ellipsoids) to check the set-up; used by the tests")
     parser.add_argument("--rebuild-steps", default=None, metavar="K",
