@@ -163,3 +163,13 @@ def test_bench_flexible_short_writes_every_file(tmp_path, capsys):
     assert len(list((out / "traces").glob("F1_*.npz"))) == 4
     assert len((out / "results.csv").read_text().strip().splitlines()) == 5
     assert json.loads((out / "run.json").read_text())["done"] == 4
+
+
+def test_shipped_gain_sweep_expands():
+    from benchmarks.core.sweep import expand, load_sweep
+
+    cases = expand(load_sweep("flexible_gains"))
+    assert len(cases) == 18
+    assert {c.family for c in cases} == {"flexible"}
+    slopes = {c.settings["alpha_f"] for c in cases if c.controller == "MTSMC"}
+    assert slopes == {0.05, 0.1, 0.2}
