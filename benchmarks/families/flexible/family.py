@@ -231,12 +231,14 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     gain = _linear_gain(built.controller, traj)
     bandwidth = _bandwidth(scenario, settings, sat, gain)
     fm = flexible_metrics(traj, sat, bandwidth=bandwidth)
-    err = np.abs(sat.linear_state(traj.x[-1], attitude="euler")[:3])
-    error_deg = np.degrees([np.linalg.norm(sat.linear_state(x, attitude="euler")[:3]) for x in traj.x])
+    euler = np.abs([sat.linear_state(x, attitude="euler")[:3] for x in traj.x])  # error 3-2-1 angles
+    err = euler[-1]
+    error_deg = np.degrees(np.linalg.norm(euler, axis=1))
     n = sat.n_modes
     half = traj.t >= traj.t[-1] / 2.0
     metrics: dict[str, Any] = {
         "final_abs_err": {ax: float(err[i]) for i, ax in enumerate(("roll", "pitch", "yaw"))},
+        "sum_abs_err": {ax: float(euler[:, i].sum()) for i, ax in enumerate(("roll", "pitch", "yaw"))},
         "max_abs_u": fm["peak_u"],
         **{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in fm.items()},
         "final_error_deg": float(np.degrees(fm["final_error"])),
