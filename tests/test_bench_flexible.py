@@ -33,6 +33,7 @@ CONTRACT_KEYS = (
         ({"settings": {"polytope": "box"}}, "polytope"),
         ({"settings": {"shrink": 1.5}}, "shrink"),
         ({"scenario": "M2"}, "scenario"),  # an mrp-family field
+        ({"controller": "RMPC", "handover_deg": 20.0}, "handover_deg"),
     ],
 )
 def test_bad_flexible_fields_name_the_field(data, field):
@@ -60,9 +61,11 @@ def test_suite_cases_cover_the_four_experiments():
     gains = sorted(s.integral_gain for s in by_exp["F3"] if s.controller == "MTSMC")
     assert gains == sorted(F3_INTEGRAL_GAINS)
     assert {s.experiment for s in by_exp["F3"]} == {"steady"}
-    f4 = {s.controller: s for s in by_exp["F4"]}
+    f4 = {s.controller: s for s in by_exp["F4"] if s.handover_deg is None}
     assert set(f4) == {"MTSMC", "LQR", "OfflineRMPC", "RMPC"}
     assert {s.experiment for s in f4.values()} == {"small"}
+    (hand,) = [s for s in by_exp["F4"] if s.handover_deg is not None]
+    assert (hand.controller, hand.experiment, hand.dt) == ("OfflineRMPC", "vslew", 0.01)
     assert f4["RMPC"].saturation == f4["OfflineRMPC"].saturation == "constraint"
     with pytest.raises(ConfigError, match="--experiments"):
         flexible_cases(experiments=["F5"])
@@ -109,6 +112,25 @@ def test_offline_rmpc_keeps_its_peak_bound_on_the_small_slew():
     assert m["final_error_deg"] < 15.0
     for key in CONTRACT_KEYS:
         assert key in m, key
+
+
+def test_handover_runs_mtsmc_then_the_offline_table():
+    rec = _run(
+        controller="OfflineRMPC",
+        experiment="small",
+        angle_deg=21.0,
+        handover_deg=20.0,
+        dt=0.01,
+        duration=8.0,
+        settings={"polytope": "nominal", "n_ellipsoids": 2},
+    )
+    m, s = rec["metrics"], rec["settings"]
+    assert s["controller_name"] == "MTSMC>OfflineRMPC"
+    assert s["limiter_in_loop"] and m["max_abs_u"] <= 2.0 + 1e-12
+    assert 0.0 < s["handover_time"] < 8.0
+    steps = round(s["handover_time"] / 0.01)
+    assert m["status_counts"]["ok"] == steps  # MTSMC's steps, then the table's
+    assert s["n_ellipsoids"] == 2 and sum(m["status_counts"].values()) == 800
 
 
 def test_online_rmpc_reports_its_solves():

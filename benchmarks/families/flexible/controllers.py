@@ -16,7 +16,9 @@
   (:class:`rmpc.OfflineRMPC`, Wan & Kothare 2003, its table designed once from the initial
   state) on the 14-state linear model ``[q_v, w, eta, eta']`` of the error quaternion
   (:meth:`models.FlexibleSatellite.linear_state`), through :class:`rmpc.MappedController`; their
-  PZT commands are zero (or AVC's).
+  PZT commands are zero (or AVC's). With ``handover_deg`` set, ``OfflineRMPC`` takes over from
+  MTSMC once the rotation error first falls below that angle (:class:`HandOver`, seed 9's
+  hand-over for the large slew); its table is then designed from the state at the hand-over.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import numpy as np
 from benchmarks.core.family import BuiltController
 from toolkit_common.errors import ConfigError
 
-__all__ = ["CONSTRAINED", "CONTROLLERS", "FlexibleModel", "linear_weights", "settings_check"]
+__all__ = ["CONSTRAINED", "CONTROLLERS", "FlexibleModel", "HandOver", "linear_weights", "settings_check"]
 
 
 class FlexibleModel:
@@ -40,6 +42,64 @@ class FlexibleModel:
         self.dt = dt
         self.polytope = polytope
         self.x_design = x_design
+
+
+class HandOver:
+    """A slew law until the rotation error first falls below ``angle``, then a fine law for good.
+
+    Parameters
+    ----------
+    slew : object
+        The large-angle law, ``step(x, pzt=v)`` returning ``[u; v]`` (:class:`rmpc.MTSMC`).
+    fine : object
+        The law near the target, ``step(x)`` returning ``[u; 0]`` (the mapped robust MPC).
+    angle : float
+        The hand-over rotation error (rad).
+
+    Attributes
+    ----------
+    name : str
+        ``"<slew>><fine>"``, e.g. ``"MTSMC>OfflineRMPC"``.
+    controller : object
+        The fine law's inner controller (its table or gain, for the report).
+    handover_step : int or None
+        The step at which the fine law took over (``None``: not yet).
+    """
+
+    def __init__(self, slew: Any, fine: Any, angle: float) -> None:
+        self.slew = slew
+        self.fine = fine
+        self.angle = float(angle)
+        self.name = f"{type(slew).__name__}>{getattr(fine, 'name', type(fine).__name__)}"
+        self.controller = getattr(fine, "controller", fine)
+        self.handover_step: int | None = None
+        self._count = 0
+        self.last: Any = None
+
+    def reset(self) -> None:
+        """Reset both laws; the slew law runs again first."""
+        self.slew.reset()
+        self.fine.reset()
+        self.handover_step = None
+        self._count = 0
+        self.last = None
+
+    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+        """``[u; v]`` from the slew law, or from the fine law once the error was below ``angle``."""
+        from models.quaternion import rotation_angle
+
+        if self.handover_step is None and rotation_angle(np.asarray(x, dtype=float)[:4]) < self.angle:
+            self.handover_step = self._count
+        self._count += 1
+        if self.handover_step is None:
+            u = np.asarray(self.slew.step(x, pzt=pzt), dtype=float)
+            self.last = self.slew.last
+            return u
+        u = np.array(self.fine.step(x), dtype=float)
+        if pzt is not None:
+            u[3:] = pzt
+        self.last = self.fine.last
+        return u
 
 
 def _with_avc(law: Any, m: FlexibleModel, scenario: Any) -> Any:
@@ -139,7 +199,7 @@ def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControl
 
 
 def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from rmpc import OfflineRMPC
+    from rmpc import MTSMC, OfflineRMPC
 
     constrained = scenario.saturation == "constraint"
     Q, R = linear_weights(s, m.satellite.n_modes)
@@ -149,11 +209,21 @@ def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCont
         R,
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
-        x_design=m.x_design,
+        x_design=None if scenario.handover_deg is not None else m.x_design,
         n_ellipsoids=s["n_ellipsoids"],
         shrink=s["shrink"],
     )
-    return BuiltController(_with_avc(_mapped(ctrl, m, "OfflineRMPC"), m, scenario), _limited(scenario))
+    law = _mapped(ctrl, m, "OfflineRMPC")
+    if scenario.handover_deg is not None:
+        slew = MTSMC(m.satellite, m.dt, eps=scenario.epsilon, **_MTSMC_HANDOVER)
+        law = HandOver(slew, law, np.deg2rad(scenario.handover_deg))
+        # MTSMC has no constraint: the limiter stays in the loop (the LMIs' bound is inside it)
+        return BuiltController(_with_avc(law, m, scenario), scenario.saturation != "none")
+    return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
+
+
+#: MTSMC's settings in the hand-over (its defaults in :mod:`benchmarks.families.flexible.defaults`).
+_MTSMC_HANDOVER: Mapping[str, float] = {"alpha_f": 0.1, "tau_a": 15.0, "K_s": 20.0, "W_0": 1.0}
 
 
 #: Controller name -> factory ``(FlexibleModel, scenario, settings) -> BuiltController``.

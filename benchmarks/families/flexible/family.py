@@ -36,6 +36,11 @@ time_scale : float
     Factor on the experiment's run length (``rmpc bench flexible --short``; no measurement).
 dt : float
     Control period (s): default 0.01, 0.5 for ``RMPC`` and ``OfflineRMPC`` (their LMIs).
+handover_deg : float or None
+    ``OfflineRMPC`` only: MTSMC slews until the rotation error first falls below this angle
+    (deg), then the robust MPC takes over, its table designed from the state at the hand-over
+    (:class:`benchmarks.families.flexible.controllers.HandOver`; run it at ``dt = 0.01``).
+    The record's ``settings.controller_name`` is then ``"MTSMC>OfflineRMPC"``.
 """
 
 from __future__ import annotations
@@ -87,6 +92,9 @@ FIELDS: Mapping[str, Field] = {
     "duration": Field(None, _optional_positive),
     "time_scale": Field(1.0, lambda v, w: check_real(v, w, low=0.0, high=1.0, low_open=True)),
     "dt": Field(defaults.SMC_PERIOD, _positive),
+    "handover_deg": Field(
+        None, lambda v, w: None if v is None else check_real(v, w, low=0.0, high=180.0, low_open=True)
+    ),
 }
 
 
@@ -106,6 +114,9 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
     if values["integral_gain"] > 0.0 and controller != "MTSMC":
         expected = f"0 for {controller} (only MTSMC has the integral term)"
         raise ConfigError(name("integral_gain"), expected, repr(values["integral_gain"]))
+    if values["handover_deg"] is not None and controller != "OfflineRMPC":
+        expected = f"none for {controller} (only OfflineRMPC takes over from MTSMC)"
+        raise ConfigError(name("handover_deg"), expected, repr(values["handover_deg"]))
     if values["duration"] is not None and values["duration"] < values["dt"]:
         expected = f"at least one sample (dt = {values['dt']:g} s)"
         raise ConfigError(name("duration"), expected, repr(values["duration"]))
@@ -113,7 +124,8 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
 
 def controller_name(scenario: Any) -> str:
     """The record name of the closed loop: the controller, ``"+AVC"`` with vibration control."""
-    return scenario.controller + ("+AVC" if scenario.avc else "")
+    base = scenario.controller if scenario.handover_deg is None else "MTSMC>" + scenario.controller
+    return base + ("+AVC" if scenario.avc else "")
 
 
 def _label(scenario: Any) -> str:
@@ -124,6 +136,8 @@ def _label(scenario: Any) -> str:
         parts.append(f"eps {scenario.epsilon:g}")
     if scenario.integral_gain > 0.0:
         parts.append(f"k_I {scenario.integral_gain:g}")
+    if scenario.handover_deg is not None:
+        parts.append(f"hand-over {scenario.handover_deg:g} deg")
     return " ".join(parts)
 
 
@@ -260,8 +274,10 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "n_vertices": None if poly is None else poly.n_vertices,
         "n_ellipsoids": None if table is None else table.n_ellipsoids,
         "offline_stop_reason": None if table is None else table.stop_reason,
+        "offline_design_time_s": None if table is None else table.design_time,
         "limiter_in_loop": limiter is not None,
         "mode1_axis": "xyz"[int(np.argmax(np.abs(sat.coupling[0])))],
+        "handover_time": _handover_time(built.controller, traj),
     }
     trace: dict[str, np.ndarray] = {}
     if keep_trace:
@@ -273,6 +289,11 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
             "eta": traj.x[:, 7 : 7 + n],
         }
     return CaseResult(extra, metrics, trace)
+
+
+def _handover_time(ctrl: Any, traj: Any) -> float | None:
+    step = getattr(getattr(ctrl, "attitude", None), "handover_step", None)
+    return None if step is None else float(traj.t[step])
 
 
 def _timing(traj: Any) -> dict[str, Any]:
