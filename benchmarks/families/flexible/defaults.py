@@ -151,6 +151,12 @@ def settings_rows() -> list[tuple[str, str, str]]:
         ),
         ("RMPC", "resolve_threshold 0.5: the last solution is held while x' Q^-1 x <= 0.5", "toolkit"),
         (
+            "hand-over (F4, V-slew)",
+            "MTSMC until the rotation error < 20 deg, then OfflineRMPC at 0.01 s, its table designed from "
+            "the state at the hand-over; the 2 N m clip stays in the loop",
+            "assumed (seed 9: 'inside ~20 deg')",
+        ),
+        (
             "OfflineRMPC",
             "6 ellipsoids along the ray of the initial state, shrink 0.5, interpolation",
             "toolkit (Wan & Kothare 2003)",
