@@ -2,7 +2,8 @@
 
 - :mod:`benchmarks.families.rigid`: paper P's rigid satellite (``family = "rigid"``, the default);
 - :mod:`benchmarks.families.wheel`: paper W's four-wheel satellite with wheel faults (``"wheel"``);
-- :mod:`benchmarks.families.mrp`: paper M's MRP satellite with the spinning disk (``"mrp"``).
+- :mod:`benchmarks.families.mrp`: paper M's MRP satellite with the spinning disk (``"mrp"``);
+- :mod:`benchmarks.families.flexible`: paper V's flexible satellite with PZT patches (``"flexible"``).
 
 A new family is a sub-package with a :class:`~benchmarks.core.family.PlantFamily` object,
 registered below with :func:`~benchmarks.core.family.register_family`; a user's own family can
@@ -10,6 +11,7 @@ be registered the same way from their code, before the scenarios that name it ar
 """
 
 from benchmarks.core.family import register_family
+from benchmarks.families.flexible.family import FLEXIBLE
 from benchmarks.families.mrp.family import MRP
 from benchmarks.families.rigid.family import RIGID
 from benchmarks.families.wheel.family import WHEEL
@@ -17,5 +19,6 @@ from benchmarks.families.wheel.family import WHEEL
 register_family(RIGID)
 register_family(WHEEL)
 register_family(MRP)
+register_family(FLEXIBLE)
 
-__all__ = ["MRP", "RIGID", "WHEEL"]
+__all__ = ["FLEXIBLE", "MRP", "RIGID", "WHEEL"]

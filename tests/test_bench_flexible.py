@@ -1,0 +1,199 @@
+"""The flexible family of the harness and ``rmpc bench flexible`` (issue 15, parts 3 and 4)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from benchmarks.cli import main
+from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.families.flexible.family import eta1_frequency
+from benchmarks.suites.flexible import flexible_cases, inconsistencies
+from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
+from toolkit_common.errors import ConfigError
+
+CONTRACT_KEYS = (
+    "final_abs_err", "sum_abs_err", "max_abs_u", "solve_time_p50", "t_s", "ci", "eta_peak", "v_peak", "regime"
+)
+
+
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"experiment": "orbit"}, "experiment"),
+        ({"controller": "MTSMC", "switch": "sign"}, "switch"),
+        ({"controller": "CSMC", "integral_gain": 0.01}, "integral_gain"),
+        ({"controller": "MTSMC", "saturation": "constraint"}, "saturation"),
+        ({"u_max": 0.0}, "u_max"),
+        ({"duration": 0.1, "dt": 0.5}, "duration"),
+        ({"avc": "yes"}, "avc"),
+        ({"angle_deg": 200.0}, "angle_deg"),
+        ({"settings": {"polytope": "box"}}, "polytope"),
+        ({"settings": {"shrink": 1.5}}, "shrink"),
+        ({"scenario": "M2"}, "scenario"),  # an mrp-family field
+        ({"controller": "RMPC", "handover_deg": 20.0}, "handover_deg"),
+    ],
+)
+def test_bad_flexible_fields_name_the_field(data, field):
+    with pytest.raises(ConfigError, match=field):
+        Scenario.from_dict({"family": "flexible", "controller": "OfflineRMPC", **data})
+
+
+def test_linear_controllers_default_to_their_period_and_constraint():
+    off = Scenario.from_dict({"family": "flexible", "controller": "OfflineRMPC"})
+    smc = Scenario.from_dict({"family": "flexible", "controller": "MTSMC"})
+    assert (off.dt, off.saturation, off.plant) == (0.5, "constraint", "flexible")
+    assert (smc.dt, smc.saturation) == (0.01, "limiter")
+
+
+def test_suite_cases_cover_the_four_experiments():
+    cases = flexible_cases()
+    by_exp = {e: [c.scenario for c in cases if c.experiment == e] for e in ("F1", "F2", "F3", "F4")}
+    assert {(s.controller, s.avc) for s in by_exp["F1"]} == {
+        (c, a) for c in ("MTSMC", "CSMC") for a in (False, True)
+    }
+    for ctrl in ("MTSMC", "CSMC"):
+        eps = sorted(s.epsilon for s in by_exp["F2"] if s.controller == ctrl and s.switch == "tanh")
+        assert eps == sorted(F2_EPSILONS)
+    assert any(s.switch == "sign" for s in by_exp["F2"])
+    gains = sorted(s.integral_gain for s in by_exp["F3"] if s.controller == "MTSMC")
+    assert gains == sorted(F3_INTEGRAL_GAINS)
+    assert {s.experiment for s in by_exp["F3"]} == {"steady"}
+    f4 = {s.controller: s for s in by_exp["F4"] if s.handover_deg is None}
+    assert set(f4) == {"MTSMC", "LQR", "OfflineRMPC", "RMPC"}
+    assert {s.experiment for s in f4.values()} == {"small"}
+    (hand,) = [s for s in by_exp["F4"] if s.handover_deg is not None]
+    assert (hand.controller, hand.experiment, hand.dt) == ("OfflineRMPC", "vslew", 0.01)
+    assert f4["RMPC"].saturation == f4["OfflineRMPC"].saturation == "constraint"
+    with pytest.raises(ConfigError, match="--experiments"):
+        flexible_cases(experiments=["F5"])
+
+
+def _run(**data):
+    return run_scenario(Scenario.from_dict({"family": "flexible", **data}))
+
+
+@pytest.mark.parametrize("avc", [False, True])
+def test_mtsmc_case_has_the_contract_keys_and_avc_drives_the_pzt(avc):
+    rec = _run(controller="MTSMC", avc=avc, duration=0.5)
+    m = rec["metrics"]
+    for key in CONTRACT_KEYS:
+        assert key in m, key
+    assert set(m["final_abs_err"]) == set(m["sum_abs_err"]) == {"roll", "pitch", "yaw"}
+    assert rec["plant"] == "flexible"
+    assert rec["settings"]["controller_name"] == ("MTSMC+AVC" if avc else "MTSMC")
+    assert (m["v_peak"] > 0.0) == avc
+    assert m["status_counts"] == {"ok": 50}
+
+
+@pytest.mark.parametrize("data", [{"controller": "CSMC", "switch": "sign"}, {"controller": "PD"}])
+def test_csmc_sign_and_pd_cases_respect_the_limiter(data):
+    rec = _run(duration=0.5, **data)
+    m = rec["metrics"]
+    assert rec["settings"]["limiter_in_loop"]
+    assert 0.0 < m["max_abs_u"] <= 2.0 + 1e-12
+    assert m["regime"] in ("rigid-like", "flexible", "flexible-hard")
+
+
+def test_offline_rmpc_keeps_its_peak_bound_on_the_small_slew():
+    rec = _run(
+        controller="OfflineRMPC",
+        experiment="small",
+        duration=3.0,
+        settings={"polytope": "nominal", "n_ellipsoids": 2},
+    )
+    m, s = rec["metrics"], rec["settings"]
+    assert s["n_vertices"] == 1 and s["n_ellipsoids"] == 2
+    assert not s["limiter_in_loop"]
+    assert m["status_counts"] == {"optimal": 6}  # every step inside the table, no fallback
+    assert 0.0 < m["max_abs_u"] <= 2.0 + 1e-6  # the LMIs' peak bound, no limiter in the loop
+    assert m["final_error_deg"] < 15.0
+    for key in CONTRACT_KEYS:
+        assert key in m, key
+
+
+def test_handover_runs_mtsmc_then_the_offline_table():
+    rec = _run(
+        controller="OfflineRMPC",
+        experiment="small",
+        angle_deg=21.0,
+        handover_deg=20.0,
+        dt=0.01,
+        duration=8.0,
+        settings={"polytope": "nominal", "n_ellipsoids": 2},
+    )
+    m, s = rec["metrics"], rec["settings"]
+    assert s["controller_name"] == "MTSMC>OfflineRMPC"
+    assert s["limiter_in_loop"] and m["max_abs_u"] <= 2.0 + 1e-12
+    assert 0.0 < s["handover_time"] < 8.0
+    steps = round(s["handover_time"] / 0.01)
+    assert m["status_counts"]["ok"] == steps  # MTSMC's steps, then the table's
+    assert s["n_ellipsoids"] == 2 and sum(m["status_counts"].values()) == 800
+
+
+def test_online_rmpc_reports_its_solves():
+    rec = _run(controller="RMPC", experiment="small", duration=1.0, settings={"polytope": "nominal"})
+    m = rec["metrics"]
+    assert sum(m["status_counts"].values()) == 2
+    assert m["solve_time_p50"] > 0.0
+    assert m["max_abs_u"] <= 2.0 + 1e-6
+
+
+def test_eta1_frequency_of_a_damped_sine():
+    t = np.arange(0.0, 60.0, 0.01)
+    y = 0.01 + np.exp(-0.005 * t) * np.sin(0.7681 * t + 0.3)
+    assert eta1_frequency(t, y) == pytest.approx(0.7681, rel=2e-3)
+    assert eta1_frequency(t[:50], y[:50]) is None
+
+
+def _f2(eps_ci):
+    return [
+        {
+            "experiment": "F2",
+            "controller": "CSMC",
+            "settings": {"epsilon": e, "switch": "tanh"},
+            "metrics": {"ci": c},
+        }
+        for e, c in eps_ci
+    ]
+
+
+def test_inconsistency_lines_follow_the_numbers():
+    falling = inconsistencies(_f2([(0.01, 0.5), (0.002, 0.9), (0.05, 0.1)]))
+    rising = inconsistencies(_f2([(0.01, 0.5), (0.002, 0.4), (0.05, 0.9)]))
+    assert any("monotone here" in line for line in falling)
+    assert any("not monotone" in line for line in rising)
+    assert any("couples mainly to x" in line for line in falling)
+
+
+def test_bench_flexible_short_writes_every_file(tmp_path, capsys):
+    out = tmp_path / "flex"
+    args = ["bench", "flexible", "--out", str(out), "--short", "--workers", "0", "--experiments", "F1"]
+    status = main([*args, "--no-progress"])
+    stdout = capsys.readouterr().out
+    assert status == 0, stdout
+    assert "4 cases done, 0 failed" in stdout
+    records = json.loads((out / "results.json").read_text())
+    assert {r["settings"]["controller_name"] for r in records} == {"MTSMC", "MTSMC+AVC", "CSMC", "CSMC+AVC"}
+    for rec in records:
+        for key in CONTRACT_KEYS:
+            assert key in rec["metrics"], key
+    md = (out / "results.md").read_text()
+    for section in ("## F1", "## Paper V's reported results", "## Inconsistencies", "## Settings", "**V4**"):
+        assert section in md
+    assert (out / "figures" / "F1.png").stat().st_size > 0
+    assert len(list((out / "traces").glob("F1_*.npz"))) == 4
+    assert len((out / "results.csv").read_text().strip().splitlines()) == 5
+    assert json.loads((out / "run.json").read_text())["done"] == 4
+
+
+def test_shipped_gain_sweep_expands():
+    from benchmarks.core.sweep import expand, load_sweep
+
+    cases = expand(load_sweep("flexible_gains"))
+    assert len(cases) == 18
+    assert {c.family for c in cases} == {"flexible"}
+    slopes = {c.settings["alpha_f"] for c in cases if c.controller == "MTSMC"}
+    assert slopes == {0.05, 0.1, 0.2}
