@@ -102,46 +102,75 @@ def _report_suite(name: str, outcome: Any, out: str) -> int:
     return 1 if failed or (ex is not None and ex.unfinished) else 0
 
 
-def _cmd_bench_faults(args: argparse.Namespace) -> int:
-    from benchmarks.suites.faults import SHORT_TIME_SCALE, run_faults
+def _cmd_bench_suite(args: argparse.Namespace) -> int:
+    """``rmpc bench faults | mrp | flexible``: the suites of the later papers share one command shape."""
+    import importlib
 
-    outcome = run_faults(
+    module = importlib.import_module(f"benchmarks.suites.{args.suite_module}")
+    outcome = getattr(module, args.suite_runner)(
         args.out,
         workers=args.workers,
         scheduler=args.scheduler,
-        time_scale=SHORT_TIME_SCALE if args.short else 1.0,
+        time_scale=module.SHORT_TIME_SCALE if args.short else 1.0,
         experiments=args.experiments,
         progress=None if not args.no_progress else False,
     )
-    return _report_suite("faults", outcome, args.out)
+    return _report_suite(args.bench_command, outcome, args.out)
 
 
-def _cmd_bench_mrp(args: argparse.Namespace) -> int:
-    from benchmarks.suites.mrp import SHORT_TIME_SCALE, run_mrp
+#: The later papers' suites: command -> (module in benchmarks.suites, runner, help, what it runs,
+#: --short help, experiment names for --experiments).
+_SUITES: dict[str, tuple[str, str, str, str, str, str]] = {
+    "faults": (
+        "faults",
+        "run_faults",
+        "paper W's wheel-fault scenarios S1-S4 (W1-W4)",
+        "Run W1-W4 (paper W's S1-S4 on the four-wheel satellite: ABFTC, RMPC, CRMPC, GIPC) and write "
+        "results.json, results.md (tables, paper W's reported results next to the measured ones, its "
+        "inconsistencies, every setting chosen), results.csv, run.json, figures/W*.png and traces/*.npz "
+        "into DIR.",
+        "a smoke run (run lengths and fault windows x 0.1) to check the set-up; no measurement",
+        "W1,...",
+    ),
+    "mrp": (
+        "mrp",
+        "run_mrp",
+        "paper M's MRP satellite scenarios M1-M3",
+        "Run M1-M3 (paper M's MRP satellite with the spinning disk: BS, MAB, TFAB, RMPC, CRMPC) and write "
+        "results.json, results.md (tables, paper M's reported results next to the measured ones, its "
+        "inconsistencies, every setting chosen), results.csv, run.json, figures/M*.png and traces/*.npz "
+        "into DIR.",
+        "a smoke run (run lengths x 0.05); no measurement",
+        "M1,...",
+    ),
+    "flexible": (
+        "flexible",
+        "run_flexible",
+        "paper V's flexible satellite study F1-F4",
+        "Run F1-F4 (paper V's flexible satellite: MTSMC and CSMC with and without PZT vibration control on "
+        "the V-slew, the boundary-layer sweep, steady error with the integral term, OfflineRMPC and RMPC on "
+        "the 14-state model on a small slew) and write results.json, results.md (tables, paper V's reported "
+        "results next to the measured ones, the seed's inconsistencies, every setting chosen), results.csv, "
+        "run.json, figures/F*.png and traces/*.npz into DIR.",
+        "a smoke run (run lengths x 0.02); no measurement",
+        "F1,...",
+    ),
+}
 
-    outcome = run_mrp(
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        time_scale=SHORT_TIME_SCALE if args.short else 1.0,
-        experiments=args.experiments,
-        progress=None if not args.no_progress else False,
+
+def _add_suite(bsub: Any, name: str, workers_help: str) -> None:
+    module, runner, help_text, description, short_help, metavar = _SUITES[name]
+    status = "Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted."
+    parser = bsub.add_parser(name, help=help_text, description=f"{description} {status}")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    parser.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
+    parser.add_argument("--short", action="store_true", help=short_help)
+    parser.add_argument(
+        "--experiments", type=_experiments, default=None, metavar=metavar, help="run only these experiments"
     )
-    return _report_suite("mrp", outcome, args.out)
-
-
-def _cmd_bench_flexible(args: argparse.Namespace) -> int:
-    from benchmarks.suites.flexible import SHORT_TIME_SCALE, run_flexible
-
-    outcome = run_flexible(
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        time_scale=SHORT_TIME_SCALE if args.short else 1.0,
-        experiments=args.experiments,
-        progress=None if not args.no_progress else False,
-    )
-    return _report_suite("flexible", outcome, args.out)
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    parser.set_defaults(func=_cmd_bench_suite, suite_module=module, suite_runner=runner)
 
 
 def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
@@ -228,67 +257,8 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     paper.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     paper.set_defaults(func=_cmd_bench_paper)
 
-    faults = bsub.add_parser(
-        "faults",
-        help="paper W's wheel-fault scenarios S1-S4 (W1-W4)",
-        description="Run W1-W4 (paper W's S1-S4 on the four-wheel satellite: ABFTC, RMPC, CRMPC, GIPC) and "
-        "write results.json, results.md (tables, paper W's reported results next to the measured ones, "
-        "its inconsistencies, every setting chosen), results.csv, run.json, figures/W*.png and "
-        "traces/*.npz into DIR. Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted.",
-    )
-    faults.add_argument("--out", required=True, metavar="DIR", help="output directory")
-    faults.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
-    faults.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
-    faults.add_argument(
-        "--short",
-        action="store_true",
-        help="a smoke run (run lengths and fault windows x 0.1) to check the set-up; no measurement",
-    )
-    faults.add_argument(
-        "--experiments", type=_experiments, default=None, metavar="W1,...", help="run only these experiments"
-    )
-    faults.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
-    faults.set_defaults(func=_cmd_bench_faults)
-
-    mrp = bsub.add_parser(
-        "mrp",
-        help="paper M's MRP satellite scenarios M1-M3",
-        description="Run M1-M3 (paper M's MRP satellite with the spinning disk: BS, MAB, TFAB, RMPC, CRMPC) "
-        "and write results.json, results.md (tables, paper M's reported results next to the measured ones, "
-        "its inconsistencies, every setting chosen), results.csv, run.json, figures/M*.png and traces/*.npz "
-        "into DIR. Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted.",
-    )
-    mrp.add_argument("--out", required=True, metavar="DIR", help="output directory")
-    mrp.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
-    mrp.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
-    mrp.add_argument("--short", action="store_true", help="a smoke run (run lengths x 0.05); no measurement")
-    mrp.add_argument(
-        "--experiments", type=_experiments, default=None, metavar="M1,...", help="run only these experiments"
-    )
-    mrp.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
-    mrp.set_defaults(func=_cmd_bench_mrp)
-
-    flexible = bsub.add_parser(
-        "flexible",
-        help="paper V's flexible satellite study F1-F4",
-        description="Run F1-F4 (paper V's flexible satellite: MTSMC and CSMC with and without PZT vibration "
-        "control on the V-slew, the boundary-layer sweep, steady error with the integral term, OfflineRMPC "
-        "and RMPC on the 14-state model on a small slew) and write results.json, results.md (tables, paper "
-        "V's reported results next to the measured ones, the seed's inconsistencies, every setting chosen), "
-        "results.csv, run.json, figures/F*.png and traces/*.npz into DIR. Exit status: 0 all done, 1 some "
-        "cases failed, 2 bad input, 130 interrupted.",
-    )
-    flexible.add_argument("--out", required=True, metavar="DIR", help="output directory")
-    flexible.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
-    flexible.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
-    flexible.add_argument(
-        "--short", action="store_true", help="a smoke run (run lengths x 0.02); no measurement"
-    )
-    flexible.add_argument(
-        "--experiments", type=_experiments, default=None, metavar="F1,...", help="run only these experiments"
-    )
-    flexible.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
-    flexible.set_defaults(func=_cmd_bench_flexible)
+    for name in _SUITES:
+        _add_suite(bsub, name, workers_help)
 
     sweep = bsub.add_parser(
         "sweep",

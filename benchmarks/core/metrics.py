@@ -41,6 +41,7 @@ __all__ = [
     "overshoot",
     "recovery",
     "settling_time",
+    "step_timing",
 ]
 
 #: Names of the attitude axes, in state order.
@@ -155,6 +156,27 @@ def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = Non
     else:
         rec = float(t[idx[outside[-1] + 1]] - t_on)
     return {"peak_error": float(window.max()), "recovery_time": rec, "band": float(band)}
+
+
+def step_timing(traj: Any) -> dict[str, Any]:
+    """Per-step wall time and solve time of a run (percentiles) and its status counts.
+
+    ``solve_time_solves_*`` are over the steps that solved an optimisation problem (status not
+    ``"ok"``, the word of control laws without one, nor ``"reused"``); ``None`` when none did.
+    """
+    step = np.asarray(traj.step_time, dtype=float)
+    solve = np.asarray(traj.solve_time, dtype=float)
+    statuses = [getattr(info, "status", "ok") if info is not None else "ok" for info in traj.info]
+    solved = np.array([s for s, st in zip(solve, statuses, strict=False) if st not in ("ok", "reused")])
+    return {
+        "step_time_p50": float(np.percentile(step, 50)),
+        "step_time_p95": float(np.percentile(step, 95)),
+        "solve_time_p50": float(np.percentile(solve, 50)),
+        "solve_time_p95": float(np.percentile(solve, 95)),
+        "solve_time_solves_p50": float(np.percentile(solved, 50)) if solved.size else None,
+        "solve_time_solves_p95": float(np.percentile(solved, 95)) if solved.size else None,
+        "status_counts": traj.status_counts(),
+    }
 
 
 def overshoot(e: Any) -> float | None:

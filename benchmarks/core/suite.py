@@ -19,7 +19,15 @@ from benchmarks.core.executors import make_executor
 from benchmarks.core.progress import CaseProgress
 from benchmarks.core.scenario import Scenario
 
-__all__ = ["SuiteCase", "SuiteOutcome", "run_suite_cases"]
+__all__ = [
+    "SuiteCase",
+    "SuiteOutcome",
+    "run_suite_cases",
+    "write_records",
+    "write_rows_csv",
+    "write_run_info",
+    "write_traces",
+]
 
 
 @dataclass(frozen=True)
@@ -130,3 +138,72 @@ def run_suite_cases(
                 }
             )
     return outcome, runs
+
+
+def write_traces(out: Path, runs: Sequence[tuple[Any, dict, dict]]) -> list[Path]:
+    """Create ``figures/`` and ``traces/`` in ``out``; save each run's time series as ``traces/<key>.npz``."""
+    import numpy as np
+
+    (out / "figures").mkdir(exist_ok=True)
+    (out / "traces").mkdir(exist_ok=True)
+    files = []
+    for case, _, trace in runs:
+        path = out / "traces" / f"{case.key}.npz"
+        np.savez_compressed(path, **trace)
+        files.append(path)
+    return files
+
+
+def write_records(out: Path, records: Sequence[dict[str, Any]]) -> Path:
+    """``results.json``: the records (strict JSON)."""
+    import json
+
+    path = out / "results.json"
+    path.write_text(json.dumps(list(records), indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    return path
+
+
+def write_rows_csv(path: Path, rows: Sequence[dict[str, Any]]) -> Path | None:
+    """A CSV of the table rows (dicts with the same keys); nothing when there are no rows."""
+    import csv
+
+    if not rows:
+        return None
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+def write_run_info(
+    out: Path,
+    command: str,
+    outcome: SuiteOutcome,
+    n_cases: int,
+    workers: int | None,
+    scheduler: str | None,
+    scale: tuple[str, float],
+) -> dict[str, Any]:
+    """``run.json``: the command, wall time, executor, scale, counts, machine, versions and failures."""
+    import json
+
+    from benchmarks.core.machine import machine_info, package_versions
+
+    info = {
+        "command": command,
+        "wall_time_s": outcome.wall_time_s,
+        "executor": outcome.executor,
+        "workers": workers,
+        "scheduler": scheduler,
+        scale[0]: scale[1],
+        "cases": n_cases,
+        "done": len(outcome.records),
+        "failed": len(outcome.failures),
+        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
+        "machine": machine_info(),
+        "versions": package_versions(),
+        "failures": outcome.failures,
+    }
+    (out / "run.json").write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
+    return info

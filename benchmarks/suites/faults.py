@@ -20,8 +20,6 @@ W4    S4: wheel 4 out, wheel 1 stuck 30-60 s, wheel 2 sinusoidal 70-100 s, wheel
 
 from __future__ import annotations
 
-import csv
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -29,9 +27,16 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.scenario import Scenario
-from benchmarks.core.suite import SuiteCase, SuiteOutcome, run_suite_cases
+from benchmarks.core.suite import (
+    SuiteCase,
+    SuiteOutcome,
+    run_suite_cases,
+    write_records,
+    write_rows_csv,
+    write_run_info,
+    write_traces,
+)
 from benchmarks.families.wheel import defaults
 from benchmarks.reports.tables import to_markdown
 from toolkit_common.errors import ConfigError
@@ -282,13 +287,7 @@ def _write(
     from benchmarks.reports.fault_figures import plot_fault_case_group
     from models import WheelArray
 
-    files: list[Path] = []
-    (out / "figures").mkdir(exist_ok=True)
-    (out / "traces").mkdir(exist_ok=True)
-    for case, _, trace in runs:
-        path = out / "traces" / f"{case.key}.npz"
-        np.savez_compressed(path, **trace)
-        files.append(path)
+    files: list[Path] = write_traces(out, runs)
     wheels = WheelArray.paper_w()
     groups: dict[tuple[str, float], list[tuple[SuiteCase, dict, dict]]] = {}
     for case, rec, trace in runs:
@@ -311,30 +310,14 @@ def _write(
         files.append(path)
 
     records = outcome.records
-    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    write_records(out, records)
     rows = [{"experiment": r["experiment"], **case_row(r)} for r in records]
-    if rows:
-        with (out / "results.csv").open("w", newline="", encoding="utf-8") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        files.append(out / "results.csv")
-    run_info = {
-        "command": "rmpc bench faults",
-        "wall_time_s": outcome.wall_time_s,
-        "executor": outcome.executor,
-        "workers": workers,
-        "scheduler": scheduler,
-        "time_scale": time_scale,
-        "cases": len(cases),
-        "done": len(records),
-        "failed": len(outcome.failures),
-        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
-        "machine": machine_info(),
-        "versions": package_versions(),
-        "failures": outcome.failures,
-    }
-    (out / "run.json").write_text(json.dumps(run_info, indent=1) + "\n", encoding="utf-8")
+    csv_path = write_rows_csv(out / "results.csv", rows)
+    if csv_path is not None:
+        files.append(csv_path)
+    run_info = write_run_info(
+        out, "rmpc bench faults", outcome, len(cases), workers, scheduler, ("time_scale", time_scale)
+    )
     (out / "results.md").write_text(_markdown(records, outcome, figures, run_info, out), encoding="utf-8")
     files += [out / n for n in ("results.json", "run.json", "results.md")]
     return files

@@ -21,9 +21,7 @@ and the trajectories (``traces/*.npz``).
 
 from __future__ import annotations
 
-import csv
 import itertools
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -31,9 +29,16 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.scenario import Scenario
-from benchmarks.core.suite import SuiteCase, SuiteOutcome, run_suite_cases
+from benchmarks.core.suite import (
+    SuiteCase,
+    SuiteOutcome,
+    run_suite_cases,
+    write_records,
+    write_rows_csv,
+    write_run_info,
+    write_traces,
+)
 from benchmarks.families.flexible import defaults
 from benchmarks.reports.tables import to_markdown
 from toolkit_common.errors import ConfigError
@@ -406,13 +411,7 @@ def _write(
 ) -> list[Path]:
     from benchmarks.reports.flexible_figures import plot_flexible_group
 
-    files: list[Path] = []
-    (out / "figures").mkdir(exist_ok=True)
-    (out / "traces").mkdir(exist_ok=True)
-    for case, _, trace in runs:
-        path = out / "traces" / f"{case.key}.npz"
-        np.savez_compressed(path, **trace)
-        files.append(path)
+    files: list[Path] = write_traces(out, runs)
     groups: dict[str, list[tuple[str, dict]]] = {}
     for case, _rec, trace in runs:
         groups.setdefault(case.experiment, []).append((case.tag, trace))
@@ -426,30 +425,14 @@ def _write(
             figures[exp] = path
             files.append(path)
     records = sorted(outcome.records, key=lambda r: (r["experiment"], r["label"]))
-    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    write_records(out, records)
     rows = [{"experiment": r["experiment"], **case_row(r)} for r in records]
-    if rows:
-        with (out / "results.csv").open("w", newline="", encoding="utf-8") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        files.append(out / "results.csv")
-    info = {
-        "command": "rmpc bench flexible",
-        "wall_time_s": outcome.wall_time_s,
-        "executor": outcome.executor,
-        "workers": workers,
-        "scheduler": scheduler,
-        "time_scale": time_scale,
-        "cases": len(cases),
-        "done": len(records),
-        "failed": len(outcome.failures),
-        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
-        "machine": machine_info(),
-        "versions": package_versions(),
-        "failures": outcome.failures,
-    }
-    (out / "run.json").write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
+    csv_path = write_rows_csv(out / "results.csv", rows)
+    if csv_path is not None:
+        files.append(csv_path)
+    info = write_run_info(
+        out, "rmpc bench flexible", outcome, len(cases), workers, scheduler, ("time_scale", time_scale)
+    )
     m = info["machine"]
     lines = [
         "# Benchmark suite `flexible`: paper V's study on the flexible satellite (F1-F4)",

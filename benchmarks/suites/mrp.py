@@ -18,17 +18,20 @@ M3    the disk, the true inertia 1.3 J0 and 0.7 J0 (two runs per controller), 1 
 
 from __future__ import annotations
 
-import csv
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.scenario import Scenario
-from benchmarks.core.suite import SuiteCase, SuiteOutcome, run_suite_cases
+from benchmarks.core.suite import (
+    SuiteCase,
+    SuiteOutcome,
+    run_suite_cases,
+    write_records,
+    write_rows_csv,
+    write_run_info,
+    write_traces,
+)
 from benchmarks.families.mrp import defaults
 from benchmarks.reports.tables import to_markdown
 from toolkit_common.errors import ConfigError
@@ -213,13 +216,7 @@ def _write(
 ) -> list[Path]:
     from benchmarks.reports.mrp_figures import plot_mrp_group
 
-    files: list[Path] = []
-    (out / "figures").mkdir(exist_ok=True)
-    (out / "traces").mkdir(exist_ok=True)
-    for case, _, trace in runs:
-        path = out / "traces" / f"{case.key}.npz"
-        np.savez_compressed(path, **trace)
-        files.append(path)
+    files: list[Path] = write_traces(out, runs)
     groups: dict[tuple[str, float], list[tuple[dict, dict]]] = {}
     for case, rec, trace in runs:
         groups.setdefault((case.experiment, rec["settings"]["inertia_scale_used"]), []).append((rec, trace))
@@ -230,30 +227,14 @@ def _write(
         figures.setdefault(exp, []).append(path)
         files.append(path)
     records = outcome.records
-    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    write_records(out, records)
     rows = [{"experiment": r["experiment"], **case_row(r)} for r in records]
-    if rows:
-        with (out / "results.csv").open("w", newline="", encoding="utf-8") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
-        files.append(out / "results.csv")
-    info = {
-        "command": "rmpc bench mrp",
-        "wall_time_s": outcome.wall_time_s,
-        "executor": outcome.executor,
-        "workers": workers,
-        "scheduler": scheduler,
-        "time_scale": time_scale,
-        "cases": len(cases),
-        "done": len(records),
-        "failed": len(outcome.failures),
-        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
-        "machine": machine_info(),
-        "versions": package_versions(),
-        "failures": outcome.failures,
-    }
-    (out / "run.json").write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
+    csv_path = write_rows_csv(out / "results.csv", rows)
+    if csv_path is not None:
+        files.append(csv_path)
+    info = write_run_info(
+        out, "rmpc bench mrp", outcome, len(cases), workers, scheduler, ("time_scale", time_scale)
+    )
     m = info["machine"]
     lines = [
         "# Benchmark suite `mrp`: paper M's scenarios M1-M3",

@@ -19,16 +19,19 @@ E6    initial attitude x 1.3: RMPC and GIPC                                  lin
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.scenario import Scenario
-from benchmarks.core.suite import SuiteCase, SuiteOutcome, run_suite_cases
+from benchmarks.core.suite import (
+    SuiteCase,
+    SuiteOutcome,
+    run_suite_cases,
+    write_records,
+    write_run_info,
+    write_traces,
+)
 from benchmarks.families.rigid import defaults
 from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from models import PAPER_P_INERTIA
@@ -150,7 +153,7 @@ def run_paper(
     cases = paper_cases(duration_scale, experiments)
     outcome, runs = run_suite_cases(cases, out, "rmpc bench paper", workers, scheduler, progress, _cost)
     out = Path(out)
-    outcome.files = _write(out, cases, runs, outcome, workers, scheduler, duration_scale, outcome.executor)
+    outcome.files = _write(out, cases, runs, outcome, workers, scheduler, duration_scale)
     return outcome
 
 
@@ -162,17 +165,10 @@ def _write(
     workers: int | None,
     scheduler: str | None,
     duration_scale: float,
-    where: str,
 ) -> list[Path]:
     from benchmarks.reports.figures import plot_gamma, plot_responses
 
-    files: list[Path] = []
-    (out / "figures").mkdir(exist_ok=True)
-    (out / "traces").mkdir(exist_ok=True)
-    for case, _, trace in runs:
-        path = out / "traces" / f"{case.key}.npz"
-        np.savez_compressed(path, **trace)
-        files.append(path)
+    files: list[Path] = write_traces(out, runs)
     groups: dict[str, list[tuple[dict, dict]]] = {}
     for case, rec, trace in runs:
         groups.setdefault(case.experiment, []).append((rec, trace))
@@ -194,25 +190,12 @@ def _write(
     files += [p for ps in figures.values() for p in ps] + ([gamma] if gamma else [])
 
     records = outcome.records
-    (out / "results.json").write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    write_records(out, records)
     header, rows = metric_table(records)
     files += write_tables(out, header, rows, "Benchmark suite paper: E1-E6")
-    run_info = {
-        "command": "rmpc bench paper",
-        "wall_time_s": outcome.wall_time_s,
-        "executor": where,
-        "workers": workers,
-        "scheduler": scheduler,
-        "duration_scale": duration_scale,
-        "cases": len(cases),
-        "done": len(records),
-        "failed": len(outcome.failures),
-        "interrupted": bool(outcome.execution and outcome.execution.interrupted),
-        "machine": machine_info(),
-        "versions": package_versions(),
-        "failures": outcome.failures,
-    }
-    (out / "run.json").write_text(json.dumps(run_info, indent=1) + "\n", encoding="utf-8")
+    run_info = write_run_info(
+        out, "rmpc bench paper", outcome, len(cases), workers, scheduler, ("duration_scale", duration_scale)
+    )
     md = _markdown(records, outcome, figures, gamma, run_info, out)
     (out / "results.md").write_text(md, encoding="utf-8")
     files += [out / n for n in ("results.json", "run.json", "results.md")]

@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.family import CaseResult, ControllerSpec, Field, PlantFamily, check_choice, check_real
+from benchmarks.core.metrics import step_timing
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import CONSTRAINED, CONTROLLERS, FlexibleModel, settings_check
 from toolkit_common.errors import ConfigError
@@ -264,7 +265,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     }
     if "regime" not in metrics:
         metrics["regime"] = None
-    metrics.update(_timing(traj))
+    metrics.update(step_timing(traj))
     inner = getattr(getattr(built.controller, "attitude", None), "controller", None)
     table = getattr(inner, "table", None)
     extra = {
@@ -294,22 +295,6 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 def _handover_time(ctrl: Any, traj: Any) -> float | None:
     step = getattr(getattr(ctrl, "attitude", None), "handover_step", None)
     return None if step is None else float(traj.t[step])
-
-
-def _timing(traj: Any) -> dict[str, Any]:
-    step = np.asarray(traj.step_time, dtype=float)
-    solve = np.asarray(traj.solve_time, dtype=float)
-    statuses = [getattr(info, "status", "ok") if info is not None else "ok" for info in traj.info]
-    solved = np.array([s for s, st in zip(solve, statuses, strict=False) if st not in ("ok", "reused")])
-    return {
-        "step_time_p50": float(np.percentile(step, 50)),
-        "step_time_p95": float(np.percentile(step, 95)),
-        "solve_time_p50": float(np.percentile(solve, 50)),
-        "solve_time_p95": float(np.percentile(solve, 95)),
-        "solve_time_solves_p50": float(np.percentile(solved, 50)) if solved.size else None,
-        "solve_time_solves_p95": float(np.percentile(solved, 95)) if solved.size else None,
-        "status_counts": traj.status_counts(),
-    }
 
 
 FLEXIBLE = PlantFamily(

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.family import CaseResult, ControllerSpec, Field, PlantFamily, check_choice, check_real
+from benchmarks.core.metrics import step_timing
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
 from toolkit_common.errors import ConfigError
@@ -144,7 +145,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "max_abs_u_time": float(traj.t[int(np.abs(traj.u_applied).max(axis=1).argmax())]),
         "max_abs_u_cmd": float(np.abs(traj.u_cmd).max()),
     }
-    metrics.update(_timing(traj))
+    metrics.update(step_timing(traj))
     estimate = [info.extra.get("torque_estimate") if info is not None else None for info in traj.info]
     if traj.d.size and all(e is not None for e in estimate):
         est = np.asarray(estimate, dtype=float)
@@ -173,20 +174,6 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         if "td_est_err_max" in metrics:
             trace["torque_estimate"] = np.asarray(estimate, dtype=float)
     return CaseResult(extra, metrics, trace)
-
-
-def _timing(traj: Any) -> dict[str, Any]:
-    step = np.asarray(traj.step_time, dtype=float)
-    solve = np.asarray(traj.solve_time, dtype=float)
-    solved = solve[solve > 0]
-    return {
-        "step_time_p50": float(np.percentile(step, 50)),
-        "step_time_p95": float(np.percentile(step, 95)),
-        "solve_time_p50": float(np.percentile(solve, 50)),
-        "solve_time_solves_p50": float(np.percentile(solved, 50)) if solved.size else None,
-        "solve_time_solves_p95": float(np.percentile(solved, 95)) if solved.size else None,
-        "status_counts": traj.status_counts(),
-    }
 
 
 MRP = PlantFamily(
