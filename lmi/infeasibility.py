@@ -29,10 +29,14 @@ import numpy as np
 from lmi.affine import smat_matrix, svec_indices
 from toolkit_common.errors import InvalidArgumentError
 
-__all__ = ["MIN_RADIUS", "InfeasibilityCertificate", "check_farkas"]
+__all__ = ["MIN_RADIUS", "PSD_TOL", "InfeasibilityCertificate", "check_farkas"]
 
 #: A certificate proves infeasibility for the toolkit when no solution of norm below this exists.
 MIN_RADIUS = 1e8
+#: ... and its blocks are positive semidefinite up to rounding: smallest eigenvalue at least
+#: minus this times the block's largest (a block far from the cone is not a certificate, even if
+#: the shifted one would still be; phase one's blocks are positive definite by construction).
+PSD_TOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -68,9 +72,10 @@ class InfeasibilityCertificate:
 
     @property
     def ok(self) -> bool:
-        """``objective < 0`` and ``radius >= min_radius``: the problem has no solution of norm
-        below ``min_radius``."""
-        return bool(np.isfinite(self.objective) and self.objective < 0.0 and self.radius >= self.min_radius)
+        """``objective < 0``, ``radius >= min_radius`` and ``min_eigenvalue >= -PSD_TOL``: the
+        problem has no solution of norm below ``min_radius``."""
+        return bool(np.isfinite(self.objective) and self.objective < 0.0 and self.radius >= self.min_radius
+                    and self.min_eigenvalue >= -PSD_TOL)
 
 
 def check_farkas(
