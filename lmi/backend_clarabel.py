@@ -40,6 +40,7 @@ from scipy import sparse
 
 from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 from lmi.data import KothareData
+from lmi.infeasibility import InfeasibilityCertificate
 from lmi.status import CLARABEL_STATUS_MAP, INFEASIBLE, SOLVER_ERROR, UNBOUNDED
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
@@ -73,6 +74,8 @@ class RawResult:
     Y: np.ndarray | None
     iterations: int | None
     solve_time: float
+    #: A checked proof of infeasibility (the IPM's phase one), when the status is "infeasible".
+    infeasibility: InfeasibilityCertificate | None = None
 
 
 def clarabel_settings(options: dict[str, Any] | None) -> Any:

@@ -16,13 +16,14 @@ from typing import Any
 import clarabel
 import numpy as np
 
-from lmi.affine import smat_matrix, svec_indices
+from lmi.affine import smat_matrix, svec_indices, svec_matrix
 from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.data import KothareData
+from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import scale_data, state_scaling
-from lmi.status import INACCURATE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
+from lmi.status import INACCURATE, INFEASIBLE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["DEFAULT_IPM_OPTIONS", "IPMKothare"]
@@ -55,6 +56,7 @@ DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "warm_max_iter": 25,
     "fallback": True,
     "state_scaling": True,
+    "phase_one": True,
 }
 _STATUS = {
     "optimal": OPTIMAL,
@@ -81,7 +83,7 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
-    for key in ("warm_start", "fallback", "state_scaling"):
+    for key in ("warm_start", "fallback", "state_scaling", "phase_one"):
         if not isinstance(merged[key], bool):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
     return merged
@@ -129,6 +131,7 @@ class IPMKothare(ClarabelKothare):
             self._scaled_blocks.append((j, parts))
         self._warm_start = merged.pop("warm_start")
         self._fallback = merged.pop("fallback")
+        self._phase_one = merged.pop("phase_one")
         self._solver = BlockLMISolver(self._q, blocks, factors=self._block_factors(len(blocks)),
                                       **merged)
 
@@ -157,12 +160,18 @@ class IPMKothare(ClarabelKothare):
             self._solver.set_block(j, const_j, coef_j * scale)
 
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
-        """Solve with the IPM; anything but ``"optimal"`` is re-solved by Clarabel.
+        """Solve with the IPM; a failure goes to phase one, then (unless proved infeasible) to
+        Clarabel.
 
-        The IPM has no infeasibility certificates (no homogeneous embedding), so a failed solve
-        is handed to Clarabel (same conic data), which classifies it (``"infeasible"``, ...)
-        or solves it; ``solver_status`` then reads ``"ipm <word>; clarabel <word>"`` and the
-        time and iterations are the sum of both.
+        A solve that does not end ``"optimal"`` runs phase one
+        (:meth:`lmi.ipm.BlockLMISolver.phase_one`). If it proves the problem infeasible and
+        the proof passes :func:`lmi.infeasibility.check_farkas` on the conic data of the
+        fallback (independent of the IPM's own packing, equilibration and factored forms), the
+        answer is ``"infeasible"`` with that certificate (``RawResult.infeasibility``) and
+        ``solver_status`` ``"ipm <word>; phase one infeasible"``. Otherwise the failed solve is
+        handed to Clarabel as before (same conic data), which classifies it or solves it;
+        ``solver_status`` then reads ``"ipm <word>; phase one <word>; clarabel <word>"``.
+        Times and iterations are the sums over every stage.
         """
         # the state in the scaled coordinates, normalised again (exact: the LMIs are homogeneous);
         # unscaled, nothing is touched, so the answers are bit-identical to the unscaled solver's
@@ -172,7 +181,13 @@ class IPMKothare(ClarabelKothare):
             norm = float(np.linalg.norm(xs))
             xs, u_max, y_max = xs / norm, u_max / norm, y_max / norm
         raw = self._solve_ipm(xs, u_max, y_max)
-        if raw.status == OPTIMAL or not self._fallback:
+        if raw.status == OPTIMAL:
+            return self._unscale(raw, norm)
+        if self._phase_one:
+            raw = self._decide(raw, xs, u_max, y_max)
+            if raw.status == INFEASIBLE:
+                return raw
+        if not self._fallback:
             return self._unscale(raw, norm)
         backup = super().solve(xs, u_max, y_max)
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
@@ -180,6 +195,46 @@ class IPMKothare(ClarabelKothare):
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
             iterations=iterations, solve_time=raw.solve_time + backup.solve_time,
         ), norm)
+
+    def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+        """Phase one after the failed solve ``raw`` (blocks already at this state): ``raw`` as
+        ``"infeasible"`` with the checked certificate, or ``raw`` with phase one's word, time
+        and iterations added."""
+        start = time.perf_counter()
+        try:
+            with self._blas.limit():
+                res = self._solver.phase_one()
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
+            return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {err!r}",
+                                       solve_time=raw.solve_time + time.perf_counter() - start)
+        word = res.status
+        cert = None
+        if res.status == "infeasible":
+            cert = self.farkas_check(res.Z, xs, u_max, y_max)
+            if not cert.ok:
+                word = "infeasible (unchecked)"
+        iterations = (raw.iterations or 0) + res.iterations
+        elapsed = raw.solve_time + time.perf_counter() - start
+        if cert is not None and cert.ok:
+            return RawResult(INFEASIBLE, f"ipm {raw.solver_status}; phase one infeasible", np.nan, None,
+                             None, iterations, elapsed, infeasibility=cert)
+        return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {word}",
+                                   iterations=iterations, solve_time=elapsed)
+
+    def farkas_check(self, z_blocks: list[np.ndarray], xs: np.ndarray, u_max: np.ndarray,
+                     y_max: np.ndarray) -> InfeasibilityCertificate:
+        """Check multipliers ``Z`` (one block per LMI block of the solver) as a Farkas certificate
+        on the conic data Clarabel would be given at this (normalised, balanced) state and
+        bounds: ``A`` with the bound rows scaled, ``b`` with the state block."""
+        parts, cones = [], []
+        for cone, zj, rows in zip(self._cones, z_blocks, self._block_rows, strict=True):
+            if isinstance(cone, clarabel.PSDTriangleConeT):
+                parts.append(svec_matrix(0.5 * (zj + zj.T)))
+                cones.append(("psd", zj.shape[0]))
+            else:  # a non-negative cone: its IPM block is diagonal, only the diagonal of Z counts
+                parts.append(np.diag(zj).copy())
+                cones.append(("nonneg", rows.stop - rows.start))
+        return check_farkas(self._a_matrix(u_max, y_max), self._b_vector(xs), cones, np.concatenate(parts))
 
     def _unscale(self, raw: RawResult, norm: float) -> RawResult:
         """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,

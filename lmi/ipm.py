@@ -52,7 +52,8 @@ from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
 __all__ = [
-    "DIRECT_MIN_VARIABLES", "REDUCED_TOL", "STALL_WINDOW", "BlockFactor", "BlockLMISolver", "IPMResult",
+    "DIRECT_MIN_VARIABLES", "PHASE_ONE_MARGIN", "REDUCED_TOL", "STALL_WINDOW", "BlockFactor",
+    "BlockLMISolver", "IPMResult", "PhaseOneResult",
 ]
 
 #: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
@@ -91,6 +92,21 @@ STALL_FACTOR = 0.5
 #: took the warm median from 876 ms to 21 ms (load ~7).
 DIRECT_MIN_VARIABLES = 64
 
+#: Phase one (:meth:`BlockLMISolver.phase_one`) accepts a corrected dual point ``Z`` as a proof of
+#: infeasibility only if ``sum_j <C_j, Z_j> <= -PHASE_ONE_MARGIN ||C|| ||Z||`` (Frobenius norms
+#: over all blocks): a margin far above the rounding of the correction onto ``A'Z = 0``.
+PHASE_ONE_MARGIN = 1e-7
+#: ... and tries the correction only when the dual residual ``||G'z||`` is below this fraction of
+#: ``||z||`` (before, it fails; see :func:`_dual_correction`).
+PHASE_ONE_RESIDUAL = 1e-8
+#: Phase one's iteration limit and tolerances: it runs until a proof is found or it stalls
+#: (its own optimality test, at these tolerances, practically never ends it first). On the
+#: stress set's infeasible problems the proof came after 45-60 iterations: the phase-one
+#: problem of an infeasible Kothare problem converges slowly (the gap shrinks by about 0.7 per
+#: iteration), and the correction onto ``A'Z = 0`` succeeds only near its end.
+PHASE_ONE_MAX_ITER = 100
+PHASE_ONE_TOL = 1e-13
+
 
 @dataclass
 class IPMResult:
@@ -110,6 +126,34 @@ class IPMResult:
     primal_residual: float
     dual_residual: float
     gap: float
+    solve_time: float
+
+
+@dataclass
+class PhaseOneResult:
+    """Outcome of :meth:`BlockLMISolver.phase_one`.
+
+    ``status`` is ``"infeasible"`` (``Z`` proves it, see below), ``"feasible"`` (``x`` is a
+    point with every ``C_j - sum_i x_i A_ij`` positive definite, checked by Cholesky) or
+    ``"inconclusive"`` (phase one ended, ``run_status``, without either).
+
+    For ``"infeasible"``, ``Z`` holds positive semidefinite blocks (smallest eigenvalues in
+    ``min_eigenvalue``, relative to each block's largest) with ``sum_j <A_ij, Z_j> = 0`` for
+    every ``i`` to rounding (``residual``, the largest ``|sum_j <A_ij, Z_j>|`` over
+    ``||A_i|| ||Z||``) and ``objective = sum_j <C_j, Z_j> < 0``: a feasible ``x`` would give
+    ``0 <= sum_j <S_j, Z_j> = objective - sum_i x_i sum_j <A_ij, Z_j>``, impossible unless
+    ``||x||`` is at least about ``|objective| / (residual ||A|| ||Z||)``.
+    """
+
+    status: str
+    Z: list[np.ndarray] | None
+    x: np.ndarray | None
+    objective: float
+    residual: float
+    min_eigenvalue: float
+    t: float
+    iterations: int
+    run_status: str
     solve_time: float
 
 
@@ -212,6 +256,8 @@ class BlockLMISolver:
         self._fact_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
         self._fact: tuple[np.ndarray, ...] = ()
         self._direct = False
+        self._const: list[np.ndarray] = [const for const, _ in checked]
+        self._phase_one_solver: BlockLMISolver | None = None
         for j, (const, coef) in enumerate(checked):
             self._set_checked(j, const, coef)
             if factors is not None and factors[j] is not None:
@@ -243,6 +289,7 @@ class BlockLMISolver:
         rows = self._layout.rows(j)
         iu0, iu1, w = self._layout.triangle(j)
         self._h_vec[rows] = const[iu0, iu1] * w
+        self._const[j] = const.copy()
         if coef is not None and not np.array_equal(coef, self._coef[j]):
             self._coef[j] = coef.copy()
             self._dirty.add(j)
@@ -335,6 +382,87 @@ class BlockLMISolver:
         res.solve_time = time.perf_counter() - start
         return res
 
+    def phase_one(self) -> PhaseOneResult:
+        """Decide feasibility of the current data: ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0``.
+
+        The phase-one problem is strictly feasible by construction and started at a feasible
+        point (``x = 0``, ``t = 1 + max(0, -lambda_min(C))``), so its primal iterates stay
+        feasible and its dual iterates ``Z`` stay positive definite. It stops as soon as
+
+        * an iterate has ``t < 0``: its ``x`` is strictly feasible for the original problem
+          (``"feasible"``; checked by Cholesky of every ``C_j - sum_i x_i A_ij``), or
+        * the dual iterate, moved onto ``sum_j <A_ij, Z_j> = 0`` (for every original ``i``) by
+          the least-norm correction, is still positive semidefinite with
+          ``sum_j <C_j, Z_j> <= -PHASE_ONE_MARGIN ||C|| ||Z||``: a Farkas certificate of
+          infeasibility (``"infeasible"``, see :class:`PhaseOneResult`).
+
+        Otherwise (its optimum ``t* = 0``, i.e. the data on the boundary of feasibility, or a
+        failed run) the answer is ``"inconclusive"``. An interior ``Z`` is well conditioned, so
+        the correction, of the size of the dual residual, leaves it positive definite once
+        that residual is small; the limit of a failed run of the problem itself is a nearly
+        singular ray that such a correction makes indefinite. The phase-one solver is built on
+        the first call (the same blocks with one more variable of coefficient ``-I``; factored
+        blocks keep their factored form when their dictionary holds the identity columns) and
+        reused.
+        """
+        start = time.perf_counter()
+        self._refresh()
+        aux = self._phase_one_data()
+        aux._refresh()
+        n, kmax = self.n, self._kmax
+        orders = self.block_orders
+        low = min(float(np.linalg.eigvalsh(c)[0]) for c in self._const)
+        t0 = 1.0 + max(0.0, -low)
+        s0 = np.zeros((len(orders), kmax, kmax))
+        z0 = np.zeros_like(s0)
+        for j, k in enumerate(orders):
+            s0[j, :k, :k] = self._const[j] + t0 * np.eye(k)
+            z0[j, :k, :k] = np.eye(k) / self.degree
+        x0 = np.zeros(n + 1)
+        x0[n] = t0
+        check = _PhaseOneCheck(self, aux._dscale)
+        res = aux._run((x0, s0, z0), PHASE_ONE_MAX_ITER, check)
+        found = check.found
+        status = res.status if res.status in ("feasible", "infeasible") else "inconclusive"
+        if status == "inconclusive" and res.status in ("optimal", "inaccurate"):
+            # the last chance: the final dual point (at t* = 0 it cannot prove anything)
+            zfin = np.zeros_like(z0)
+            for j, k in enumerate(orders):
+                zfin[j, :k, :k] = res.Z[j]
+            if check(res.x / aux._dscale, None, zfin) == "infeasible":
+                status, found = "infeasible", check.found
+        return PhaseOneResult(
+            status, found.get("Z"), found.get("x"), found.get("objective", np.nan),
+            found.get("residual", np.nan), found.get("min_eigenvalue", np.nan),
+            float(found.get("t", res.x[n] if res.x.size > n else np.nan)), res.iterations,
+            res.status, time.perf_counter() - start,
+        )
+
+    def _phase_one_data(self) -> BlockLMISolver:
+        """The phase-one solver (built once), its blocks brought up to date with this one's."""
+        n = self.n
+        aux = self._phase_one_solver
+        fresh = aux is None
+        blocks, factors = [], []
+        for j, k in enumerate(self.block_orders):
+            if fresh or not np.array_equal(aux._coef[j][:n], self._coef[j]):
+                coef = np.concatenate([self._coef[j], -np.eye(k)[None]])
+                factor = _with_identity(self._factor_raw[j], n, k)
+                if fresh:
+                    blocks.append((self._const[j], coef))
+                    factors.append(factor)
+                else:
+                    aux.set_block(j, self._const[j], coef, factor)
+            elif not fresh:
+                aux.set_block(j, self._const[j])
+        if fresh:
+            cvec = np.zeros(n + 1)
+            cvec[n] = 1.0
+            aux = self._phase_one_solver = BlockLMISolver(
+                cvec, blocks, tol_feas=PHASE_ONE_TOL, tol_gap_abs=PHASE_ONE_TOL,
+                tol_gap_rel=PHASE_ONE_TOL, max_iter=PHASE_ONE_MAX_ITER, factors=factors)
+        return aux
+
     def _initial_point(self, cvec: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """CVXOPT's initial point: least squares, shifted into the interiors."""
         g_mat, h_vec = self._g_mat, self._h_vec
@@ -344,7 +472,9 @@ class BlockLMISolver:
         z = self._shift_interior(self._unpack(-g_mat @ cho_solve(gtg_f, cvec)))
         return x, s, z
 
-    def _run(self, warm: tuple | None, max_iter: int) -> IPMResult:
+    def _run(self, warm: tuple | None, max_iter: int, monitor: Any = None) -> IPMResult:
+        """The iterations. ``monitor(x, s, z)`` (optional, phase one) is called at every iterate
+        with the equilibrated ``x``; a word it returns ends the run with that status."""
         n = self.n
         lay = self._layout
         packing = lay.arrays
@@ -398,6 +528,9 @@ class BlockLMISolver:
                 break
             if max(pres, dres) <= REDUCED_TOL and min(gap, rel_gap) <= REDUCED_TOL:
                 best = (x, s, z, pres, dres, gap)
+            if monitor is not None and (word := monitor(x, s, z)) is not None:
+                status, best = word, None
+                break
             merits.append(max(pres, dres, min(gap, rel_gap)))
             if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW]:
                 status = "insufficient_progress"
@@ -504,6 +637,115 @@ def _load_kernels() -> None:
         return
     _KERNELS_LOADED.set()
     BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
+
+
+class _PhaseOneCheck:
+    """Phase one's monitor: is the iterate a strictly feasible point or does its dual point,
+    corrected onto ``A'Z = 0``, prove infeasibility? (see :meth:`BlockLMISolver.phase_one`).
+    What it found is left in ``found``."""
+
+    def __init__(self, solver: BlockLMISolver, aux_scale: np.ndarray) -> None:
+        self.solver = solver
+        self.aux_scale = aux_scale
+        self.found: dict[str, Any] = {}
+
+    def __call__(self, x: np.ndarray, s: np.ndarray | None, z: np.ndarray) -> str | None:
+        slv = self.solver
+        n, lay = slv.n, slv._layout
+        packing = lay.arrays
+        t = float(x[n] * self.aux_scale[n])
+        if t < 0.0:
+            xo = x[:n] * self.aux_scale[:n]
+            slack = _kernels.unpack(slv._h_vec - slv._g_mat @ (xo / slv._dscale), *packing, slv._kmax)
+            chol = np.zeros_like(slack)
+            if _kernels.cholesky_blocks(slack, lay.orders, chol):
+                self.found = {"x": xo, "t": t}
+                return "feasible"
+        h = slv._h_vec
+        zp = _kernels.pack(z, *packing)
+        if float(h @ zp) >= 0.0:  # -<C, Z> <= 0 before the correction: not yet
+            return None
+        # the correction succeeds only once the dual residual is small compared with Z's
+        # smallest eigenvalues, i.e. near the end of phase one (measured on the stress set:
+        # residuals 1e-11..1e-10 of unit-trace Z); it costs a least-squares solve
+        if float(np.linalg.norm(slv._g_mat.T @ zp)) > PHASE_ONE_RESIDUAL * float(np.linalg.norm(zp)):
+            return None
+        blocks = _dual_correction(slv, z)
+        if blocks is None:
+            return None
+        zc = np.zeros_like(z)
+        for j, k in enumerate(slv.block_orders):
+            zc[j, :k, :k] = blocks[j]
+        zp = _kernels.pack(zc, *packing)
+        z_norm = float(np.linalg.norm(zp))
+        objective = float(h @ zp)
+        if not (z_norm > 0.0 and objective <= -PHASE_ONE_MARGIN * float(np.linalg.norm(h)) * z_norm):
+            return None
+        worst = np.inf
+        for zj in blocks:
+            lam = np.linalg.eigvalsh(zj)
+            worst = min(worst, float(lam[0] / max(float(np.max(np.abs(lam))), 1e-300)))
+        if not worst >= 0.0:
+            return None
+        # |sum_j <A_ij, Z_j>| relative to ||A_i|| ||Z|| (the equilibrated columns have unit norm)
+        residual = float(np.max(np.abs(slv._g_mat.T @ zp), initial=0.0)) / z_norm
+        self.found = {"Z": blocks, "objective": objective, "residual": residual,
+                      "min_eigenvalue": worst, "t": t}
+        return "infeasible"
+
+
+def _dual_correction(slv: BlockLMISolver, z: np.ndarray) -> list[np.ndarray] | None:
+    """``Z`` (positive definite blocks, padded) moved onto ``sum_j <A_ij, Z_j> = 0`` by the
+    correction of least norm in ``Z``'s own metric: with ``Z_j = L_j L_j'``, ``Z_j + dZ_j =
+    L_j (I + F_j) L_j'`` with ``||F||_F`` least, i.e. ``F`` the least-norm solution of
+    ``sum_j <L_j' A_ij L_j, F_j> = -sum_j <A_ij, Z_j>``. The result is positive semidefinite
+    exactly when every ``I + F_j`` is (checked); a correction of least Frobenius norm in ``Z``'s
+    coordinates instead falls mostly on the directions where ``Z`` is small and made it
+    indefinite (measured). ``None`` when it is not positive definite or ``I + F`` is not."""
+    factors, cols = [], []
+    for j, k in enumerate(slv.block_orders):
+        try:
+            low = np.linalg.cholesky(z[j, :k, :k])
+        except np.linalg.LinAlgError:
+            return None
+        factors.append(low)
+        scaled = low.T @ (slv._coef[j] * slv._dscale[:, None, None]) @ low  # (n, k, k)
+        iu0, iu1, w = slv._layout.triangle(j)
+        cols.append(scaled[:, iu0, iu1] * w)
+    p_t = np.concatenate(cols, axis=1)  # (n, size): row i = packed L'A_i L
+    resid = slv._g_mat.T @ _kernels.pack(z, *slv._layout.arrays)
+    f_vec = np.linalg.lstsq(p_t, -resid, rcond=None)[0]
+    out = []
+    for j, k in enumerate(slv.block_orders):
+        rows = slv._layout.rows(j)
+        iu0, iu1, w = slv._layout.triangle(j)
+        f_mat = np.zeros((k, k))
+        f_mat[iu0, iu1] = f_vec[rows] / w
+        f_mat[iu1, iu0] = f_vec[rows] / w
+        inner = np.eye(k) + f_mat
+        if not float(np.linalg.eigvalsh(inner)[0]) >= 0.0:
+            return None
+        out.append(factors[j] @ inner @ factors[j].T)
+    return out
+
+
+def _with_identity(raw: BlockFactor | None, n: int, k: int) -> BlockFactor | None:
+    """Block ``j``'s factored coefficients with one more variable (index ``n``) of coefficient
+    ``-I``, or ``None`` if the dictionary lacks an identity column for some row."""
+    if raw is None:
+        return None
+    dmat, var, p, q, val = raw
+    unit = (np.count_nonzero(dmat, axis=0) == 1) & (np.max(dmat, axis=0) == 1.0)
+    row_of = np.argmax(np.abs(dmat), axis=0)
+    cols = []
+    for r in range(k):
+        hit = np.flatnonzero(unit & (row_of == r))
+        if hit.size == 0:
+            return None
+        cols.append(int(hit[0]))
+    idx = np.asarray(cols, dtype=np.int64)
+    return (dmat, np.concatenate([var, np.full(k, n, dtype=np.int64)]), np.concatenate([p, idx]),
+            np.concatenate([q, idx]), np.concatenate([val, -np.ones(k)]))
 
 
 def _entry_weight(p: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -16,6 +16,7 @@ from lmi.backend_clarabel import ClarabelKothare, RawResult
 from lmi.backend_ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
+from lmi.infeasibility import InfeasibilityCertificate
 from lmi.status import OPTIMAL, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
@@ -50,6 +51,11 @@ class LMISolution:
     backend : str
     x : ndarray
         The state the problem was solved at.
+    infeasibility : InfeasibilityCertificate or None
+        With status ``"infeasible"`` from the ``"ipm"`` back-end: the Farkas certificate its
+        phase one found, checked on the conic data of the problem as solved (normalised state,
+        balanced coordinates; see :mod:`lmi.infeasibility`). ``ok`` is always true here: an
+        unchecked proof never makes a status ``"infeasible"``.
     """
 
     status: str
@@ -63,6 +69,7 @@ class LMISolution:
     certificate: Certificate | None
     backend: str
     x: np.ndarray = field(repr=False)
+    infeasibility: InfeasibilityCertificate | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -113,8 +120,10 @@ class KothareProblem:
         Output constraints ``|(C x(k+i))_r| <= y_max_r`` for ``i >= 1`` (Kothare 1996, sec. 3.2).
     backend : str
         ``"ipm"`` (default: the toolkit's own structure-exploiting interior-point method
-        :mod:`lmi.ipm`, data built once, warm-started, any non-optimal solve handed to Clarabel;
-        :mod:`lmi.backend_ipm`), ``"clarabel"`` (Clarabel's own API, data built once) or
+        :mod:`lmi.ipm`, data built once, warm-started; a failed solve runs phase one, which
+        either proves the problem infeasible (status ``"infeasible"`` with
+        ``LMISolution.infeasibility``) or hands the state to Clarabel; :mod:`lmi.backend_ipm`),
+        ``"clarabel"`` (Clarabel's own API, data built once) or
         ``"cvxpy"`` with ``solver`` naming any installed
         cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
     solver : str, optional
@@ -250,7 +259,7 @@ class KothareProblem:
         if raw.Q is None or raw.Y is None:
             return LMISolution(
                 raw.status, np.nan, None, None, None, raw.solve_time, raw.iterations,
-                raw.solver_status, None, self.backend, x,
+                raw.solver_status, None, self.backend, x, raw.infeasibility,
             )
         s2 = scale**2
         q_mat = 0.5 * (raw.Q + raw.Q.T) * s2

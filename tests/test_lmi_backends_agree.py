@@ -195,14 +195,17 @@ def test_bad_solver_option_value_names_the_option():
 
 @pytest.mark.parametrize("backend", ["clarabel", "ipm"])
 def test_known_solver_options_are_applied(backend):
-    options = {"max_iter": 2} if backend == "clarabel" else {"max_iter": 2, "fallback": False}
+    # (the IPM's phase one, which would add its iterations after the failure, is off here)
+    options = {"max_iter": 2} if backend == "clarabel" else {"max_iter": 2, "fallback": False,
+                                                             "phase_one": False}
     prob = KothareProblem(**GOOD, backend=backend, solver_options=options)
     sol = prob.solve([1.0, 0.0])
     assert sol.status == "max_iterations" and sol.iterations == 2
 
 
 def test_ipm_failure_is_resolved_by_the_clarabel_fallback():
-    """With ``max_iter = 2`` the IPM stops early; the default fallback hands the state to Clarabel.
+    """With ``max_iter = 2`` the IPM stops early; phase one finds a strictly feasible point, so
+    the default fallback hands the state to Clarabel.
 
     The fallback solves the IPM's conic data, which are in the coordinates of
     :func:`lmi.scaling.state_scaling`: the same problem as Clarabel's own back-end, so ``gamma``
@@ -213,7 +216,7 @@ def test_ipm_failure_is_resolved_by_the_clarabel_fallback():
         opts = {"max_iter": 2, "state_scaling": scaling}
         sol = KothareProblem(**GOOD, solver_options=opts).solve([1.0, 0.0])
         assert sol.status == "optimal"
-        assert sol.solver_status == "ipm max_iterations; clarabel Solved"
+        assert sol.solver_status == "ipm max_iterations; phase one feasible; clarabel Solved"
         assert sol.gamma == pytest.approx(ref.gamma, rel=rel)
 
 
