@@ -255,6 +255,8 @@ class BlockLMISolver:
         self._factor_raw: list[BlockFactor | None] = [None] * len(checked)
         self._fact_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
         self._fact: tuple[np.ndarray, ...] = ()
+        self._groups: tuple[np.ndarray, np.ndarray] = (np.zeros(1, dtype=np.int64),
+                                                       np.zeros(0, dtype=np.int64))
         self._direct = False
         self._const: list[np.ndarray] = [const for const, _ in checked]
         self._phase_one_solver: BlockLMISolver | None = None
@@ -329,6 +331,7 @@ class BlockLMISolver:
         if rebuild:
             self._sparse = _concatenate_sparse(self._sparse_parts)
             self._fact = _concatenate_factors(self._fact_parts, self._kmax)
+            self._groups = _factor_groups(self._fact_parts, self._factor_raw)
             self._direct = self._direct_is_cheaper()
 
     def _factored_part(self, j: int) -> tuple[np.ndarray, ...]:
@@ -500,7 +503,6 @@ class BlockLMISolver:
         no_pt = np.zeros((n, 0))  # P not formed: the kernels use the sparse coefficients
         h_mat = np.zeros((n, n))
         sp = self._sparse
-        sp_args = (sp[0], sp[1], sp[2], sp[3], sp[5], sp[6])
         s_chol = np.zeros_like(s)
         status = "max_iterations"
         pres = dres = gap = np.inf
@@ -542,8 +544,8 @@ class BlockLMISolver:
                 break
             pt_use = pt_mat
             if self._direct and not use_qr:  # H from the factored coefficients, P not formed
-                if not _kernels.scaling_and_schur_direct(s_chol, z, orders, *self._fact, kk, lam,
-                                                         h_mat):
+                if not _kernels.scaling_and_schur_grouped(s_chol, z, orders, *self._fact,
+                                                          *self._groups, kk, lam, h_mat):
                     status = "numerical_error"
                     break
                 r_fac, use_qr = _cholesky(h_mat)
@@ -562,7 +564,7 @@ class BlockLMISolver:
             s_new, z_new, chol_new = np.zeros_like(s), np.zeros_like(z), np.zeros_like(s)
             code, x_new, theta, a_aff, sigma, alpha = _kernels.newton_step(
                 pt_use, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
-                max(c_norm, n_gtz), *packing, *sp_args, s_new, z_new, chol_new)
+                max(c_norm, n_gtz), *packing, *sp, s_new, z_new, chol_new)
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
             if code != 0:
@@ -767,6 +769,27 @@ def _concatenate_factors(parts: list[tuple[np.ndarray, ...]], kmax: int) -> tupl
         np.concatenate([part[3] for part in parts]).astype(np.int64),
         np.concatenate([part[4] for part in parts]).astype(float),
     )
+
+
+def _factor_groups(parts: list[tuple[np.ndarray, ...]],
+                   raw: list[BlockFactor | None]) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's ``grp_off, grp_blk`` (:func:`lmi.ipm_kernels.scaling_and_schur_grouped`):
+    blocks given in factored form whose order, dictionary width and entries are equal form one
+    group (a Kothare problem's vertex blocks); every other block is a group of its own. Groups
+    are ordered by their first block. Blocks without a given factor are never grouped: their
+    entry values change in place with the bound scalings (see ``_refresh``)."""
+    groups: list[list[int]] = []
+    for j, part in enumerate(parts):
+        for grp in groups:
+            head = parts[grp[0]]
+            if (raw[j] is not None and raw[grp[0]] is not None and part[0].shape == head[0].shape
+                    and all(np.array_equal(a, b) for a, b in zip(part[1:], head[1:], strict=True))):
+                grp.append(j)
+                break
+        else:
+            groups.append([j])
+    offsets = np.cumsum([0, *(len(g) for g in groups)]).astype(np.int64)
+    return offsets, np.array([j for g in groups for j in g], dtype=np.int64)
 
 
 def _check_factor(j: int, factor: Any, coef: np.ndarray | None, n: int) -> BlockFactor:

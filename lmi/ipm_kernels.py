@@ -33,7 +33,7 @@ from numba import njit
 
 __all__ = [
     "cholesky_blocks", "newton_step", "pack", "residuals", "scaling_and_schur_direct",
-    "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
+    "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
 ]
 
 #: At most this many steps of iterative refinement per Newton solve (each stops early once
@@ -217,36 +217,54 @@ def scaling_and_schur_direct(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_
     of the number of entries, not ``rows x n^2``. With ``D = I`` this is the sparse formula of
     SDPA (Fujisawa, Kojima, Nakata 1997); with the Kothare blocks' dictionaries
     (:mod:`lmi.kothare_factors`) a vertex block of order ``2n`` has about ``5 n^2 / 2`` entries.
-    Returns ``False`` if a block lost positive definiteness.
+    Returns ``False`` if a block lost positive definiteness. Every block is its own group of
+    :func:`scaling_and_schur_grouped` (the same arithmetic, in the same order).
+    """
+    nb = orders.shape[0]
+    return scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p,
+                                     fe_q, fe_val, np.arange(nb + 1), np.arange(nb), kk_out,
+                                     lam_out, h_out)
+
+
+@njit(**_JIT)
+def scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q,
+                              fe_val, grp_off, grp_blk, kk_out, lam_out, h_out):
+    """:func:`scaling_and_schur_direct` with blocks that share their entries summed together.
+
+    The blocks ``grp_blk[grp_off[g]:grp_off[g + 1]]`` of group ``g`` have the same order,
+    dictionary width and entries (``fe_var``, ``fe_p``, ``fe_q``, ``fe_val``; those of the
+    group's first block are used); only their dictionaries ``D_j`` and NT points differ, as for
+    the vertex blocks of a Kothare problem (only ``A_j``, ``B_j`` change from vertex to vertex).
+    Their ``G_j`` are stacked ``(d, d, members)``, so a pair of entries reads its indices once
+    and the group's ``G`` values from contiguous memory: ``c = v v' sum_j (G_j,pr G_j,qs +
+    G_j,ps G_j,qr)``, the sum over ``j`` compiled with re-association allowed (vectorised; its
+    rounding differs from the block-by-block sum). A group of one block does the arithmetic of
+    :func:`scaling_and_schur_direct` bit for bit. Groups are summed into ``H`` in their order.
     """
     n = h_out.shape[0]
     for a in range(n):
         for b in range(n):
             h_out[a, b] = 0.0
-    for j in range(orders.shape[0]):
-        k = orders[j]
-        if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
-            return False
-        d = dict_dims[j]
-        kd = np.ascontiguousarray(kk_out[j, :k, :k]) @ np.ascontiguousarray(dict_mat[j, :k, :d])
-        g = kd.T @ kd
-        for e1 in range(fe_off[j], fe_off[j + 1]):
-            i1 = fe_var[e1]
-            p, q = fe_p[e1], fe_q[e1]
-            v1 = fe_val[e1]
-            gp = g[p]
-            gq = g[q]
-            hrow = h_out[i1]
-            # the pair (e1, e1) once, pairs (e1, e2 > e1) of the same variable twice (for
-            # (e2, e1)), pairs with a later variable once (H is mirrored below)
-            hrow[i1] += v1 * v1 * (gp[p] * gq[q] + gp[q] * gq[p])
-            for e2 in range(e1 + 1, fe_off[j + 1]):
-                r, t = fe_p[e2], fe_q[e2]
-                c = v1 * fe_val[e2] * (gp[r] * gq[t] + gp[t] * gq[r])
-                i2 = fe_var[e2]
-                if i2 == i1:
-                    c *= 2.0
-                hrow[i2] += c
+    for g in range(grp_off.shape[0] - 1):
+        first = grp_blk[grp_off[g]]
+        members = grp_off[g + 1] - grp_off[g]
+        k = orders[first]
+        d = dict_dims[first]
+        gs = np.empty((d, d, members))
+        for jj in range(members):
+            j = grp_blk[grp_off[g] + jj]
+            if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
+                return False
+            kd = np.ascontiguousarray(kk_out[j, :k, :k]) @ np.ascontiguousarray(dict_mat[j, :k, :d])
+            gj = kd.T @ kd
+            if members == 1:
+                _pair_sum(gj, fe_off[first], fe_off[first + 1], fe_var, fe_p, fe_q, fe_val, h_out)
+            else:
+                for a in range(d):
+                    for b in range(d):
+                        gs[a, b, jj] = gj[a, b]
+        if members > 1:
+            _pair_sum_group(gs, fe_off[first], fe_off[first + 1], fe_var, fe_p, fe_q, fe_val, h_out)
     for a in range(n):
         for b in range(a + 1, n):
             h_out[b, a] = h_out[a, b]
@@ -254,45 +272,98 @@ def scaling_and_schur_direct(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_
 
 
 @njit(**_JIT)
+def _pair_sum(g, lo, hi, fe_var, fe_p, fe_q, fe_val, h_out):
+    """One block's pairs of entries ``lo:hi`` into the upper triangle of ``h_out`` (see
+    :func:`scaling_and_schur_direct`)."""
+    for e1 in range(lo, hi):
+        i1 = fe_var[e1]
+        p, q = fe_p[e1], fe_q[e1]
+        v1 = fe_val[e1]
+        gp = g[p]
+        gq = g[q]
+        hrow = h_out[i1]
+        # the pair (e1, e1) once, pairs (e1, e2 > e1) of the same variable twice (for
+        # (e2, e1)), pairs with a later variable once (H is mirrored by the caller)
+        hrow[i1] += v1 * v1 * (gp[p] * gq[q] + gp[q] * gq[p])
+        for e2 in range(e1 + 1, hi):
+            r, t = fe_p[e2], fe_q[e2]
+            c = v1 * fe_val[e2] * (gp[r] * gq[t] + gp[t] * gq[r])
+            i2 = fe_var[e2]
+            if i2 == i1:
+                c *= 2.0
+            hrow[i2] += c
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract", "nsz"})
+def _pair_sum_group(gs, lo, hi, fe_var, fe_p, fe_q, fe_val, h_out):
+    """:func:`_pair_sum` for a group of blocks with the same entries, ``gs`` ``(d, d, members)``;
+    the sum over the members may be re-associated (vectorised)."""
+    members = gs.shape[2]
+    for e1 in range(lo, hi):
+        i1 = fe_var[e1]
+        p, q = fe_p[e1], fe_q[e1]
+        v1 = fe_val[e1]
+        gp = gs[p]
+        gq = gs[q]
+        hrow = h_out[i1]
+        s = 0.0
+        for jj in range(members):
+            s += gp[p, jj] * gq[q, jj] + gp[q, jj] * gq[p, jj]
+        hrow[i1] += v1 * v1 * s
+        for e2 in range(e1 + 1, hi):
+            r, t = fe_p[e2], fe_q[e2]
+            s = 0.0
+            for jj in range(members):
+                s += gp[r, jj] * gq[t, jj] + gp[t, jj] * gq[r, jj]
+            c = v1 * fe_val[e2] * s
+            i2 = fe_var[e2]
+            if i2 == i1:
+                c *= 2.0
+            hrow[i2] += c
+
+
+@njit(**_JIT)
 def _pt_times(pt, v, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-              pair_row, pair_col, n):
+              pair_off, pair_row, pair_col, n):
     """``P' v`` for a packed ``v``: ``pt @ v`` if ``P`` is formed (``pt`` has columns), else
-    ``sum_j <A_ij, K_j' V_j K_j>`` from the sparse coefficients."""
+    ``sum_j <A_ij, K_j' V_j K_j>`` from the sparse coefficients: ``M = K_j' V_j K_j``, then
+    ``M_ab + M_ba`` (``M_aa`` on the diagonal) once per position pair, then one multiply-add
+    per coefficient entry."""
     if pt.shape[1] > 0:
         return pt @ v
     out = np.zeros(n)
+    mp = np.empty(pair_row.shape[0])
     for j in range(orders.shape[0]):
         k = orders[j]
         kj = np.ascontiguousarray(kk[j, :k, :k])
         m = kj.T @ _unpack_block(v, j, k, offsets, ent_row, ent_col, ent_w) @ kj
-        for e in range(sp_off[j], sp_off[j + 1]):
-            q = sp_pair[e]
+        for q in range(pair_off[j], pair_off[j + 1]):
             a, b = pair_row[q], pair_col[q]
-            if a == b:
-                out[sp_var[e]] += sp_val[e] * m[a, a]
-            else:
-                out[sp_var[e]] += sp_val[e] * (m[a, b] + m[b, a])
+            mp[q] = m[a, a] if a == b else m[a, b] + m[b, a]
+        for e in range(sp_off[j], sp_off[j + 1]):
+            out[sp_var[e]] += sp_val[e] * mp[sp_pair[e]]
     return out
 
 
 @njit(**_JIT)
 def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-             pair_row, pair_col):
+             pair_off, pair_row, pair_col):
     """``P dx`` (packed): ``pt.T @ dx`` if ``P`` is formed, else the packed
-    ``K_j (sum_i dx_i A_ij) K_j'`` from the sparse coefficients."""
+    ``K_j (sum_i dx_i A_ij) K_j'`` from the sparse coefficients (summed per position pair, in
+    entry order)."""
     if pt.shape[1] > 0:
         return pt.T @ dx
     out = np.empty(offsets[-1])
+    acc_pair = np.zeros(pair_row.shape[0])
     for j in range(orders.shape[0]):
         k = orders[j]
-        acc = np.zeros((k, k))
         for e in range(sp_off[j], sp_off[j + 1]):
-            q = sp_pair[e]
+            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
+        acc = np.zeros((k, k))
+        for q in range(pair_off[j], pair_off[j + 1]):
             a, b = pair_row[q], pair_col[q]
-            val = sp_val[e] * dx[sp_var[e]]
-            acc[a, b] += val
-            if a != b:
-                acc[b, a] += val
+            acc[a, b] = acc_pair[q]
+            acc[b, a] = acc_pair[q]
         kj = np.ascontiguousarray(kk[j, :k, :k])
         _pack_block(kj @ acc @ kj.T, j, offsets, ent_row, ent_col, ent_w, out)
     return out
@@ -302,12 +373,11 @@ def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_va
 def _triangular_solve(r_fac, b):
     """``x`` with ``R'R x = b`` for upper triangular ``R``."""
     n = b.shape[0]
-    y = np.empty(n)
-    for i in range(n):  # R' y = b (forward)
-        s = b[i]
-        for p in range(i):
-            s -= r_fac[p, i] * y[p]
-        y[i] = s / r_fac[i, i]
+    y = b.copy()
+    for i in range(n):  # R' y = b (forward), by rows of R: the subtractions of a row-by-column
+        y[i] = y[i] / r_fac[i, i]  # loop in the same order (p ascending), contiguous reads
+        for p in range(i + 1, n):
+            y[p] -= r_fac[i, p] * y[i]
     x = np.empty(n)
     for i in range(n - 1, -1, -1):  # R x = y (backward)
         s = y[i]
@@ -323,7 +393,7 @@ def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_
 
     Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
     refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks. ``sp`` holds the
-    sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_row, pair_col)`` used for the
+    sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)`` used for the
     products with ``P`` when ``P`` is not formed (see :func:`_pt_times`).
     """
     n = rd.shape[0]
@@ -467,8 +537,8 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
 
 @njit(**_JIT)
 def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
-                orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_row,
-                pair_col, s_out, z_out, chol_out):
+                orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+                pair_row, pair_col, s_out, z_out, chol_out):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
 
     The new ``S`` is recomputed from ``x`` as ``h - G x + theta r0`` (``theta`` decays by
@@ -499,7 +569,7 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
         k = orders[j]
         for a in range(k):
             u[_diagonal_entry(offsets, j, k, a)] = -lam[j, a]
-    sp = (sp_off, sp_var, sp_pair, sp_val, pair_row, pair_col)
+    sp = (sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)
     _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col,
                             ent_w, sp)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))

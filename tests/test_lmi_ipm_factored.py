@@ -192,3 +192,78 @@ def test_rigid_hub_converges_with_the_state_scaling():
             assert want.status == "optimal"
             assert abs(got.gamma - want.gamma) <= 1e-7 * want.gamma
     assert gammas[8] >= gammas[2] * (1.0 - 1e-8)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_grouped_schur_complement_is_the_trace_formula(seed):
+    """Blocks that share their entries (a group, as the Kothare vertex blocks) summed together
+    by :func:`lmi.ipm_kernels.scaling_and_schur_grouped`: ``H`` equals the plain numpy
+    ``sum_j tr(A_ij W^-1 A_kj W^-1)`` within ``1e-11 max |H|`` and the block-by-block kernel
+    (:func:`lmi.ipm_kernels.scaling_and_schur_direct`) within ``1e-13 max |H|`` (only the
+    order of the sum over the group differs)."""
+    rng = np.random.default_rng(100 + seed)
+    n, k, d, count, members = 6, 7, 9, 30, int(rng.integers(2, 9))
+    base, _ = _random_factor(rng, n, k, d, count)
+    _, var, p, q, val = base
+    factors = [(rng.normal(size=(k, d)), var, p, q, val) for _ in range(members)]
+    single, single_coef = _random_factor(rng, n, 5, 4, 12)
+    factors.insert(1, single)  # a group of one between the group's members
+    orders = [k if f is not single else 5 for f in factors]
+    coefs = []
+    for f in factors:
+        nmat = np.zeros((n, f[0].shape[1], f[0].shape[1]))
+        np.add.at(nmat, (f[1], f[2], f[3]), f[4])
+        off = f[2] != f[3]
+        np.add.at(nmat, (f[1][off], f[3][off], f[2][off]), f[4][off])
+        coefs.append(np.einsum("ka,iab,lb->ikl", f[0], nmat, f[0]))
+    nb, kmax, dmax = len(orders), max(orders), d
+    s_blocks = [_rand_pd(rng, kj) for kj in orders]
+    z_blocks = [_rand_pd(rng, kj) for kj in orders]
+    s_chol = np.zeros((nb, kmax, kmax))
+    z = np.zeros((nb, kmax, kmax))
+    dict_mat = np.zeros((nb, kmax, dmax))
+    fe = [[], [], [], []]
+    off_list = [0]
+    for j, (kj, f) in enumerate(zip(orders, factors, strict=True)):
+        s_chol[j, :kj, :kj] = np.linalg.cholesky(s_blocks[j])
+        z[j, :kj, :kj] = z_blocks[j]
+        dict_mat[j, :kj, : f[0].shape[1]] = f[0]
+        order = np.argsort(f[1], kind="stable")
+        weight = np.where(f[2] == f[3], 0.5, 1.0) * np.sqrt(2.0)
+        for lst, arr in zip(fe, (f[1], f[2], f[3], f[4] * weight), strict=True):
+            lst.append(arr[order])
+        off_list.append(off_list[-1] + f[1].size)
+    args = (s_chol, z, np.array(orders, dtype=np.int64), dict_mat,
+            np.array([f[0].shape[1] for f in factors], dtype=np.int64), np.array(off_list, dtype=np.int64),
+            *(np.concatenate(a).astype(np.int64) for a in fe[:3]), np.concatenate(fe[3]))
+    group = [0, *range(2, nb)]
+    grp_off = np.array([0, len(group), nb], dtype=np.int64)
+    grp_blk = np.array([*group, 1], dtype=np.int64)
+    h_grp, h_dir = np.full((n, n), np.nan), np.full((n, n), np.nan)
+    kk, lam = np.zeros((nb, kmax, kmax)), np.zeros((nb, kmax))
+    assert kernels.scaling_and_schur_grouped(*args, grp_off, grp_blk, kk, lam, h_grp)
+    assert kernels.scaling_and_schur_direct(*args, kk.copy(), lam.copy(), h_dir)
+    want = np.zeros((n, n))
+    for s, zj, coef in zip(s_blocks, z_blocks, coefs, strict=True):
+        root = _psd_sqrt(s)
+        w_inv = np.linalg.solve(root, np.linalg.solve(root, _psd_sqrt(root @ zj @ root)).T).T
+        w_inv = 0.5 * (w_inv + w_inv.T)
+        want += np.einsum("iab,bc,kcd,da->ik", coef, w_inv, coef, w_inv)
+    scale = np.max(np.abs(want))
+    assert np.array_equal(h_grp, h_grp.T)
+    assert np.max(np.abs(h_grp - want)) <= 1e-11 * scale
+    assert np.max(np.abs(h_grp - h_dir)) <= 1e-13 * scale
+    del single_coef
+
+
+def test_kothare_vertex_blocks_form_one_group():
+    """The 8 vertex blocks of the 14-state flexible problem share their entries: one group."""
+    from benchmarks.timing.scale import scale_problem
+
+    spec = scale_problem(14, 8)
+    x0 = spec.pop("x0")
+    prob = KothareProblem(**spec, backend="ipm")
+    prob.solve(x0)
+    solver = prob._backend._solver
+    sizes = np.diff(solver._groups[0])
+    assert sorted(sizes.tolist())[-1] == 8 and sizes.sum() == len(solver.block_orders)
