@@ -93,7 +93,11 @@ class FlexibleHybrid:
         extra.update(getattr(self.attitude.last, "extra", {}) or {})
         statuses = [getattr(c.last, "status", "ok") for c in (self.attitude, self.vibration) if c is not None]
         status = next((s for s in statuses if s != "ok"), "ok")
-        self.last = StepInfo(status=status, solve_time=time.perf_counter() - start, extra=extra)
+        laws = [c for c in (self.attitude, self.vibration) if c is not None]
+        fallback = any(bool(getattr(c.last, "fallback", False)) for c in laws)
+        self.last = StepInfo(
+            status=status, solve_time=time.perf_counter() - start, fallback=fallback, extra=extra
+        )
         return u
 
     def __repr__(self) -> str:

@@ -10,7 +10,7 @@ import pytest
 from benchmarks.cli import main
 from benchmarks.core.scenario import Scenario, run_scenario
 from benchmarks.families.flexible.family import eta1_frequency
-from benchmarks.suites.flexible import flexible_cases, inconsistencies
+from benchmarks.suites.flexible import F4_MODAL_BOUND, MODAL_BOUND_POLYTOPE, flexible_cases, inconsistencies
 from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 from toolkit_common.errors import ConfigError
 
@@ -34,6 +34,12 @@ CONTRACT_KEYS = (
         ({"settings": {"shrink": 1.5}}, "shrink"),
         ({"scenario": "M2"}, "scenario"),  # an mrp-family field
         ({"controller": "RMPC", "handover_deg": 20.0}, "handover_deg"),
+        ({"modal_bound": 0.0}, "modal_bound"),
+        ({"modal_bound": -0.02}, "modal_bound"),
+        ({"modal_bound": float("inf")}, "modal_bound"),
+        ({"modal_bound": "0.02"}, "modal_bound"),
+        ({"controller": "MTSMC", "modal_bound": 0.02}, "modal_bound"),
+        ({"settings": {"formulation": "exact"}}, "formulation"),
     ],
 )
 def test_bad_flexible_fields_name_the_field(data, field):
@@ -61,9 +67,18 @@ def test_suite_cases_cover_the_four_experiments():
     gains = sorted(s.integral_gain for s in by_exp["F3"] if s.controller == "MTSMC")
     assert gains == sorted(F3_INTEGRAL_GAINS)
     assert {s.experiment for s in by_exp["F3"]} == {"steady"}
-    f4 = {s.controller: s for s in by_exp["F4"] if s.handover_deg is None}
+    f4 = {
+        s.controller: s
+        for s in by_exp["F4"]
+        if s.handover_deg is None and s.settings.get("polytope", "groups") == "groups"
+    }
     assert set(f4) == {"MTSMC", "LQR", "OfflineRMPC", "RMPC"}
     assert {s.experiment for s in f4.values()} == {"small"}
+    assert {s.duration for s in f4.values()} == {None}  # every F4 run is the whole slew
+    assert f4["RMPC"].settings["polytope"] == f4["OfflineRMPC"].settings["polytope"] == "groups"
+    pair = [s for s in by_exp["F4"] if s.settings.get("polytope") == MODAL_BOUND_POLYTOPE]
+    assert sorted(s.modal_bound or 0.0 for s in pair) == [0.0, F4_MODAL_BOUND]
+    assert {(s.controller, s.experiment) for s in pair} == {("RMPC", "small")}
     (hand,) = [s for s in by_exp["F4"] if s.handover_deg is not None]
     assert (hand.controller, hand.experiment, hand.dt) == ("OfflineRMPC", "vslew", 0.01)
     assert f4["RMPC"].saturation == f4["OfflineRMPC"].saturation == "constraint"

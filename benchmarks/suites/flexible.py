@@ -9,9 +9,10 @@ F1    the V-slew (160 deg): {MTSMC, CSMC (tanh)} x {AVC off, on}, paper V's 2x2 
 F2    the boundary layer: MTSMC and CSMC (tanh) at each eps of F2_EPSILONS, CSMC (sign)
 F3    steady error at the target under 0.05 N m per axis: MTSMC with k_I in F3_INTEGRAL_GAINS,
       CSMC
-F4    a 15 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model
-      against MTSMC and the LQR reference; the V-slew by MTSMC handing over to OfflineRMPC
-      inside 20 deg
+F4    a 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model
+      over the 8-vertex polytope (inertia, modal frequencies, damping) against MTSMC and the
+      LQR reference, RMPC with a bound on the modal coordinates; the V-slew by MTSMC handing
+      over to OfflineRMPC inside 20 deg
 ====  =====================================================================================
 
 :func:`flexible_cases` lists the cases; :func:`run_flexible` runs them in parallel and writes
@@ -43,7 +44,15 @@ from benchmarks.families.flexible import defaults
 from benchmarks.reports.tables import to_markdown
 from toolkit_common.errors import ConfigError
 
-__all__ = ["EXPERIMENTS", "F4_RMPC_DURATION", "flexible_cases", "paper_v_comparison", "run_flexible"]
+__all__ = [
+    "EXPERIMENTS",
+    "F4_MODAL_BOUND",
+    "MODAL_BOUND_POLYTOPE",
+    "REACH_GAMMAS",
+    "flexible_cases",
+    "paper_v_comparison",
+    "run_flexible",
+]
 
 #: Experiment -> what it shows.
 EXPERIMENTS: dict[str, str] = {
@@ -51,17 +60,27 @@ EXPERIMENTS: dict[str, str] = {
     "F2": "The boundary layer eps of the tanh switching term: MTSMC and CSMC (tanh) per eps, CSMC (sign).",
     "F3": "Steady error at the target under a constant 0.05 N m per axis (250 s): MTSMC with and "
     "without the integral term, CSMC.",
-    "F4": "A 15 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model "
-    "(0.5 s period, per-axis peak bound) against MTSMC and the LQR reference; and the 160 deg V-slew "
-    "by MTSMC handing over to OfflineRMPC (0.01 s) inside 20 deg.",
+    "F4": "A 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model "
+    "over the 8-vertex polytope (0.5 s period, per-axis peak bound) against MTSMC and the LQR "
+    "reference; RMPC with and without |eta_i| <= 0.02 on the 2-vertex polytope; and the 160 deg "
+    "V-slew by MTSMC handing over to OfflineRMPC (0.01 s) inside 20 deg.",
 }
 
 #: The fraction of each run length kept by ``--short``.
 SHORT_TIME_SCALE = 0.02
 
-#: Run length (s) of F4's on-line RMPC: each 14-state solve takes seconds (see the report), so it
-#: runs the start of the slew only (multiplied by the time scale like every run).
-F4_RMPC_DURATION = 20.0
+#: F4's bound on every modal coordinate (kg^1/2 m) for the RMPC case with the output constraint
+#: (without it, RMPC's peak ``|eta_1|`` on the 10 deg slew is about 0.066 on this polytope).
+F4_MODAL_BOUND = 0.02
+#: The polytope of F4's modal-bound pair (RMPC with and without the bound): on the 8-vertex
+#: 'groups' polytope the ipm's answers with the output constraint are 'inaccurate' and fail the
+#: certificate (margins down to -2e-3), so every step would fall back; the 2-vertex
+#: torque-effectiveness polytope is solved and certified at every step.
+MODAL_BOUND_POLYTOPE = "effectiveness"
+
+#: Cost bounds ``gamma_s = dt gamma`` at which the report measures how far along the slew axis the
+#: LMIs reach (:func:`benchmarks.families.flexible.region.slew_reach`).
+REACH_GAMMAS = (100.0, 1000.0)
 
 #: F4's hand-over on the V-slew: MTSMC until the rotation error is below this angle (deg), then
 #: OfflineRMPC (seed 9: "inside ~20 deg").
@@ -95,7 +114,7 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
     --------
     >>> cases = flexible_cases()
     >>> len(cases), sorted({c.experiment for c in cases})
-    (23, ['F1', 'F2', 'F3', 'F4'])
+    (25, ['F1', 'F2', 'F3', 'F4'])
     """
     from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 
@@ -127,10 +146,12 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
             cases.append(_case(exp, "CSMC", {**base, "controller": "CSMC", "experiment": "steady"}))
         else:
             for ctrl in ("MTSMC", "LQR", "OfflineRMPC", "RMPC"):
-                data = {**base, "controller": ctrl, "experiment": "small"}
-                if ctrl == "RMPC":
-                    data["duration"] = max(F4_RMPC_DURATION * time_scale, defaults.LINEAR_PERIOD)
-                cases.append(_case(exp, ctrl, data))
+                cases.append(_case(exp, ctrl, {**base, "controller": ctrl, "experiment": "small"}))
+            for bound in (None, F4_MODAL_BOUND):
+                data = {**base, "controller": "RMPC", "experiment": "small", "modal_bound": bound}
+                data["settings"] = {"polytope": MODAL_BOUND_POLYTOPE}
+                tag = "RMPC_effectiveness" + ("" if bound is None else "_modal_bound")
+                cases.append(_case(exp, tag, data))
             data = {
                 **base,
                 "controller": "OfflineRMPC",
@@ -144,9 +165,9 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
 def _cost(case: SuiteCase) -> float:
     sc = case.scenario
     if sc.controller == "RMPC":
-        return 100.0
+        return 100.0 if sc.settings["polytope"] == "groups" else 10.0
     if sc.controller == "OfflineRMPC":
-        return 15.0 if sc.handover_deg is None else 25.0
+        return 100.0 if sc.handover_deg is None else 150.0
     return {"vslew": 15.0, "steady": 25.0, "small": 10.0}[sc.experiment] * (1.5 if sc.avc else 1.0)
 
 
@@ -179,8 +200,13 @@ def _ms(value: float | None) -> str:
 def case_row(rec: dict[str, Any]) -> dict[str, str]:
     """The table row of one record."""
     m, s = rec["metrics"], rec["settings"]
+    name = s["controller_name"]
+    if rec["controller"] in ("RMPC", "OfflineRMPC"):
+        name += f" ({s['settings']['polytope']}" + (
+            f", |eta| <= {s['modal_bound']:g})" if s.get("modal_bound") is not None else ")"
+        )
     return {
-        "closed loop": s["controller_name"],
+        "closed loop": name,
         "switch / eps / k_I": (
             f"{s['switch'] if rec['controller'] == 'CSMC' else '-'} / "
             f"{s['epsilon']:g} / {s['integral_gain']:g}"
@@ -350,35 +376,78 @@ def _steady_lines(records: list[dict[str, Any]]) -> list[str]:
     return ["Steady error against the seed's prediction:", "", *rows, ""]
 
 
+def _status_summary(counts: dict[str, int]) -> str:
+    """Statuses grouped: solved (optimal / inaccurate), held, infeasible, outside, other."""
+    groups = {"optimal": 0, "inaccurate": 0, "reused": 0, "infeasible": 0, "outside": 0, "ok": 0, "other": 0}
+    for key, value in counts.items():
+        groups[key if key in groups else "other"] += value
+    return ", ".join(f"{k} {v}" for k, v in groups.items() if v)
+
+
+def _us(value: float | None) -> str:
+    """A time in microseconds, or in milliseconds from 1 ms on."""
+    if value is None:
+        return "-"
+    return f"{1e3 * value:.3g} ms" if value >= 1e-3 else f"{1e6 * value:.3g} us"
+
+
 def _f4_lines(records: list[dict[str, Any]]) -> list[str]:
     recs = [r for r in records if r["experiment"] == "F4" and r["controller"] in ("RMPC", "OfflineRMPC")]
     if not recs:
         return []
-    lines = ["What the robust MPC costs on the 14-state model:", ""]
+    lines = ["What the robust MPC costs on the 14-state model (per-step times against the sample time):", ""]
     for r in recs:
         m, s = r["metrics"], r["settings"]
         solves = sum(v for k, v in m["status_counts"].items() if k not in ("reused", "ok"))
         lines.append(
-            f"- {s['controller_name']}: polytope '{r['settings']['settings']['polytope']}' "
-            f"({s['n_vertices']} vertices), built in {m['build_time_s']:.2f} s"
+            f"- {s['controller_name']}"
+            + (f" (|eta_i| <= {s['modal_bound']:g})" if s.get("modal_bound") is not None else "")
+            + f": polytope '{s['settings']['polytope']}' ({s['n_vertices']} vertices), built in "
+            f"{m['build_time_s']:.2f} s"
             + (f", handed over at {s['handover_time']:g} s" if s.get("handover_time") is not None else "")
             + (
-                f" (table of {s['n_ellipsoids']} ellipsoids in {s['offline_design_time_s']:.2f} s, "
+                f" (table of {s['n_ellipsoids']} ellipsoids in {s['offline_design_time_s']:.1f} s, "
                 f"{s['offline_stop_reason']})"
                 if s["n_ellipsoids"] is not None
                 else ""
             )
-            + f"; {s['duration_used']:g} s at {s['dt']:g} s: {solves} solves or lookups (of "
-            f"{sum(m['status_counts'].values())} steps), p50 "
-            f"{_ms(m['solve_time_solves_p50'])} ms, p95 {_ms(m['solve_time_solves_p95'])} ms; statuses "
-            + ", ".join(f"{k} {v}" for k, v in sorted(m["status_counts"].items()))
-            + "."
+            + f"; {s['duration_used']:g} s at dt = {s['dt']:g} s: per step p50 {_us(m['step_time_p50'])}, "
+            f"p95 {_us(m['step_time_p95'])} ({100 * m['step_time_p95'] / s['dt']:.3g} % of dt at p95); "
+            f"{solves} solves or lookups, p50 {_ms(m['solve_time_solves_p50'])} ms, p95 "
+            f"{_ms(m['solve_time_solves_p95'])} ms; statuses {_status_summary(m['status_counts'])}; "
+            f"fallbacks {m.get('fallback_steps', '-')}."
         )
     lines.append(
-        "- Statuses: ok, MTSMC's steps before the hand-over; optimal / reused, a solved (or looked-up) or "
-        "held robust MPC step; outside, beyond the table's largest ellipsoid (its outermost gain applied "
-        "without guarantee); any other word is a solver failure, the step then applies the fallback input."
+        "- Statuses: ok, MTSMC's steps before the hand-over; optimal / inaccurate, a solved or looked-up "
+        "step (an answer that fails the certificate is applied as a fallback, counted in fallbacks); "
+        "reused, RMPC holding its gain inside its ellipsoid; outside, beyond the table's largest "
+        "ellipsoid (its outermost gain applied without guarantee); infeasible or any other word, a "
+        "solver failure: the step applies the last certified gain (fallback)."
     )
+    pair = [
+        r
+        for r in recs
+        if r["controller"] == "RMPC" and r["settings"]["settings"]["polytope"] == MODAL_BOUND_POLYTOPE
+    ]
+    free = next((r for r in pair if r["settings"].get("modal_bound") is None), None)
+    bound = next((r for r in pair if r["settings"].get("modal_bound") is not None), None)
+    if free is not None and bound is not None:
+        b = bound["settings"]["modal_bound"]
+        fm, bm = free["metrics"], bound["metrics"]
+
+        def modes(values: list[float]) -> str:
+            return ", ".join(f"{v:.3g}" for v in values)
+
+        lines.append(
+            f"- Modal bound |eta_i| <= {b:g} kg^1/2 m (Kothare's output constraint, RMPC on the "
+            f"'{MODAL_BOUND_POLYTOPE}' polytope; guaranteed at the samples for the linear polytope only, "
+            "here measured on the nonlinear plant with its disturbance): peak |eta_i| without "
+            f"({modes(fm['eta_peak'])}) and with the bound "
+            f"({modes(bm['eta_peak'])}), largest / bound {max(fm['eta_peak']) / b:.3g} and "
+            f"{bm['eta_peak_over_bound']:.3g}; residual |eta_1| {fm['eta_residual'][0]:.2g} vs "
+            f"{bm['eta_residual'][0]:.2g}; t_s {_fmt(fm['t_s'])} vs {_fmt(bm['t_s'])} s; peak |u| "
+            f"{fm['max_abs_u']:.3g} vs {bm['max_abs_u']:.3g} N m."
+        )
     alone, hand = _find(records, "F1", "MTSMC"), _find(records, "F4", "MTSMC>OfflineRMPC")
     if alone is not None and hand is not None:
         a, h = alone["metrics"], hand["metrics"]
@@ -388,16 +457,45 @@ def _f4_lines(records: list[dict[str, Any]]) -> list[str]:
             f"peak |u| {a['max_abs_u']:.3g} vs {h['max_abs_u']:.3g} N m, CI {a['ci']:.3g} vs {h['ci']:.3g} "
             f"N m/s, residual eta_1 {a['eta_residual'][0]:.2g} vs {h['eta_residual'][0]:.2g}."
         )
-    lines += [
-        '- The 8-vertex polytope (`polytope = "groups"`: J_mb^-1 x0.8-1.2, frequencies x0.9-1.1, '
-        "damping x0.5-2) ended in solver errors on this toolkit when the suite was written (the on-line "
-        "ipm and Clarabel: numerical_error, 4-8 s per solve; the off-line design: solver_error on the "
-        "first ellipsoid); the suite uses the 2-vertex torque-effectiveness polytope (x0.8-1.2). "
-        "The 160 deg V-slew is outside the linear model: there MTSMC slews and OfflineRMPC takes over "
-        "inside 20 deg (seed 9), its table designed from the state at the hand-over.",
-        "",
-    ]
+    lines += _reach_lines()
+    lines.append("")
     return lines
+
+
+def _reach_lines() -> list[str]:
+    """How far along the slew axis the LMIs reach, measured now, and where the ipm stops."""
+    from benchmarks.families.flexible.controllers import linear_weights
+    from benchmarks.families.flexible.family import _polytope
+    from benchmarks.families.flexible.region import slew_reach
+    from models import FlexibleSatellite
+
+    sat = FlexibleSatellite.di_gennaro()
+    s = defaults.CONTROLLER_DEFAULTS["RMPC"]
+    poly = _polytope(sat, defaults.LINEAR_PERIOD, s["polytope"])
+    Q, R = linear_weights(s, sat.n_modes)
+    direction = np.concatenate((np.ones(3) / np.sqrt(3), np.zeros(3 + 2 * sat.n_modes)))
+    reach = [slew_reach(poly, Q, R, defaults.U_MAX, direction, g) for g in REACH_GAMMAS]
+    measured = "; ".join(
+        f"gamma_s = {r.gamma_s:g}: "
+        + (
+            f"{r.angle_deg:.1f} deg ({r.status}; checked: contraction {r.contraction:.6f}, peak "
+            f"|u|/u_max {r.peak_input:.6f}, {'certified' if r.certified else 'NOT certified'})"
+            if r.angle_deg is not None
+            else r.status
+        )
+        for r in reach
+    )
+    return [
+        f"- Where the LMIs reach on the slew axis ('{s['polytope']}' polytope, {poly.n_vertices} vertices, "
+        f"peak bound {defaults.U_MAX:g} N m; the largest t with t (1, 1, 1)/sqrt(3) as q_v in an invariant "
+        "ellipsoid meeting the bound at a fixed cost bound, one SDP by cvxpy + Clarabel, checked without "
+        f"the solver): {measured}. The Kothare problem is feasible well past the 10 deg slew. The "
+        "toolkit's ipm (main, measured when F4 was set up: cold solves at rest about the slew axis, "
+        "default weights) is optimal at 1-12 deg and at 13 deg, but ends in numerical_error at 12.5 "
+        "and 13.5-15 deg (its Clarabel fallback too): a numerical limit, not the region's edge. F4 "
+        "therefore slews 10 deg, where every on-line solve of the run is optimal; the OfflineRMPC "
+        "tables use Clarabel on the 'delta' form (the 'delta_shared' form ends in solver_error).",
+    ]
 
 
 def _write(

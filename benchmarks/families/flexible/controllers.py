@@ -16,9 +16,11 @@
   (:class:`rmpc.OfflineRMPC`, Wan & Kothare 2003, its table designed once from the initial
   state) on the 14-state linear model ``[q_v, w, eta, eta']`` of the error quaternion
   (:meth:`models.FlexibleSatellite.linear_state`), through :class:`rmpc.MappedController`; their
-  PZT commands are zero (or AVC's). With ``handover_deg`` set, ``OfflineRMPC`` takes over from
-  MTSMC once the rotation error first falls below that angle (:class:`HandOver`, seed 9's
-  hand-over for the large slew); its table is then designed from the state at the hand-over.
+  PZT commands are zero (or AVC's). With ``modal_bound`` set, both bound the modal coordinates
+  through Kothare's output constraint (:func:`modal_output`). With ``handover_deg`` set,
+  ``OfflineRMPC`` takes over from MTSMC once the rotation error first falls below that angle
+  (:class:`HandOver`, seed 9's hand-over for the large slew); its table is then designed from the
+  state at the hand-over.
 """
 
 from __future__ import annotations
@@ -31,7 +33,15 @@ import numpy as np
 from benchmarks.core.family import BuiltController
 from toolkit_common.errors import ConfigError
 
-__all__ = ["CONSTRAINED", "CONTROLLERS", "FlexibleModel", "HandOver", "linear_weights", "settings_check"]
+__all__ = [
+    "CONSTRAINED",
+    "CONTROLLERS",
+    "FlexibleModel",
+    "HandOver",
+    "linear_weights",
+    "modal_output",
+    "settings_check",
+]
 
 
 class FlexibleModel:
@@ -181,6 +191,28 @@ def _mapped(ctrl: Any, m: FlexibleModel, name: str) -> Any:
     return MappedController(ctrl, measure, output=output, name=name)
 
 
+def modal_output(n_modes: int, bound: float | None) -> dict[str, Any]:
+    """``output_matrix`` and ``y_max`` bounding every modal coordinate ``eta_i`` by ``bound``.
+
+    ``C`` picks ``eta`` (entries ``6 .. 6 + N``, kg^1/2 m) of the linear state
+    ``[q_v, w, eta, eta']``; Kothare's output constraint then bounds ``|eta_i(k + j)|``,
+    ``j >= 1``, at the samples, for every model of the polytope. ``bound=None``: no constraint.
+
+    Examples
+    --------
+    >>> out = modal_output(4, 0.02)
+    >>> out["output_matrix"].shape, float(out["output_matrix"][:, 6:10].trace()), out["y_max"].tolist()
+    ((4, 14), 4.0, [0.02, 0.02, 0.02, 0.02])
+    >>> modal_output(4, None)
+    {'output_matrix': None, 'y_max': None}
+    """
+    if bound is None:
+        return {"output_matrix": None, "y_max": None}
+    c = np.zeros((n_modes, 6 + 2 * n_modes))
+    c[:, 6 : 6 + n_modes] = np.eye(n_modes)
+    return {"output_matrix": c, "y_max": np.full(n_modes, float(bound))}
+
+
 def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import RMPC
 
@@ -192,6 +224,7 @@ def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControl
         R,
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
+        **modal_output(m.satellite.n_modes, scenario.modal_bound),
         resolve_threshold=s["resolve_threshold"],
         backend=s["backend"],
     )
@@ -209,9 +242,11 @@ def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCont
         R,
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
+        **modal_output(m.satellite.n_modes, scenario.modal_bound),
         x_design=None if scenario.handover_deg is not None else m.x_design,
         n_ellipsoids=s["n_ellipsoids"],
         shrink=s["shrink"],
+        formulation=s["formulation"],
     )
     law = _mapped(ctrl, m, "OfflineRMPC")
     if scenario.handover_deg is not None:
