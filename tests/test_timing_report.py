@@ -136,15 +136,20 @@ def test_polytopes_hold_the_nominal_plant(count):
 
 def test_scale_section_quick_run(tmp_path):
     """``--problems Scale --quick``: the 6-state rigid hub of the flexible model at 2 and 8
-    vertices, 2 states each (~5 s). Every path has a record with its state dimension; the IPM
-    ends optimal on every state and agrees with Clarabel wherever Clarabel is optimal; the
-    report has the scale table and the time-against-size figure."""
+    vertices, 2 states each, and cvxpy + Clarabel (textbook and delta LMIs) on the first state
+    (~6 s). Every path has a record with its state dimension and formulation; the IPM ends
+    optimal on every state and agrees with Clarabel wherever Clarabel is optimal; the report has
+    the scale table and the time-against-size figure."""
     out = tmp_path / "scale"
-    args = _parse(["--out", str(out), "--quick", "--problems", "Scale", "--no-progress"])
+    args = _parse(["--out", str(out), "--quick", "--problems", "Scale", "--no-progress",
+                   "--scale-cvxpy-steps", "1"])
     assert args.func(args) == 0
     records = json.loads((out / "timing.json").read_text())["records"]
-    assert {(r["backend"], r["vertices"], r["n_states"]) for r in records} == {
-        (b, v, 6) for b in ("ipm", "ipm-cold", "clarabel") for v in (2, 8)}
+    paths = {("ipm", "delta_shared"), ("ipm-cold", "delta_shared"), ("clarabel", "delta_shared"),
+             ("cvxpy:CLARABEL", "standard"), ("cvxpy:CLARABEL", "delta")}
+    assert {(r["backend"], r["formulation"], r["vertices"], r["n_states"]) for r in records} == {
+        (*p, v, 6) for p in paths for v in (2, 8)}
+    assert all(r["steps"] == 1 for r in records if r["backend"] == "cvxpy:CLARABEL")
     for rec in records:
         assert rec["problem"] == "Scale"
         assert 0 < rec["p50_s"] <= rec["p95_s"] <= rec["max_s"]
@@ -157,7 +162,7 @@ def test_scale_section_quick_run(tmp_path):
 
 
 @pytest.mark.parametrize("argv", [["--scale-sizes", "7"], ["--scale-steps", "0"],
-                                  ["--problems", "scale", "LQR"]])
+                                  ["--scale-cvxpy-steps", "-1"], ["--problems", "scale", "LQR"]])
 def test_scale_options_are_checked(argv):
     with pytest.raises(InvalidArgumentError, match=argv[0]):
         config_from_args(_parse(["--out", "x", *argv]))

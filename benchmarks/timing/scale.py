@@ -12,8 +12,10 @@ off (the issue's flexible problem at 4 modes).
 
 At the states of one closed loop driven by the default path (the toolkit's IPM, warm-started,
 on vertex 0), every path solves the same states, interleaved state by state: the IPM warm
-(default) and cold, Clarabel's own API (``delta_shared``), and cvxpy + SCS at SCS's default
-tolerances for a few states (up to 10 states: :data:`SCS_MAX_STATES`). Records: p50 / p95 /
+(default) and cold, Clarabel's own API (``delta_shared``), cvxpy + SCS at SCS's default
+tolerances for a few states (up to 10 states: :data:`SCS_MAX_STATES`), and cvxpy + Clarabel
+(built once, Clarabel's defaults) on the textbook LMIs (``standard``) and on the delta form for
+the first ``cvxpy_steps`` states (up to 14 states: :data:`CVXPY_MAX_STATES`). Records: p50 / p95 /
 max time per solve, median iterations, statuses, and ``gamma`` against Clarabel's (relative).
 Not a controller benchmark: the loop only supplies realistic states.
 """
@@ -41,6 +43,8 @@ EXTRA_MODES: tuple[tuple[float, float, int], ...] = ((3.3, 0.03, 1), (4.2, 0.03,
 SCS_OPTIONS: dict[str, Any] = {"eps_abs": 1e-4, "eps_rel": 1e-4}
 #: SCS only up to this size: one solve took 4.4 s at 6 states and 29 s at 14 (2 vertices, load ~7).
 SCS_MAX_STATES = 10
+#: cvxpy + Clarabel only up to this size: one solve took 250-270 s at 20 states, 8 vertices (load ~1).
+CVXPY_MAX_STATES = 14
 
 
 def _satellite(n_modes: int) -> Any:
@@ -100,7 +104,7 @@ def _states(kwargs: dict[str, Any], x0: np.ndarray, steps: int) -> list[np.ndarr
 
 
 def time_scale(steps: int, sizes: Sequence[int] = SCALE_SIZES, vertices: Sequence[int] = SCALE_VERTICES,
-               scs_steps: int = 2, progress: Any = None) -> dict[str, Any]:
+               scs_steps: int = 2, progress: Any = None, cvxpy_steps: int = 0) -> dict[str, Any]:
     """Time every path at every size and vertex count; returns ``{"records", "samples"}``."""
     from lmi import KothareProblem
 
@@ -112,21 +116,28 @@ def time_scale(steps: int, sizes: Sequence[int] = SCALE_SIZES, vertices: Sequenc
             x0 = spec.pop("x0")
             states = _states(spec, x0, steps)
             paths = [
-                ("ipm", {"backend": "ipm"}, steps, "defaults, warm-started (fallback to Clarabel on)"),
-                ("ipm-cold", {"backend": "ipm", "solver_options": {"warm_start": False}}, steps,
-                 "defaults, every solve cold"),
-                ("clarabel", {"backend": "clarabel"}, steps, "Clarabel's own API, defaults (1e-8)"),
+                ("ipm", "delta_shared", {"backend": "ipm"}, steps,
+                 "defaults, warm-started (fallback to Clarabel on)"),
+                ("ipm-cold", "delta_shared", {"backend": "ipm", "solver_options": {"warm_start": False}},
+                 steps, "defaults, every solve cold"),
+                ("clarabel", "delta_shared", {"backend": "clarabel"}, steps,
+                 "Clarabel's own API, defaults (1e-8)"),
             ]
             if scs_steps and n_states <= SCS_MAX_STATES:
                 scs = {"backend": "cvxpy", "solver": "SCS", "solver_options": SCS_OPTIONS}
-                paths.append(("cvxpy:SCS", scs, min(scs_steps, steps),
+                paths.append(("cvxpy:SCS", "delta", scs, min(scs_steps, steps),
                               f"cvxpy built once; SCS {SCS_OPTIONS}"))
+            if cvxpy_steps and n_states <= CVXPY_MAX_STATES:
+                cvx = {"backend": "cvxpy", "solver": "CLARABEL"}
+                for formulation, what in (("standard", "the textbook LMIs"), ("delta", "the delta form")):
+                    paths.append(("cvxpy:CLARABEL", formulation, cvx, min(cvxpy_steps, steps),
+                                  f"cvxpy built once, {what}; Clarabel's defaults"))
             built = []
-            for name, opts, limit, settings in paths:
+            for name, formulation, opts, limit, settings in paths:
                 start = time.perf_counter()
-                prob = KothareProblem(**spec, formulation="delta_shared" if name != "cvxpy:SCS" else "delta",
-                                      **opts)
-                built.append({"name": name, "prob": prob, "limit": limit, "settings": settings,
+                prob = KothareProblem(**spec, formulation=formulation, **opts)
+                built.append({"name": name, "formulation": formulation, "prob": prob, "limit": limit,
+                              "settings": settings,
                               "setup_s": time.perf_counter() - start, "times": [], "its": [],
                               "gammas": [], "statuses": {}})
             for k, x in enumerate(states):  # interleaved: load changes hit every path alike
@@ -146,11 +157,10 @@ def time_scale(steps: int, sizes: Sequence[int] = SCALE_SIZES, vertices: Sequenc
                 err = (float(np.max(np.abs(vals[both] / ref[: vals.size][both] - 1.0)))
                        if np.any(both) else None)
                 its = [i for i in path["its"] if i is not None]
-                key = f"Scale|{path['name']}|delta_shared|{count}|{n_states}"
+                key = f"Scale|{path['name']}|{path['formulation']}|{count}|{n_states}"
                 samples[key] = np.asarray(path["times"])
                 records.append({
-                    "problem": "Scale", "backend": path["name"],
-                    "formulation": "delta" if path["name"] == "cvxpy:SCS" else "delta_shared",
+                    "problem": "Scale", "backend": path["name"], "formulation": path["formulation"],
                     "n_states": n_states, "vertices": count, "steps": len(path["times"]),
                     **percentiles(path["times"]), "setup_s": path["setup_s"],
                     "iterations_p50": float(np.median(its)) if its else None,
@@ -171,9 +181,10 @@ def format_scale_markdown(records: Sequence[dict[str, Any]], plot_name: str | No
         "The issue-12 flexible problem (ZOH 0.05 s, Q1 = diag(100 I6, I), R = I3, peak 2 N m, 10 deg "
         "off) with 0, 2, 4, 7 modes (modes 5-7 assumed); hub-torque effectiveness 0.8/1.2 (2 vertices: "
         "all axes together, 8: per axis). Error = max |gamma / gamma_clarabel - 1|.", "",
-        "| states | vertices | path | steps | p50 (ms) | p95 (ms) | max (ms) | iterations p50 | statuses "
-        "| max rel err gamma | ipm p50 / path p50 |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| states | vertices | path | formulation | steps | p50 (ms) | p95 (ms) | max (ms) | iterations p50 "
+        "| statuses "
+        "| max rel err gamma | path p50 / ipm p50 |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     fast = {(r["n_states"], r["vertices"]): r["p50_s"] for r in records if r["backend"] == "ipm"}
     for r in records:
@@ -182,7 +193,8 @@ def format_scale_markdown(records: Sequence[dict[str, Any]], plot_name: str | No
         ratio = r["p50_s"] / fast[(r["n_states"], r["vertices"])]
         statuses = ", ".join(f"{k} {v}" for k, v in sorted(r["status_counts"].items()))
         lines.append(
-            f"| {r['n_states']} | {r['vertices']} | {r['backend']} | {r['steps']} | {1e3 * r['p50_s']:.1f} "
+            f"| {r['n_states']} | {r['vertices']} | {r['backend']} | {r['formulation']} | {r['steps']} "
+            f"| {1e3 * r['p50_s']:.1f} "
             f"| {1e3 * r['p95_s']:.1f} | {1e3 * r['max_s']:.1f} | {it} | {statuses} | {err} | {ratio:.1f}x |")
     lines.append("")
     if plot_name:
@@ -199,9 +211,10 @@ def plot_scale(records: Sequence[dict[str, Any]], path: Path) -> Path:
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     styles = {2: "-", 8: "--"}
-    for backend in dict.fromkeys(r["backend"] for r in records):
+    for backend, formulation in dict.fromkeys((r["backend"], r["formulation"]) for r in records):
         for count in sorted({r["vertices"] for r in records}):
-            recs = sorted((r for r in records if r["backend"] == backend and r["vertices"] == count),
+            recs = sorted((r for r in records if r["backend"] == backend and r["formulation"] == formulation
+                           and r["vertices"] == count),
                           key=lambda r: r["n_states"])
             if not recs:
                 continue
@@ -209,7 +222,8 @@ def plot_scale(records: Sequence[dict[str, Any]], path: Path) -> Path:
             p50 = np.array([r["p50_s"] for r in recs])
             p95 = np.array([r["p95_s"] for r in recs])
             ax.errorbar(xs, p50, yerr=[np.zeros_like(p50), np.maximum(p95 - p50, 0.0)], marker="o",
-                        linestyle=styles.get(count, ":"), capsize=3, label=f"{backend}, {count} vertices")
+                        linestyle=styles.get(count, ":"), capsize=3,
+                        label=f"{backend} {formulation}, {count} vertices")
     ax.set_yscale("log")
     ax.set_xlabel("state dimension")
     ax.set_ylabel("time per solve (s): p50, bar to p95")

@@ -107,6 +107,7 @@ class TimingConfig:
     scale_steps: int = 10
     scale_sizes: tuple[int, ...] = (6, 10, 14, 20)
     scale_scs_steps: int = 1
+    scale_cvxpy_steps: int = 2
 
     @property
     def cheap_steps(self) -> int:
@@ -195,6 +196,9 @@ def config_from_args(args: argparse.Namespace) -> TimingConfig:
     scale_steps = getattr(args, "scale_steps", None)
     scale_steps = ((2 if quick else 10) if scale_steps is None
                    else _int_option(scale_steps, "--scale-steps", 1))
+    scale_cvxpy = getattr(args, "scale_cvxpy_steps", None)
+    scale_cvxpy = ((0 if quick else 2) if scale_cvxpy is None
+                   else _int_option(scale_cvxpy, "--scale-cvxpy-steps", 0))
     sizes = getattr(args, "scale_sizes", None)
     sizes = ((6,) if quick else (6, 10, 14, 20)) if sizes is None else _sizes_option(sizes)
     return TimingConfig(
@@ -211,6 +215,7 @@ def config_from_args(args: argparse.Namespace) -> TimingConfig:
         scale_steps=scale_steps,
         scale_sizes=sizes,
         scale_scs_steps=0 if quick else 1,
+        scale_cvxpy_steps=min(scale_cvxpy, scale_steps),
     )
 
 
@@ -644,7 +649,8 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
         if "Scale" in cfg.problems:
             from benchmarks.timing.scale import time_scale
 
-            res = time_scale(cfg.scale_steps, cfg.scale_sizes, scs_steps=cfg.scale_scs_steps, progress=bar)
+            res = time_scale(cfg.scale_steps, cfg.scale_sizes, scs_steps=cfg.scale_scs_steps, progress=bar,
+                             cvxpy_steps=cfg.scale_cvxpy_steps)
             records += res["records"]
             samples.update(res["samples"])
     end_load = machine_info()["load_average"]
@@ -663,6 +669,7 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
             "x0": RigidSatellite.initial_state().tolist(), "n_ellipsoids": cfg.n_ellipsoids,
             "lookup_repeats": cfg.lookup_repeats, "scale_steps": cfg.scale_steps,
             "scale_sizes": list(cfg.scale_sizes), "scale_scs_steps": cfg.scale_scs_steps,
+            "scale_cvxpy_steps": cfg.scale_cvxpy_steps,
         },
         "wall_time_s": time.perf_counter() - start,
     }
@@ -898,6 +905,9 @@ def add_timing_parser(subparsers: Any) -> None:
                         help="Scale: closed-loop states per size and vertex count (default 10; --quick: 2)")
     parser.add_argument("--scale-sizes", nargs="+", default=None, metavar="n",
                         help="Scale: state dimensions among 6 10 14 20 (default all; --quick: 6)")
+    parser.add_argument("--scale-cvxpy-steps", default=None, metavar="K",
+                        help="Scale: states for cvxpy + Clarabel, textbook and delta LMIs, up to 14 states "
+                        "(default 2; --quick: 0; 0 leaves them out)")
     parser.add_argument("--quick", action="store_true",
                         help="a small run (3 states, 5 ellipsoids) to check the set-up; used by the tests")
     parser.add_argument("--rebuild-steps", default=None, metavar="K",
