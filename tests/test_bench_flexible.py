@@ -70,12 +70,14 @@ def test_suite_cases_cover_the_four_experiments():
     f4 = {
         s.controller: s
         for s in by_exp["F4"]
-        if s.handover_deg is None and s.settings.get("polytope", "groups") == "groups"
+        if s.handover_deg is None and s.settings.get("polytope", "groups") == "groups" and not s.modal_bound
     }
     assert set(f4) == {"MTSMC", "LQR", "OfflineRMPC", "RMPC"}
     assert {s.experiment for s in f4.values()} == {"small"}
     assert {s.duration for s in f4.values()} == {None}  # every F4 run is the whole slew
     assert f4["RMPC"].settings["polytope"] == f4["OfflineRMPC"].settings["polytope"] == "groups"
+    (bounded,) = [s for s in by_exp["F4"] if s.modal_bound is not None and s.settings["polytope"] == "groups"]
+    assert (bounded.controller, bounded.experiment, bounded.modal_bound) == ("RMPC", "small", F4_MODAL_BOUND)
     pair = [s for s in by_exp["F4"] if s.settings.get("polytope") == MODAL_BOUND_POLYTOPE]
     assert sorted(s.modal_bound or 0.0 for s in pair) == [0.0, F4_MODAL_BOUND]
     assert {(s.controller, s.experiment) for s in pair} == {("RMPC", "small")}

@@ -64,8 +64,8 @@ def test_rmpc_on_the_groups_polytope_keeps_the_bound_and_its_lyapunov_decrease()
 
 
 def test_modal_bound_holds_on_the_linear_polytope_and_binds():
-    # The 2-vertex torque-effectiveness polytope: on 'groups' the ipm's answers with the output
-    # constraint fail the certificate (see benchmarks.suites.flexible.MODAL_BOUND_POLYTOPE).
+    # The 2-vertex torque-effectiveness polytope, whose solves are a tenth of those on 'groups'
+    # (F4 runs the bound on both; tests/test_lmi_ipm_rebalance.py covers the 8-vertex solver case).
     poly = SAT.polytope(DT, attitude="quaternion", mode="effectiveness")
     bound = 0.02  # kg^1/2 m, the unit of eta in the hybrid-coordinate model
     out = modal_output(SAT.n_modes, bound)

@@ -62,7 +62,8 @@ EXPERIMENTS: dict[str, str] = {
     "without the integral term, CSMC.",
     "F4": "A 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model "
     "over the 8-vertex polytope (0.5 s period, per-axis peak bound) against MTSMC and the LQR "
-    "reference; RMPC with and without |eta_i| <= 0.02 on the 2-vertex polytope; and the 160 deg "
+    "reference; RMPC with |eta_i| <= 0.02 on the 8-vertex polytope, and with and without it on the "
+    "2-vertex polytope; and the 160 deg "
     "V-slew by MTSMC handing over to OfflineRMPC (0.01 s) inside 20 deg.",
 }
 
@@ -72,11 +73,13 @@ SHORT_TIME_SCALE = 0.02
 #: F4's bound on every modal coordinate (kg^1/2 m) for the RMPC case with the output constraint
 #: (without it, RMPC's peak ``|eta_1|`` on the 10 deg slew is about 0.066 on this polytope).
 F4_MODAL_BOUND = 0.02
-#: The polytope of F4's modal-bound pair (RMPC with and without the bound): on the 8-vertex
-#: 'groups' polytope the ipm's answers with the output constraint are 'inaccurate' and fail the
-#: certificate (margins down to -2e-3), so every step would fall back; the 2-vertex
-#: torque-effectiveness polytope is solved and certified at every step.
+#: The polytope of F4's second modal-bound pair (RMPC with and without the bound), next to the
+#: pair on the default 8-vertex 'groups' polytope (F4's RMPC case and its bounded twin): the
+#: 2-vertex torque-effectiveness polytope, whose re-solves cost a tenth as much.
 MODAL_BOUND_POLYTOPE = "effectiveness"
+#: Angles (deg) along the slew axis at which the report solves the RMPC's problem cold at rest
+#: with the toolkit's ipm (past F4's 10 deg, up to where the LMIs still reach at gamma_s = 100).
+IPM_REACH_ANGLES = (12.5, 15.0)
 
 #: Cost bounds ``gamma_s = dt gamma`` at which the report measures how far along the slew axis the
 #: LMIs reach (:func:`benchmarks.families.flexible.region.slew_reach`).
@@ -114,7 +117,7 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
     --------
     >>> cases = flexible_cases()
     >>> len(cases), sorted({c.experiment for c in cases})
-    (25, ['F1', 'F2', 'F3', 'F4'])
+    (26, ['F1', 'F2', 'F3', 'F4'])
     """
     from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 
@@ -147,6 +150,8 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
         else:
             for ctrl in ("MTSMC", "LQR", "OfflineRMPC", "RMPC"):
                 cases.append(_case(exp, ctrl, {**base, "controller": ctrl, "experiment": "small"}))
+            data = {**base, "controller": "RMPC", "experiment": "small", "modal_bound": F4_MODAL_BOUND}
+            cases.append(_case(exp, "RMPC_modal_bound", data))
             for bound in (None, F4_MODAL_BOUND):
                 data = {**base, "controller": "RMPC", "experiment": "small", "modal_bound": bound}
                 data["settings"] = {"polytope": MODAL_BOUND_POLYTOPE}
@@ -165,7 +170,9 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
 def _cost(case: SuiteCase) -> float:
     sc = case.scenario
     if sc.controller == "RMPC":
-        return 100.0 if sc.settings["polytope"] == "groups" else 10.0
+        if sc.settings["polytope"] != "groups":
+            return 10.0
+        return 100.0 if sc.modal_bound is None else 150.0
     if sc.controller == "OfflineRMPC":
         return 100.0 if sc.handover_deg is None else 150.0
     return {"vslew": 15.0, "steady": 25.0, "small": 10.0}[sc.experiment] * (1.5 if sc.avc else 1.0)
@@ -424,30 +431,8 @@ def _f4_lines(records: list[dict[str, Any]]) -> list[str]:
         "ellipsoid (its outermost gain applied without guarantee); infeasible or any other word, a "
         "solver failure: the step applies the last certified gain (fallback)."
     )
-    pair = [
-        r
-        for r in recs
-        if r["controller"] == "RMPC" and r["settings"]["settings"]["polytope"] == MODAL_BOUND_POLYTOPE
-    ]
-    free = next((r for r in pair if r["settings"].get("modal_bound") is None), None)
-    bound = next((r for r in pair if r["settings"].get("modal_bound") is not None), None)
-    if free is not None and bound is not None:
-        b = bound["settings"]["modal_bound"]
-        fm, bm = free["metrics"], bound["metrics"]
-
-        def modes(values: list[float]) -> str:
-            return ", ".join(f"{v:.3g}" for v in values)
-
-        lines.append(
-            f"- Modal bound |eta_i| <= {b:g} kg^1/2 m (Kothare's output constraint, RMPC on the "
-            f"'{MODAL_BOUND_POLYTOPE}' polytope; guaranteed at the samples for the linear polytope only, "
-            "here measured on the nonlinear plant with its disturbance): peak |eta_i| without "
-            f"({modes(fm['eta_peak'])}) and with the bound "
-            f"({modes(bm['eta_peak'])}), largest / bound {max(fm['eta_peak']) / b:.3g} and "
-            f"{bm['eta_peak_over_bound']:.3g}; residual |eta_1| {fm['eta_residual'][0]:.2g} vs "
-            f"{bm['eta_residual'][0]:.2g}; t_s {_fmt(fm['t_s'])} vs {_fmt(bm['t_s'])} s; peak |u| "
-            f"{fm['max_abs_u']:.3g} vs {bm['max_abs_u']:.3g} N m."
-        )
+    for polytope in ("groups", MODAL_BOUND_POLYTOPE):
+        lines += _modal_bound_lines(recs, polytope)
     alone, hand = _find(records, "F1", "MTSMC"), _find(records, "F4", "MTSMC>OfflineRMPC")
     if alone is not None and hand is not None:
         a, h = alone["metrics"], hand["metrics"]
@@ -460,6 +445,46 @@ def _f4_lines(records: list[dict[str, Any]]) -> list[str]:
     lines += _reach_lines()
     lines.append("")
     return lines
+
+
+def _modal_bound_lines(recs: list[dict], polytope: str) -> list[str]:
+    """RMPC with and without the modal bound on one polytope (empty if either run is missing)."""
+    pair = [r for r in recs
+            if r["controller"] == "RMPC" and r["settings"]["settings"]["polytope"] == polytope]
+    free = next((r for r in pair if r["settings"].get("modal_bound") is None), None)
+    bound = next((r for r in pair if r["settings"].get("modal_bound") is not None), None)
+    if free is None or bound is None:
+        return []
+    b = bound["settings"]["modal_bound"]
+    fm, bm = free["metrics"], bound["metrics"]
+
+    def modes(values: list[float]) -> str:
+        return ", ".join(f"{v:.3g}" for v in values)
+
+    return [
+        f"- Modal bound |eta_i| <= {b:g} kg^1/2 m (Kothare's output constraint, RMPC on the "
+        f"'{polytope}' polytope; guaranteed at the samples for the linear polytope only, "
+        "here measured on the nonlinear plant with its disturbance): peak |eta_i| without "
+        f"({modes(fm['eta_peak'])}) and with the bound "
+        f"({modes(bm['eta_peak'])}), largest / bound {max(fm['eta_peak']) / b:.3g} and "
+        f"{bm['eta_peak_over_bound']:.3g}; residual |eta_1| {fm['eta_residual'][0]:.2g} vs "
+        f"{bm['eta_residual'][0]:.2g}; t_s {_fmt(fm['t_s'])} vs {_fmt(bm['t_s'])} s; peak |u| "
+        f"{fm['max_abs_u']:.3g} vs {bm['max_abs_u']:.3g} N m; solves "
+        f"{_status_summary(fm['status_counts'])} vs {_status_summary(bm['status_counts'])}."
+    ]
+
+
+def _ipm_along_slew(poly: Any, Q: np.ndarray, R: np.ndarray, direction: np.ndarray) -> str:
+    """The RMPC's problem solved cold at rest at :data:`IPM_REACH_ANGLES` by the toolkit's ipm."""
+    from lmi import KothareProblem
+
+    words = []
+    for angle in IPM_REACH_ANGLES:
+        prob = KothareProblem(poly.A, poly.B, Q, R, u_max=defaults.U_MAX, input_constraint="peak",
+                              dt=poly.dt, backend="ipm")
+        sol = prob.solve(np.sin(np.deg2rad(angle) / 2.0) * direction)
+        words.append(f"{angle:g} deg {sol.status} ({sol.solver_status}, {sol.iterations} iterations)")
+    return "; ".join(words)
 
 
 def _reach_lines() -> list[str]:
@@ -490,11 +515,9 @@ def _reach_lines() -> list[str]:
         f"peak bound {defaults.U_MAX:g} N m; the largest t with t (1, 1, 1)/sqrt(3) as q_v in an invariant "
         "ellipsoid meeting the bound at a fixed cost bound, one SDP by cvxpy + Clarabel, checked without "
         f"the solver): {measured}. The Kothare problem is feasible well past the 10 deg slew. The "
-        "toolkit's ipm (main, measured when F4 was set up: cold solves at rest about the slew axis, "
-        "default weights) is optimal at 1-12 deg and at 13 deg, but ends in numerical_error at 12.5 "
-        "and 13.5-15 deg (its Clarabel fallback too): a numerical limit, not the region's edge. F4 "
-        "therefore slews 10 deg, where every on-line solve of the run is optimal; the OfflineRMPC "
-        "tables use Clarabel on the 'delta' form (the 'delta_shared' form ends in solver_error).",
+        "toolkit's ipm on the RMPC's problem, cold at rest on the slew axis, measured now: "
+        f"{_ipm_along_slew(poly, Q, R, direction)}. F4 slews 10 deg; the OfflineRMPC tables use "
+        "Clarabel on the 'delta' form (the 'delta_shared' form ends in solver_error).",
     ]
 
 
