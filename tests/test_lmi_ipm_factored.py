@@ -39,18 +39,59 @@ def _psd_sqrt(a: np.ndarray) -> np.ndarray:
     return (v * np.sqrt(w)) @ v.T
 
 
+def _coefficients(dmat: np.ndarray, var, p, q, val, n: int) -> np.ndarray:
+    """The coefficients ``A_i = D N_i D'`` that the entries ``(var, p, q, val)`` mean."""
+    d = dmat.shape[1]
+    nmat = np.zeros((n, d, d))
+    for i, a, b, v in zip(var, p, q, val, strict=True):
+        nmat[i, a, b] += v
+        if a != b:
+            nmat[i, b, a] += v
+    return np.einsum("ka,iab,lb->ikl", dmat, nmat, dmat)
+
+
 def _random_factor(rng: np.random.Generator, n: int, k: int, d: int, count: int):
     """``(D, var, p, q, value)`` with ``count`` random entries and the coefficients they mean."""
     dmat = rng.normal(size=(k, d))
     var = rng.integers(0, n, size=count)
     p, q = np.sort(rng.integers(0, d, size=(2, count)), axis=0)
     val = rng.normal(size=count)
-    nmat = np.zeros((n, d, d))
-    for i, a, b, v in zip(var, p, q, val, strict=True):
-        nmat[i, a, b] += v
-        if a != b:
-            nmat[i, b, a] += v
-    return (dmat, var, p, q, val), np.einsum("ka,iab,lb->ikl", dmat, nmat, dmat)
+    return (dmat, var, p, q, val), _coefficients(dmat, var, p, q, val, n)
+
+
+def _kernel_args(orders, s_blocks, z_blocks, factors, fill: float) -> tuple:
+    """The direct kernels' arguments before their outputs; unused slots hold ``fill``."""
+    nb, kmax = len(orders), max(orders)
+    dmax = max(f[0].shape[1] for f in factors)
+    s_chol = np.full((nb, kmax, kmax), fill)
+    z = np.full((nb, kmax, kmax), fill)
+    dict_mat = np.full((nb, kmax, dmax), fill)
+    fe = [[], [], [], []]
+    off = [0]
+    for j, (k, f) in enumerate(zip(orders, factors, strict=True)):
+        s_chol[j, :k, :k] = np.linalg.cholesky(s_blocks[j])
+        z[j, :k, :k] = z_blocks[j]
+        dmat, var, p, q, val = f
+        dict_mat[j, :k, : dmat.shape[1]] = dmat
+        order = np.argsort(var, kind="stable")
+        weight = np.where(p == q, 0.5, 1.0) * np.sqrt(2.0)  # the kernel's stored sqrt(2) h v
+        for lst, arr in zip(fe, (var, p, q, val * weight), strict=True):
+            lst.append(arr[order])
+        off.append(off[-1] + var.size)
+    dims = np.array([f[0].shape[1] for f in factors], dtype=np.int64)
+    return (s_chol, z, np.array(orders, dtype=np.int64), dict_mat, dims, np.array(off, dtype=np.int64),
+            *(np.concatenate(a).astype(np.int64) for a in fe[:3]), np.concatenate(fe[3]))
+
+
+def _trace_formula(s_blocks, z_blocks, coefs) -> np.ndarray:
+    """``sum_j tr(A_ij W^-1 A_kj W^-1)`` with each block's NT point ``W``, in plain numpy."""
+    want = np.zeros((coefs[0].shape[0],) * 2)
+    for s, zj, coef in zip(s_blocks, z_blocks, coefs, strict=True):
+        root = _psd_sqrt(s)
+        w_inv = np.linalg.solve(root, np.linalg.solve(root, _psd_sqrt(root @ zj @ root)).T).T
+        w_inv = 0.5 * (w_inv + w_inv.T)
+        want += np.einsum("iab,bc,kcd,da->ik", coef, w_inv, coef, w_inv)
+    return want
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -67,36 +108,12 @@ def test_direct_schur_complement_is_the_trace_formula(seed):
     factors, coefs = zip(*(_random_factor(rng, n, k, int(rng.integers(1, 13)), int(rng.integers(1, 41)))
                            for k in orders), strict=True)
     nb, kmax = len(orders), max(orders)
-    dmax = max(f[0].shape[1] for f in factors)
-    s_chol = np.full((nb, kmax, kmax), np.nan)
-    z = np.full((nb, kmax, kmax), np.nan)
-    dict_mat = np.full((nb, kmax, dmax), np.nan)
-    fe = [[], [], [], []]
-    off = [0]
-    for j, (k, f) in enumerate(zip(orders, factors, strict=True)):
-        s_chol[j, :k, :k] = np.linalg.cholesky(s_blocks[j])
-        z[j, :k, :k] = z_blocks[j]
-        dmat, var, p, q, val = f
-        dict_mat[j, :k, : dmat.shape[1]] = dmat
-        order = np.argsort(var, kind="stable")
-        weight = np.where(p == q, 0.5, 1.0) * np.sqrt(2.0)  # the kernel's stored sqrt(2) h v
-        for lst, arr in zip(fe, (var, p, q, val * weight), strict=True):
-            lst.append(arr[order])
-        off.append(off[-1] + var.size)
-    ints = [np.concatenate(a).astype(np.int64) for a in fe[:3]]
     kk = np.full((nb, kmax, kmax), np.nan)
     lam = np.full((nb, kmax), np.nan)
     h = np.full((n, n), np.nan)
-    dims = np.array([f[0].shape[1] for f in factors], dtype=np.int64)
-    assert kernels.scaling_and_schur_direct(s_chol, z, np.array(orders, dtype=np.int64), dict_mat, dims,
-                                            np.array(off, dtype=np.int64), *ints, np.concatenate(fe[3]),
+    assert kernels.scaling_and_schur_direct(*_kernel_args(orders, s_blocks, z_blocks, factors, np.nan),
                                             kk, lam, h)
-    want = np.zeros((n, n))
-    for s, zj, coef in zip(s_blocks, z_blocks, coefs, strict=True):
-        root = _psd_sqrt(s)
-        w_inv = np.linalg.solve(root, np.linalg.solve(root, _psd_sqrt(root @ zj @ root)).T).T
-        w_inv = 0.5 * (w_inv + w_inv.T)
-        want += np.einsum("iab,bc,kcd,da->ik", coef, w_inv, coef, w_inv)
+    want = _trace_formula(s_blocks, z_blocks, coefs)
     assert np.array_equal(h, h.T)
     assert np.max(np.abs(h - want)) <= 1e-11 * np.max(np.abs(want))
 
@@ -206,36 +223,14 @@ def test_grouped_schur_complement_is_the_trace_formula(seed):
     base, _ = _random_factor(rng, n, k, d, count)
     _, var, p, q, val = base
     factors = [(rng.normal(size=(k, d)), var, p, q, val) for _ in range(members)]
-    single, single_coef = _random_factor(rng, n, 5, 4, 12)
+    single, _ = _random_factor(rng, n, 5, 4, 12)
     factors.insert(1, single)  # a group of one between the group's members
     orders = [k if f is not single else 5 for f in factors]
-    coefs = []
-    for f in factors:
-        nmat = np.zeros((n, f[0].shape[1], f[0].shape[1]))
-        np.add.at(nmat, (f[1], f[2], f[3]), f[4])
-        off = f[2] != f[3]
-        np.add.at(nmat, (f[1][off], f[3][off], f[2][off]), f[4][off])
-        coefs.append(np.einsum("ka,iab,lb->ikl", f[0], nmat, f[0]))
-    nb, kmax, dmax = len(orders), max(orders), d
+    coefs = [_coefficients(*f, n) for f in factors]
+    nb, kmax = len(orders), max(orders)
     s_blocks = [_rand_pd(rng, kj) for kj in orders]
     z_blocks = [_rand_pd(rng, kj) for kj in orders]
-    s_chol = np.zeros((nb, kmax, kmax))
-    z = np.zeros((nb, kmax, kmax))
-    dict_mat = np.zeros((nb, kmax, dmax))
-    fe = [[], [], [], []]
-    off_list = [0]
-    for j, (kj, f) in enumerate(zip(orders, factors, strict=True)):
-        s_chol[j, :kj, :kj] = np.linalg.cholesky(s_blocks[j])
-        z[j, :kj, :kj] = z_blocks[j]
-        dict_mat[j, :kj, : f[0].shape[1]] = f[0]
-        order = np.argsort(f[1], kind="stable")
-        weight = np.where(f[2] == f[3], 0.5, 1.0) * np.sqrt(2.0)
-        for lst, arr in zip(fe, (f[1], f[2], f[3], f[4] * weight), strict=True):
-            lst.append(arr[order])
-        off_list.append(off_list[-1] + f[1].size)
-    args = (s_chol, z, np.array(orders, dtype=np.int64), dict_mat,
-            np.array([f[0].shape[1] for f in factors], dtype=np.int64), np.array(off_list, dtype=np.int64),
-            *(np.concatenate(a).astype(np.int64) for a in fe[:3]), np.concatenate(fe[3]))
+    args = _kernel_args(orders, s_blocks, z_blocks, factors, 0.0)
     group = [0, *range(2, nb)]
     grp_off = np.array([0, len(group), nb], dtype=np.int64)
     grp_blk = np.array([*group, 1], dtype=np.int64)
@@ -243,17 +238,11 @@ def test_grouped_schur_complement_is_the_trace_formula(seed):
     kk, lam = np.zeros((nb, kmax, kmax)), np.zeros((nb, kmax))
     assert kernels.scaling_and_schur_grouped(*args, grp_off, grp_blk, kk, lam, h_grp)
     assert kernels.scaling_and_schur_direct(*args, kk.copy(), lam.copy(), h_dir)
-    want = np.zeros((n, n))
-    for s, zj, coef in zip(s_blocks, z_blocks, coefs, strict=True):
-        root = _psd_sqrt(s)
-        w_inv = np.linalg.solve(root, np.linalg.solve(root, _psd_sqrt(root @ zj @ root)).T).T
-        w_inv = 0.5 * (w_inv + w_inv.T)
-        want += np.einsum("iab,bc,kcd,da->ik", coef, w_inv, coef, w_inv)
+    want = _trace_formula(s_blocks, z_blocks, coefs)
     scale = np.max(np.abs(want))
     assert np.array_equal(h_grp, h_grp.T)
     assert np.max(np.abs(h_grp - want)) <= 1e-11 * scale
     assert np.max(np.abs(h_grp - h_dir)) <= 1e-13 * scale
-    del single_coef
 
 
 def test_kothare_vertex_blocks_form_one_group():
