@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lmi.backend_clarabel import ClarabelKothare, RawResult
-from lmi.backend_ipm import IPMKothare
+from lmi.backends.clarabel import ClarabelKothare, RawResult
+from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.infeasibility import InfeasibilityCertificate
@@ -22,7 +22,7 @@ from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
 if TYPE_CHECKING:
-    from lmi.backend_cvxpy import CvxpyKothare
+    from lmi.backends.cvxpy import CvxpyKothare
 
 __all__ = ["KothareProblem", "LMISolution"]
 
@@ -122,7 +122,7 @@ class KothareProblem:
         ``"ipm"`` (default: the toolkit's own structure-exploiting interior-point method
         :mod:`lmi.ipm`, data built once, warm-started; a failed solve runs phase one, which
         either proves the problem infeasible (status ``"infeasible"`` with
-        ``LMISolution.infeasibility``) or hands the state to Clarabel; :mod:`lmi.backend_ipm`),
+        ``LMISolution.infeasibility``) or hands the state to Clarabel; :mod:`lmi.backends.ipm`),
         ``"clarabel"`` (Clarabel's own API, data built once) or
         ``"cvxpy"`` with ``solver`` naming any installed
         cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
@@ -135,7 +135,7 @@ class KothareProblem:
         (a congruence; same optimum, better conditioned at small ``dt``); ``"delta_shared"``
         also lifts the common ``Q1``/``R`` part into one shared block so each vertex cone
         shrinks to ``2n``;
-        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backend_clarabel`.
+        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backends.clarabel`.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed relative LMI margin is ``>= -tol``.
 
@@ -192,7 +192,7 @@ class KothareProblem:
                 raise InvalidArgumentError("solver", "None with backend='ipm'", repr(solver))
             self._backend = IPMKothare(self.data, solver_options)
         elif backend == "cvxpy":
-            from lmi.backend_cvxpy import CvxpyKothare  # cvxpy costs ~0.5 s to import
+            from lmi.backends.cvxpy import CvxpyKothare  # cvxpy costs ~0.5 s to import
 
             self._backend = CvxpyKothare(self.data, solver or "CLARABEL", solver_options)
         else:

@@ -9,7 +9,7 @@ more LMI, the nesting ``Q_{i-1} - Q_i >= 0``, so that the invariant ellipsoids
 unknowns of step ``i``, and the previous solution, scaled to the new state, satisfies it, so
 every design state strictly inside the previous ellipsoid gives a feasible problem.
 
-The LMIs are the cvxpy formulation of :mod:`lmi.backend_cvxpy` (same delta form and
+The LMIs are the cvxpy formulation of :mod:`lmi.backends.cvxpy` (same delta form and
 scalings, so the design is well conditioned at ``Ts = 0.01`` s) with the extra constraints
 added; the design is off-line and not time-critical. Every stored ellipsoid is certified by
 :func:`lmi.certify` (the LMIs recomputed in numpy) and by the recomputed nesting margin.
@@ -32,7 +32,7 @@ from typing import Any
 import cvxpy as cp
 import numpy as np
 
-from lmi.backend_cvxpy import CvxpyKothare
+from lmi.backends.cvxpy import CvxpyKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.status import CVXPY_STATUS_MAP, INACCURATE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
@@ -69,7 +69,7 @@ def interpolation_margin(data: KothareData, q_outer: np.ndarray, f_inner: np.nda
 
     ``Q_i^-1 - M_j' Q_i^-1 M_j > 0`` with ``M_j = A_j + B_j F_{i+1}`` is, after the congruence
     with ``Q_i`` and division by ``dt``, ``[[-(H_j + H_j'), sqrt(dt) H_j'], [sqrt(dt) H_j, Q_i]] > 0``
-    with ``H_j = (M_j - I) Q_i / dt`` (the delta form of :mod:`lmi.backend_clarabel`, exact for
+    with ``H_j = (M_j - I) Q_i / dt`` (the delta form of :mod:`lmi.backends.clarabel`, exact for
     any ``dt`` and well conditioned when ``M_j`` is close to ``I``). Returns the smallest
     relative eigenvalue over the vertices; the condition holds when it is ``> 0``.
     """
@@ -179,7 +179,7 @@ class NestedKothareProblem:
     solver : str
         Any installed cvxpy conic solver (default ``"CLARABEL"``).
     solver_options : dict, optional
-        Solver settings, validated as in :mod:`lmi.backend_cvxpy`.
+        Solver settings, validated as in :mod:`lmi.backends.cvxpy`.
     certificate_tol : float
         Every recomputed relative margin (Kothare LMIs, nesting) must be ``>= -tol``.
     interpolation_tol : float
@@ -233,7 +233,7 @@ class NestedKothareProblem:
         self._base = CvxpyKothare(self.data, solver, solver_options)
         n = self.data.n
         base = self._base
-        # gamma_s = dt gamma in the delta formulations (see lmi.backend_clarabel).
+        # gamma_s = dt gamma in the delta formulations (see lmi.backends.clarabel).
         self._gamma_scale = 1.0 if formulation == "standard" else self.data.dt
         self._outer = cp.Parameter((n, n), symmetric=True)
         extra = [self._outer - base.Qv >> 0]

@@ -29,7 +29,7 @@ is active the optimal ellipsoid is squeezed along directions the state does not 
 flexible satellite's 8-vertex polytope at 0.5 s with a 2 N m peak bound, 14 deg off, the
 optimal ``Q~`` in these coordinates still spans 1e-4 (modal coordinates) to 20 (attitude). The
 IPM back-end then retries a failed solve in coordinates balanced on its own last iterate
-(``rebalance`` in :data:`lmi.backend_ipm.DEFAULT_IPM_OPTIONS`).
+(``rebalance`` in :data:`lmi.backends.ipm.DEFAULT_IPM_OPTIONS`).
 """
 
 from __future__ import annotations

@@ -10,13 +10,13 @@ Examples
 """
 
 from models.actuators import ReactionWheelActuator, TorqueLimiter
-from models.discretize import zoh
-from models.flexible import FlexibleSatellite
-from models.kinematics import kinematics_matrix
-from models.mrp_satellite import MRPSatellite
-from models.mrp_scenarios import PaperMScenario, paper_m_scenario
-from models.polytope import PolytopicModel
-from models.satellite import (
+from models.attitude.euler import kinematics_matrix
+from models.flexible.satellite import FlexibleSatellite
+from models.linear import PolytopicModel, zoh
+from models.mrp.satellite import MRPSatellite
+from models.mrp.scenarios import PaperMScenario, paper_m_scenario
+from models.mrp.spinning_disk import SpinningDisk
+from models.rigid.satellite import (
     INPUT_NAMES,
     PAPER_P_INERTIA,
     PAPER_P_INITIAL_STATE,
@@ -25,13 +25,12 @@ from models.satellite import (
     STATE_NAMES,
     RigidSatellite,
 )
-from models.spinning_disk import SpinningDisk
-from models.wheel_faults import FaultSchedule, RankWindow, WheelFault, rank_deficient_windows
-from models.wheel_noise import AttitudeNoiseSensor, WheelDisturbance
-from models.wheel_satellite import WheelSatellite
-from models.wheel_scenarios import WheelScenario, paper_w_scenario
-from models.wheel_stage import WheelInputStage
-from models.wheels import WheelArray
+from models.wheels.array import WheelArray
+from models.wheels.faults import FaultSchedule, RankWindow, WheelFault, rank_deficient_windows
+from models.wheels.noise import AttitudeNoiseSensor, WheelDisturbance
+from models.wheels.satellite import WheelSatellite
+from models.wheels.scenarios import WheelScenario, paper_w_scenario
+from models.wheels.stage import WheelInputStage
 
 __all__ = [
     "INPUT_NAMES",

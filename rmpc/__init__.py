@@ -3,28 +3,28 @@
 Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`).
 """
 
-from rmpc.adaptive_backstepping import AdaptiveBacksteppingFTC
-from rmpc.adaptive_smc import AdaptiveSMC
-from rmpc.attitude_pd import AttitudePD
-from rmpc.cf_backstepping import CFBackstepping
-from rmpc.command_filter import CommandFilter
 from rmpc.controller import Controller, StepInfo
-from rmpc.crmpc import CRMPC
-from rmpc.csmc import CSMC
-from rmpc.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
-from rmpc.flexible_hybrid import FlexibleHybrid
-from rmpc.gipc import GIPC
-from rmpc.lqr import LQR
-from rmpc.lqr_flexible import flexible_lqr
-from rmpc.mab import MAB
-from rmpc.mtsmc import MTSMC
-from rmpc.neso import NESO
-from rmpc.offline_rmpc import OfflineRMPC
-from rmpc.robust_avc import RobustAVC
-from rmpc.robust_mpc import RMPC
-from rmpc.scheduled_rmpc import ScheduledRMPC
-from rmpc.simulate import Trajectory, simulate
-from rmpc.tuning_function_ab import TuningFunctionAB
+from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
+from rmpc.laws.flexible.attitude_pd import AttitudePD
+from rmpc.laws.flexible.csmc import CSMC
+from rmpc.laws.flexible.hybrid import FlexibleHybrid
+from rmpc.laws.flexible.lqr import flexible_lqr
+from rmpc.laws.flexible.mtsmc import MTSMC
+from rmpc.laws.flexible.robust_avc import RobustAVC
+from rmpc.laws.mrp.cf_backstepping import CFBackstepping
+from rmpc.laws.mrp.command_filter import CommandFilter
+from rmpc.laws.mrp.mab import MAB
+from rmpc.laws.mrp.neso import NESO
+from rmpc.laws.mrp.tuning_function_ab import TuningFunctionAB
+from rmpc.laws.wheel.adaptive_backstepping import AdaptiveBacksteppingFTC
+from rmpc.mpc.crmpc import CRMPC
+from rmpc.mpc.gipc import GIPC
+from rmpc.mpc.lqr import LQR
+from rmpc.mpc.offline import OfflineRMPC
+from rmpc.mpc.robust_mpc import RMPC
+from rmpc.mpc.scheduled import ScheduledRMPC
+from rmpc.sim.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
+from rmpc.sim.simulate import Trajectory, simulate
 from rmpc.wrappers import MappedController
 
 __all__ = [

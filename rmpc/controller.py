@@ -1,13 +1,28 @@
-"""The controller protocol every controller of the toolkit follows, and its per-step info."""
+"""The controller protocol every controller of the toolkit follows, its per-step info and inputs.
+
+A controller is built once, ``reset()`` before a run and called once per sample with the
+measured state: ``u = controller.step(x)``. After each call ``controller.last`` is a
+:class:`StepInfo` whose ``status`` is a word of the one status vocabulary
+(:class:`~toolkit_common.status.Status`, re-exported here).
+
+What a law needs at a sample besides the state goes through one typed channel,
+:class:`StepInputs`: ``controller.step(x, StepInputs(pzt=v))`` hands the flexible satellite's
+attitude law this sample's piezoelectric command, ``rmpc.step(x, StepInputs(u_max=b))`` gives
+robust MPC a bound for this step only. A controller lists the fields it uses in its
+``accepts`` attribute; any other field set to a value is an error naming it.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["Controller", "StepInfo"]
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.status import Status, as_status
+
+__all__ = ["Controller", "Status", "StepInfo", "StepInputs", "check_step_inputs"]
 
 
 @dataclass(frozen=True)
@@ -16,11 +31,15 @@ class StepInfo:
 
     Attributes
     ----------
-    status : str
-        ``"optimal"`` or a failure word (``"infeasible"``, ``"numerical_error"``,
-        ``"max_iterations"``, ...); ``"reused"`` when a previous certified answer was kept.
+    status : Status
+        A word of the status vocabulary: ``"optimal"`` or a solver's failure word for a
+        controller that solves an optimisation problem, ``"reused"`` when a previous certified
+        answer was kept, ``"ok"`` for a law evaluated in closed form (see
+        :data:`toolkit_common.status.STATUS_TABLE`). A plain string is converted; a word outside
+        the vocabulary is an error.
     solve_time : float
-        Time spent in the optimiser during this step (s); 0 for a fixed gain.
+        Time spent in the optimiser during this step (s); for a law without one, the time of
+        the step.
     gamma : float or None
         The cost bound of robust MPC, where the controller has one.
     iterations : int or None
@@ -31,12 +50,64 @@ class StepInfo:
         Controller-specific details.
     """
 
-    status: str
+    status: Status
     solve_time: float = 0.0
     gamma: float | None = None
     iterations: int | None = None
     fallback: bool = False
     extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "status", as_status(self.status, "StepInfo.status"))
+
+
+@dataclass(frozen=True)
+class StepInputs:
+    """What a controller may receive at a sample besides the measured state.
+
+    Attributes
+    ----------
+    pzt : (n_a,) array_like or None
+        This sample's piezoelectric command ``v`` of the flexible satellite (from the vibration
+        law); an attitude law that cancels its reaction on the hub uses it.
+    u_max : float, array_like or None
+        The input bound for this step instead of the controller's own (same kind), e.g. what
+        CRMPC's disturbance correction leaves of the torque limit.
+    """
+
+    pzt: Any = None
+    u_max: Any = None
+
+    def given(self) -> tuple[str, ...]:
+        """The names of the fields set to a value (not ``None``)."""
+        return tuple(f.name for f in fields(self) if getattr(self, f.name) is not None)
+
+
+def check_step_inputs(inputs: StepInputs | None, accepts: frozenset[str], owner: str) -> StepInputs:
+    """Return ``inputs`` (an empty :class:`StepInputs` for ``None``), checking it against ``accepts``.
+
+    Raises
+    ------
+    ArgumentTypeError
+        When ``inputs`` is not a :class:`StepInputs`.
+    InvalidArgumentError
+        Naming the field when a field outside ``accepts`` is set.
+    """
+    if inputs is None:
+        return _NO_INPUTS
+    if not isinstance(inputs, StepInputs):
+        raise ArgumentTypeError("inputs", "None or an rmpc.StepInputs", type(inputs).__name__)
+    extra = [name for name in inputs.given() if name not in accepts]
+    if extra:
+        allowed = ", ".join(sorted(accepts)) if accepts else "none"
+        raise InvalidArgumentError(
+            f"inputs.{extra[0]}", f"only the step inputs {owner} uses ({allowed})",
+            f"{extra[0]} set to a value",
+        )
+    return inputs
+
+
+_NO_INPUTS = StepInputs()
 
 
 @runtime_checkable
@@ -45,12 +116,15 @@ class Controller(Protocol):
 
     A controller is built once, ``reset()`` before a run, and called once per sample with the
     measured state; it returns the control to apply now. After each call ``last`` describes
-    that step (at least ``status`` and ``solve_time``; see :class:`StepInfo`).
+    that step (see :class:`StepInfo`); ``name`` is its short name in reports (``"RMPC"``,
+    ``"MAB"``, ``"CSMC+AVC"``). ``accepts`` names the :class:`StepInputs` fields it uses.
     """
 
-    last: Any
+    name: str
+    last: StepInfo | None
+    accepts: ClassVar[frozenset[str]]
 
-    def step(self, x: np.ndarray) -> np.ndarray:  # pragma: no cover - protocol
+    def step(self, x: np.ndarray, inputs: StepInputs | None = None) -> np.ndarray:  # pragma: no cover
         """Return the control to apply for the measured state ``x``."""
         ...
 

@@ -24,10 +24,10 @@ import math
 import numpy as np
 import pytest
 
+from benchmarks.families.wheel.metrics import fault_metrics
+from benchmarks.families.wheel.plant import scenario_plant
 from models import WheelSatellite, paper_w_scenario, rank_deficient_windows
 from rmpc import AdaptiveBacksteppingFTC, simulate
-from rmpc.fault_metrics import fault_metrics
-from rmpc.wheel_plant import scenario_plant
 
 PLATFORM_RANGE = math.radians(40.0)
 

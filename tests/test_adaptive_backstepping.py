@@ -15,9 +15,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import FaultSchedule, WheelFault, WheelSatellite, paper_w_scenario
-from models.kinematics_inverse import inverse_kinematics_matrix
+from models.attitude.euler_inverse import inverse_kinematics_matrix
 from rmpc import AdaptiveBacksteppingFTC, Controller
-from rmpc.adaptive_backstepping import wrap_angle
+from rmpc.laws.wheel.adaptive_backstepping import wrap_angle
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 
@@ -33,7 +33,7 @@ def test_alpha1_dot_equals_a_central_difference(sat: WheelSatellite) -> None:  #
         x = np.r_[rng.uniform(-0.6, 0.6, 3), rng.uniform(-0.2, 0.2, 3), np.zeros(4)]
         rates = ftc.law(0.0, x, ftc.g_nom, ftc.theta_hat)
         # alpha1 depends on eta only, and eta' = K(eta) w: differentiate along that flow
-        from models.kinematics import kinematics_matrix
+        from models.attitude.euler import kinematics_matrix
 
         eta_dot = kinematics_matrix(x[0], x[1]) @ x[3:6]
         h = 1e-6

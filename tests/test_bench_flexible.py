@@ -11,7 +11,7 @@ from benchmarks.cli import main
 from benchmarks.core.scenario import Scenario, run_scenario
 from benchmarks.families.flexible.family import eta1_frequency
 from benchmarks.suites.flexible import F4_MODAL_BOUND, MODAL_BOUND_POLYTOPE, flexible_cases, inconsistencies
-from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
+from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 from toolkit_common.errors import ConfigError
 
 CONTRACT_KEYS = (

@@ -13,7 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rmpc import NESO, CommandFilter
-from rmpc.neso import fal
+from rmpc.laws.mrp.neso import fal
 from toolkit_common.errors import InvalidArgumentError
 
 ZETA, WN = 0.5, 2.0

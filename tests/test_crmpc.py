@@ -425,7 +425,7 @@ def _adaptive_loop(a: np.ndarray, b: np.ndarray, f: np.ndarray, p: np.ndarray, c
     integrates the claimed V' = e'(A_t'P + P A_t)e + 2 (c - 1) e' P B F zm. Returns V, int V', theta."""
     from scipy.integrate import solve_ivp
 
-    from rmpc.mras import LyapunovRule
+    from rmpc.mpc.adaptation import LyapunovRule
 
     rule = LyapunovRule(3, gain=gain, dt=0.01)
     a_cl, a_t = a + b @ f, a + c * b @ f

@@ -1,4 +1,4 @@
-"""Paper W's run metrics (rmpc.fault_metrics) and the scenario plants (rmpc.wheel_plant).
+"""Paper W's run metrics and scenario plants (benchmarks.families.wheel.metrics and .plant).
 
 The metric tests use hand-made trajectories whose answers follow from their definitions
 (seed 6.10: recovery runs from the event until max |eta_i| stays <= 2 deg); one short S1 run
@@ -12,9 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from models import FaultSchedule, WheelFault, WheelSatellite, paper_w_scenario
-from rmpc import AdaptiveBacksteppingFTC, Trajectory, simulate
-from rmpc.fault_metrics import (
+from benchmarks.families.wheel.metrics import (
     attitude_error,
     fault_metrics,
     max_abs_momentum,
@@ -23,7 +21,9 @@ from rmpc.fault_metrics import (
     recovery_times,
     saturated_fraction,
 )
-from rmpc.wheel_plant import scenario_plant, wheel_plant
+from benchmarks.families.wheel.plant import scenario_plant, wheel_plant
+from models import FaultSchedule, WheelFault, WheelSatellite, paper_w_scenario
+from rmpc import AdaptiveBacksteppingFTC, Trajectory, simulate
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 

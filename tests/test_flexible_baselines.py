@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from models import FlexibleSatellite
-from models.flexible_scenario import PaperVDisturbance
-from models.quaternion import quat_from_axis_angle, rotation_angle
+from models.attitude.quaternion import quat_from_axis_angle, rotation_angle
+from models.flexible.scenario import PaperVDisturbance
 from rmpc import (
     AdaptiveSMC,
     AttitudePD,
@@ -25,7 +25,7 @@ from rmpc import (
     flexible_lqr,
     simulate,
 )
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import InvalidArgumentError
 
 DT = 0.01

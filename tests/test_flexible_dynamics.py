@@ -15,8 +15,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import FlexibleSatellite, RigidSatellite
-from models.kinematics import kinematics_matrix
-from models.quaternion import (
+from models.attitude.euler import kinematics_matrix
+from models.attitude.quaternion import (
     euler321_to_quat,
     quat_error,
     quat_from_axis_angle,

@@ -1,4 +1,4 @@
-"""Paper V's metrics (rmpc.flexible_metrics) and the scenario data (models.flexible_scenario).
+"""Paper V's metrics (benchmarks.families.flexible.metrics) and the scenario data (models.flexible.scenario).
 
 Each metric is checked on a run whose value is known in closed form: a constant command
 beyond the 2 N m clip (peak, saturated fraction, effort, chattering index), the satellite at
@@ -10,18 +10,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.families.flexible.metrics import flexible_metrics, settling_time
 from models import FlexibleSatellite
-from models.flexible_scenario import (
+from models.attitude.quaternion import rotation_angle
+from models.flexible.scenario import (
     F2_EPSILONS,
     ConstantHubTorque,
     PaperVDisturbance,
     paper_v_scenario,
     steady_error_scenario,
 )
-from models.quaternion import rotation_angle
 from rmpc import StepInfo, simulate
-from rmpc.flexible_metrics import flexible_metrics, settling_time
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 

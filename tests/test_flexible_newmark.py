@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from models import FlexibleSatellite, RigidSatellite
-from models.flexible_scenario import paper_v_scenario
-from models.quaternion import quat_error, rotation_angle
+from models.attitude.quaternion import quat_error, rotation_angle
+from models.flexible.scenario import paper_v_scenario
 from rmpc import CSMC, MTSMC, simulate
-from rmpc.newmark import NewmarkPlant
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.newmark import NewmarkPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 

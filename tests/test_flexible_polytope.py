@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from models import FlexibleSatellite, zoh
-from models.flexible_linear import ParameterPoint
-from models.flexible_polytope import (
+from models.flexible.linear import ParameterPoint
+from models.flexible.polytope import (
     DEFAULT_DAMPING_SCALE,
     DEFAULT_FREQUENCY_SCALE,
     DEFAULT_INERTIA_SCALE,

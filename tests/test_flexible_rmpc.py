@@ -13,7 +13,7 @@ from benchmarks.families.flexible.controllers import linear_weights, modal_outpu
 from benchmarks.families.flexible.defaults import CONTROLLER_DEFAULTS, U_MAX
 from benchmarks.families.flexible.region import slew_reach
 from models import FlexibleSatellite
-from models.quaternion import quat_from_axis_angle
+from models.attitude.quaternion import quat_from_axis_angle
 from rmpc import RMPC
 
 DT = 0.5

@@ -22,13 +22,13 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from benchmarks.families.flexible.metrics import flexible_metrics
 from models import FlexibleSatellite
-from models.flexible_scenario import PaperVDisturbance, paper_v_scenario, steady_error_scenario
-from models.quaternion import quat_from_axis_angle, rotation_angle
+from models.attitude.quaternion import quat_from_axis_angle, rotation_angle
+from models.flexible.scenario import PaperVDisturbance, paper_v_scenario, steady_error_scenario
 from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, simulate
-from rmpc.disturbances import ConstantDisturbance
-from rmpc.flexible_metrics import flexible_metrics
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.disturbances import ConstantDisturbance
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 DT = 0.01

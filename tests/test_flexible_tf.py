@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import FlexibleSatellite
-from models.flexible_tf import REGIME_LABELS, flexible_factor, regime
+from models.flexible.single_axis import REGIME_LABELS, flexible_factor, regime
 from toolkit_common.errors import InvalidArgumentError
 
 #: Single-axis free-free frequencies of seed 2.5 (rad/s), per axis.

@@ -9,7 +9,7 @@ import pytest
 from models import PolytopicModel, RigidSatellite
 from rmpc import GIPC, StepDisturbance, simulate
 from rmpc.controller import Controller
-from rmpc.gipc import prediction_matrices, velocity_form
+from rmpc.mpc.gipc import prediction_matrices, velocity_form
 from rmpc.qp import ProxQPBackend, QPBackend, QPResult, SolverResiduals
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 

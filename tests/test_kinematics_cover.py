@@ -12,7 +12,7 @@ from scipy.linalg import expm
 from scipy.optimize import linprog
 
 from models import RigidSatellite
-from models.kinematics import kinematics_cover, kinematics_matrix
+from models.attitude.euler import kinematics_cover, kinematics_matrix
 from toolkit_common.errors import InvalidArgumentError, SingularityError
 
 

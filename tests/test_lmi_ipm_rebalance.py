@@ -1,4 +1,4 @@
-"""The IPM's rebalanced retry (``solver_options["rebalance"]``, :mod:`lmi.backend_ipm`).
+"""The IPM's rebalanced retry (``solver_options["rebalance"]``, :mod:`lmi.backends.ipm`).
 
 The plant is a small analogue of the flexible satellite on its 8-vertex 'groups' polytope: one
 axis, a hub of inertia ``J`` (``20 / 0.8`` and ``20 / 1.2`` kg m^2) carrying one lightly damped

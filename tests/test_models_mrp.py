@@ -14,9 +14,8 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from models import MRPSatellite, SpinningDisk, paper_m_scenario
-from models.kinematics import rotation_matrix
-from models.mrp import (
-    RMPCStateMap,
+from models.attitude.euler import rotation_matrix
+from models.attitude.mrp import (
     dcm_from_euler321,
     euler321_from_dcm,
     mrp_angle,
@@ -31,11 +30,10 @@ from models.mrp import (
     mrp_switch,
     mrp_to_dcm,
     mrp_to_quaternion,
-    rmpc_state,
-    tracking_error,
 )
+from models.mrp.tracking import RMPCStateMap, rmpc_state, tracking_error
 from rmpc import simulate
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SingularityError
 
 SIGMA0 = [0.195676, -0.096964, 0.130312]
@@ -76,7 +74,7 @@ def test_initial_attitude_and_euler_angles() -> None:
     sigma0 = mrp_from_euler321(angles)
     np.testing.assert_allclose(mrp_to_dcm(sigma0), reference, atol=1e-12)
     np.testing.assert_allclose(dcm_from_euler321(angles), reference, atol=1e-12)
-    np.testing.assert_allclose(rotation_matrix(angles).T, reference, atol=1e-12)  # models.kinematics
+    np.testing.assert_allclose(rotation_matrix(angles).T, reference, atol=1e-12)  # models.attitude.euler
     np.testing.assert_allclose(sigma0, SIGMA0, atol=1e-6)
     np.testing.assert_allclose(euler321_from_dcm(reference), angles, atol=1e-12)
     with pytest.raises(SingularityError, match="pitch"):

@@ -21,7 +21,7 @@ from scipy.integrate import solve_ivp
 
 from models import RigidSatellite
 from rmpc import LQR, simulate
-from rmpc.plants import NonlinearSatellitePlant
+from rmpc.sim.plants import NonlinearSatellitePlant
 
 ENERGY_TOL = 1e-11
 MOMENTUM_TOL = 3e-10

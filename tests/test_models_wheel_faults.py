@@ -22,8 +22,9 @@ from models import (
     paper_w_scenario,
     rank_deficient_windows,
 )
+from models.protocols import InputStage
 from rmpc import StepInfo, simulate
-from rmpc.plants import InputStage, NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 WHEELS = WheelArray.paper_w()

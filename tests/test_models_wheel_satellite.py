@@ -14,8 +14,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import WheelArray, WheelSatellite
-from models.kinematics import kinematics_matrix
-from models.kinematics_inverse import inverse_kinematics_matrix
+from models.attitude.euler import kinematics_matrix
+from models.attitude.euler_inverse import inverse_kinematics_matrix
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 ONES = np.ones((3, 3))
@@ -88,7 +88,7 @@ def test_kinematics_and_gravity(sat: WheelSatellite) -> None:  # seed 6.4
     assert inverted.gravity_torque(level_40)[0] > sat.wheels.axis_authority()[0]
     np.testing.assert_array_equal(sat.replace(gravity="off").gravity_torque(level_40), 0.0)
     # the general form m g (r x k) with k the body-frame image of the inertial "down"
-    from models.kinematics import rotation_matrix
+    from models.attitude.euler import rotation_matrix
 
     att = np.array([0.3, -0.2, 1.1])
     k = rotation_matrix(att).T @ np.array([0.0, 0.0, 1.0])

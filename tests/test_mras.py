@@ -1,4 +1,4 @@
-"""The MIT rule (rmpc.mras) against Astrom & Wittenmark's example 5.2 and a continuous-time solution.
+"""The MIT rule (rmpc.mpc.adaptation) against Astrom & Wittenmark's example 5.2 and a continuous solution.
 
 Example 5.2 (Astrom & Wittenmark, *Adaptive Control*, 2nd ed.): plant ``y' = -y + 0.5 u``,
 model ``ym' = -2 ym + 2 uc``, ``u = theta1 uc - theta2 y``, square-wave command of period
@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from mras_example_5_2 import EXAMPLE_5_2_GAINS, example_5_2
 from scipy.integrate import solve_ivp
 
 from rmpc.errors import ArgumentTypeError, InvalidArgumentError
-from rmpc.mras import EXAMPLE_5_2_GAINS, MITRule, SensitivityFilter, example_5_2
+from rmpc.mpc.adaptation import MITRule, SensitivityFilter
 
 
 def _continuous_example_5_2(gamma: float, duration: float, period: float = 20.0) -> np.ndarray:
@@ -174,7 +175,7 @@ def test_bad_types_name_the_argument() -> None:
 
 def test_lyapunov_rule_over_actuated_uses_the_minimum_norm_rate():
     """Four inputs through a rank-3 input matrix (paper W's wheels): no singular solve."""
-    from rmpc.mras import LyapunovRule
+    from rmpc.mpc.adaptation import LyapunovRule
 
     d = np.array([[1.0, 0, 0, 1], [0, 1.0, 0, 1], [0, 0, 1.0, 1]]) / np.array([1, 1, 1, np.sqrt(3)])
     b = np.vstack([np.zeros((3, 4)), d])

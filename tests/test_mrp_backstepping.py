@@ -4,7 +4,7 @@ The Lyapunov checks integrate plant and controller jointly (``closed_loop_rhs`` 
 they test the identities of seed sections 5.1-5.3, which hold in continuous time. The scenario
 checks are seed section 7.9. Run lengths: the continuous M1 and M2 runs use the seed's 100 s
 and window [50, 100] s (joint integration takes under 4 s); the *sampled* runs (the ``step``
-protocol through :func:`rmpc.simulate`, RK4 plant at 0.01 s) are shortened to 60 s with the
+protocol through :func:`rmpc.sim.simulate`, RK4 plant at 0.01 s) are shortened to 60 s with the
 window [30, 60] s. On the full 100 s (script outside the repository, see the closing report)
 the sampled windows [30, 60] and [50, 100] gave the same maxima to 0.1 %: the transients are
 over by 15 s and the window holds more than one period (20.9 s) of the disk's speed.
@@ -17,9 +17,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from models import MRPSatellite, paper_m_scenario
-from models.mrp import mrp_error_angle
+from models.attitude.mrp import mrp_error_angle
 from rmpc import MAB, NESO, CFBackstepping, CommandFilter, ConstantDisturbance, TuningFunctionAB, simulate
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 CONTROLLERS = {"BS": CFBackstepping, "MAB": MAB, "TFAB": TuningFunctionAB}
@@ -152,7 +152,7 @@ def test_m2_outcomes_continuous(m2, m2_continuous) -> None:
 
 @pytest.fixture(scope="module")
 def m2_sampled(m2):
-    """The step protocol through rmpc.simulate on M2, 60 s, at Ts = 0.01 s and 0.05 s (RK4 plant, 0.01 s)."""
+    """The step protocol through simulate on M2, 60 s, at Ts = 0.01 s and 0.05 s (RK4 plant, 0.01 s)."""
     out = {}
     for dt in (0.01, 0.05):
         sc = paper_m_scenario("M2", duration=60.0, dt=dt)

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from models import RigidSatellite
+from models.protocols import InputStage
 from rmpc import LQR, StepDisturbance, simulate
-from rmpc.plants import InputStage, NonlinearPlant, NonlinearSatellitePlant
+from rmpc.sim.plants import NonlinearPlant, NonlinearSatellitePlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 Q = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])

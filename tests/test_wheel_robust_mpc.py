@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.families.wheel.plant import wheel_plant
 from models import WheelFault, WheelSatellite
 from rmpc import CRMPC, GIPC, RMPC, MappedController, OfflineRMPC, simulate
-from rmpc.wheel_plant import wheel_plant
 
 Q = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
 R = np.eye(4)

@@ -78,8 +78,9 @@ def _init_worker() -> None:
 
 #: Modules the fork server imports once, so that each worker starts with them loaded (importing
 #: the controllers, cvxpy, python-control and SciPy costs about 2 s of CPU per process).
-PRELOAD: tuple[str, ...] = ("benchmarks.core.runner", "rmpc", "rmpc.gipc", "rmpc.crmpc", "lmi", "control",
-                            "scipy.integrate")
+PRELOAD: tuple[str, ...] = (
+    "benchmarks.core.runner", "rmpc", "rmpc.mpc.gipc", "rmpc.mpc.crmpc", "lmi", "control", "scipy.integrate",
+)
 
 
 def _context() -> multiprocessing.context.BaseContext:

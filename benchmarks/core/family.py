@@ -68,7 +68,7 @@ class Field:
 
 @dataclass(frozen=True)
 class BuiltController:
-    """A controller ready for :func:`rmpc.simulate` and whether it needs a limiter in the loop."""
+    """A controller ready for :func:`rmpc.sim.simulate` and whether it needs a limiter in the loop."""
 
     controller: Any
     needs_limiter: bool

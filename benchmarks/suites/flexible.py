@@ -119,7 +119,7 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
     >>> len(cases), sorted({c.experiment for c in cases})
     (26, ['F1', 'F2', 'F3', 'F4'])
     """
-    from models.flexible_scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
+    from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 
     if not 0.0 < time_scale <= 1.0:
         raise ConfigError("time_scale", "a factor in (0, 1]", repr(time_scale))
@@ -361,7 +361,7 @@ def _steady_lines(records: list[dict[str, Any]]) -> list[str]:
     recs = [r for r in records if r["experiment"] == "F3"]
     if not recs:
         return []
-    from models.flexible_scenario import steady_error_scenario
+    from models.flexible.scenario import steady_error_scenario
 
     d = np.linalg.norm(steady_error_scenario().disturbance(0.0))
     s = defaults.CONTROLLER_DEFAULTS["MTSMC"]

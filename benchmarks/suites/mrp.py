@@ -195,10 +195,10 @@ def paper_m_comparison(records: list[dict[str, Any]]) -> list[str]:
         )
     lines += [
         "",
-        "Inconsistencies of paper M (seed 8), as `models.mrp_scenarios.PAPER_M_NOTES` states them:",
+        "Inconsistencies of paper M (seed 8), as `models.mrp.scenarios.PAPER_M_NOTES` states them:",
         "",
     ]
-    from models.mrp_scenarios import PAPER_M_NOTES
+    from models.mrp.scenarios import PAPER_M_NOTES
 
     lines += [f"- {note}" for note in PAPER_M_NOTES]
     lines.append("")

@@ -49,7 +49,7 @@ CVXPY_MAX_STATES = 14
 
 def _satellite(n_modes: int) -> Any:
     from models import FlexibleSatellite
-    from models.flexible import (
+    from models.flexible.satellite import (
         DI_GENNARO_COUPLING,
         DI_GENNARO_DAMPING,
         DI_GENNARO_FREQUENCIES,

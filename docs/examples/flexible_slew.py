@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from models.flexible_scenario import paper_v_scenario
+from benchmarks.families.flexible.metrics import flexible_metrics
+from models.flexible.scenario import paper_v_scenario
 from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, simulate
-from rmpc.flexible_metrics import flexible_metrics
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 
 scenario = paper_v_scenario(duration=20.0)  # 160 deg about (1, 1, 1), u_max = 2 N m, d(t) of paper V
 sat = scenario.satellite

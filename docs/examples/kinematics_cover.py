@@ -4,7 +4,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from models import RigidSatellite, kinematics_matrix
-from models.kinematics import kinematics_cover
+from models.attitude.euler import kinematics_cover
 
 sat = RigidSatellite.paper_p()
 x0 = sat.initial_state(1.3)  # E6: paper P's initial attitude x 1.3, at rest

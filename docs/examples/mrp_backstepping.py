@@ -3,9 +3,9 @@
 import numpy as np
 
 from models import paper_m_scenario
-from models.mrp import mrp_error_angle
+from models.attitude.mrp import mrp_error_angle
 from rmpc import MAB, CFBackstepping, TuningFunctionAB, simulate
-from rmpc.plants import NonlinearPlant
+from rmpc.sim.plants import NonlinearPlant
 
 m2 = paper_m_scenario("M2", duration=40.0, dt=0.05)  # window [20, 40] s; the seed's is 100 s
 print(f"initial error {m2.initial_error_deg:.2f} deg, window {m2.steady_window} s")

@@ -3,10 +3,10 @@ S1 run with its fault metrics, and robust MPC on the wheel-effectiveness polytop
 
 import numpy as np
 
+from benchmarks.families.wheel.metrics import fault_metrics
+from benchmarks.families.wheel.plant import scenario_plant
 from models import WheelArray, WheelSatellite, paper_w_scenario, rank_deficient_windows
 from rmpc import RMPC, AdaptiveBacksteppingFTC, simulate
-from rmpc.fault_metrics import fault_metrics
-from rmpc.wheel_plant import scenario_plant
 
 wheels = WheelArray.paper_w()
 skew = np.degrees(np.arccos(wheels.D[:, 3]))

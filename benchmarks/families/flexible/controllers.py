@@ -96,7 +96,7 @@ class HandOver:
 
     def step(self, x: Any, pzt: Any = None) -> np.ndarray:
         """``[u; v]`` from the slew law, or from the fine law once the error was below ``angle``."""
-        from models.quaternion import rotation_angle
+        from models.attitude.quaternion import rotation_angle
 
         if self.handover_step is None and rotation_angle(np.asarray(x, dtype=float)[:4]) < self.angle:
             self.handover_step = self._count

@@ -8,9 +8,9 @@ plant : {"flexible"}
     (:class:`models.FlexibleSatellite`, the published set of seed 2.5), quaternion attitude,
     integrated by DOP853 (rtol 1e-8) between samples.
 experiment : {"vslew", "steady", "small"}
-    The run: paper V's V-slew (:func:`models.flexible_scenario.paper_v_scenario`, 160 deg,
+    The run: paper V's V-slew (:func:`models.flexible.scenario.paper_v_scenario`, 160 deg,
     150 s, ``d(t)`` of seed 3), the steady-error study
-    (:func:`models.flexible_scenario.steady_error_scenario`: at the target under a constant
+    (:func:`models.flexible.scenario.steady_error_scenario`: at the target under a constant
     0.05 N m per axis, 250 s) or the small-angle slew (10 deg, 200 s, where the linear model
     of the robust MPC holds).
 angle_deg : float or None
@@ -158,8 +158,8 @@ def _label(scenario: Any) -> str:
 
 
 def paper_scenario(scenario: Any) -> Any:
-    """The :class:`models.flexible_scenario.VSlewScenario` of a case (its angle, length, step)."""
-    from models.flexible_scenario import paper_v_scenario, steady_error_scenario
+    """The :class:`models.flexible.scenario.VSlewScenario` of a case (its angle, length, step)."""
+    from models.flexible.scenario import paper_v_scenario, steady_error_scenario
 
     kind = scenario.experiment
     angle = scenario.angle_deg if scenario.angle_deg is not None else defaults.EXPERIMENT_ANGLES[kind]
@@ -180,7 +180,7 @@ def _polytope(sat: Any, dt: float, kind: str) -> Any:
 
 
 def _design_state(sat: Any, case: Any) -> np.ndarray:
-    from models.quaternion import quat_from_axis_angle
+    from models.attitude.quaternion import quat_from_axis_angle
 
     x = sat.linear_state(case.initial_state())
     if np.linalg.norm(x) > 1e-9:
@@ -239,9 +239,9 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     """Build the flexible satellite, the case's run and controller; simulate; measure."""
     import time
 
+    from benchmarks.families.flexible.metrics import flexible_metrics
     from rmpc import simulate
-    from rmpc.flexible_metrics import flexible_metrics
-    from rmpc.plants import NonlinearPlant
+    from rmpc.sim.plants import NonlinearPlant
 
     case = paper_scenario(scenario)
     sat = case.satellite

@@ -6,7 +6,7 @@ bound ``gamma`` asks for, and keeps the input bound on ``E(Q)``. For a fixed ``g
 largest ``t`` with ``t d`` in such an ellipsoid is one semidefinite program (the containment
 LMI ``[[1, t d'], [t d, Q]] >= 0`` is linear in ``t`` and ``Q``); the feasible states are
 star-shaped, so ``t`` is the reach along ``d``. :func:`slew_reach` solves it (cvxpy + Clarabel,
-the delta form of :mod:`lmi.backend_cvxpy` with ``gamma_s = dt gamma``) and checks the answer
+the delta form of :mod:`lmi.backends.cvxpy` with ``gamma_s = dt gamma``) and checks the answer
 without the solver: ``Acl_j' Q^-1 Acl_j <= Q^-1`` on every vertex, the peak input over ``E(Q)``
 and the level of ``t d``.
 """

@@ -5,7 +5,7 @@ their torque per axis at ``u_max``, which is what their own ``u_max`` option doe
 ``"constraint"`` (RMPC and CRMPC: a per-axis peak bound in the LMIs, CRMPC with the torque
 budget). The robust MPC sees the error attitude (3-2-1 angles of the body relative to the
 target) and the rates relative to the orbital frame, through :class:`rmpc.MappedController`
-and :class:`models.mrp.RMPCStateMap`; paper M's controllers see the MRP state.
+and :class:`models.mrp.tracking.RMPCStateMap`; paper M's controllers see the MRP state.
 """
 
 from __future__ import annotations

@@ -100,7 +100,7 @@ def rationale() -> str:
     return (
         "Paper M's initial state, target, run length and step were lost; the seed's choices are used "
         "(an initial error of 57.8 deg). The robust MPC runs on the error attitude in 3-2-1 angles and "
-        "the rates relative to the orbital frame (models.mrp.RMPCStateMap), designed on the rigid "
+        "the rates relative to the orbital frame (models.mrp.tracking.RMPCStateMap), designed on the rigid "
         "satellite linearised at the target; its polytope also covers the kinematics over the box of "
         "attitude errors the manoeuvre sweeps, so its LMI guarantees hold along the large slew. "
         "Paper M's controllers see the MRP state and the target; only MAB and TFAB estimate the disk's "

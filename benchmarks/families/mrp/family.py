@@ -91,7 +91,7 @@ def _label(scenario: Any) -> str:
 
 
 def paper_scenario(scenario: Any) -> Any:
-    """The :class:`models.mrp_scenarios.PaperMScenario` of a case (its length, step, inertia)."""
+    """The :class:`models.mrp.scenarios.PaperMScenario` of a case (its length, step, inertia)."""
     from models import paper_m_scenario
 
     base = paper_m_scenario(scenario.scenario)
@@ -105,9 +105,10 @@ def paper_scenario(scenario: Any) -> Any:
 def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper M's satellite, the disk, the controller (and the RMPC polytope); run; measure."""
     from models import RigidSatellite, TorqueLimiter
-    from models.mrp import RMPCStateMap, mrp_error_angle
+    from models.attitude.mrp import mrp_error_angle
+    from models.mrp.tracking import RMPCStateMap
     from rmpc import simulate
-    from rmpc.plants import NonlinearPlant
+    from rmpc.sim.plants import NonlinearPlant
 
     case = paper_scenario(scenario)
     model = case.model()

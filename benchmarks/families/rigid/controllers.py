@@ -33,13 +33,13 @@ def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from rmpc.robust_mpc import RMPC
+    from rmpc.mpc.robust_mpc import RMPC
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
     if scenario.kinematics == "scheduled":
         from models import RigidSatellite
-        from rmpc.scheduled_rmpc import ScheduledRMPC
+        from rmpc.mpc.scheduled import ScheduledRMPC
 
         sched = ScheduledRMPC.for_satellite(
             RigidSatellite.paper_p(), poly.dt, scenario.spread, q, r,
@@ -64,7 +64,7 @@ def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
 
 def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -> BuiltController:
-    from rmpc.crmpc import CRMPC
+    from rmpc.mpc.crmpc import CRMPC
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
@@ -98,7 +98,7 @@ def _crmpc_mit(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltControlle
 
 
 def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from rmpc.gipc import GIPC
+    from rmpc.mpc.gipc import GIPC
 
     constrained = scenario.saturation == "constraint"
     ctrl = GIPC(
@@ -115,7 +115,7 @@ def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
 
 def _offline(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from rmpc.offline_rmpc import OfflineRMPC
+    from rmpc.mpc.offline import OfflineRMPC
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
@@ -133,7 +133,7 @@ def _offline(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
 
 def _lqr(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from rmpc.lqr import LQR
+    from rmpc.mpc.lqr import LQR
 
     q, r = _weights(s)
     return BuiltController(LQR(poly, q, r), scenario.saturation == "limiter")

@@ -1,7 +1,7 @@
 """The controllers of the wheel-fault benchmarks and how each meets the wheel torque limit.
 
 Every wheel's torque and momentum limits act in the plant (the input stage of
-:func:`rmpc.wheel_plant.wheel_plant`), whatever the controller. ``saturation`` says whether the
+:func:`benchmarks.families.wheel.plant.wheel_plant`), whatever the controller. ``saturation`` says whether the
 controller designs for the torque limit itself:
 
 - ``"constraint"``: RMPC (per-wheel peak bound ``|u_j| <= u_max`` in its LMIs), CRMPC (the same,

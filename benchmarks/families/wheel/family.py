@@ -217,10 +217,10 @@ def _label(scenario: Any) -> str:
 
 def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper W's satellite, the faults, the controller's polytope and the controller; run; measure."""
+    from benchmarks.families.wheel.metrics import fault_metrics
+    from benchmarks.families.wheel.plant import wheel_plant
     from models import FaultSchedule, WheelSatellite
     from rmpc import simulate
-    from rmpc.fault_metrics import fault_metrics
-    from rmpc.wheel_plant import wheel_plant
 
     paper = _paper_scenario({"scenario": scenario.scenario})
     duration = _run_length(

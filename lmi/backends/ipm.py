@@ -1,0 +1,337 @@
+"""The toolkit's own structure-exploiting interior-point back-end (:mod:`lmi.ipm`).
+
+The LMIs are the same affine matrices as for :class:`lmi.backends.clarabel.ClarabelKothare`
+(built once); here they are kept as matrices, ``S_j = C_j - sum_i z_i A_ij``, and handed to
+:class:`lmi.ipm.BlockLMISolver`. Per state only the state block's constant and the bound
+scalings of the input (and output) blocks change; they are written in place. Successive
+solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any
+
+import clarabel
+import numpy as np
+
+from lmi.affine import smat_matrix, svec_indices, svec_matrix
+from lmi.backends.clarabel import ClarabelKothare, RawResult
+from lmi.data import KothareData
+from lmi.infeasibility import InfeasibilityCertificate, check_farkas
+from lmi.ipm import BlockLMISolver
+from lmi.kothare_factors import VariableLayout, cost_block_factors
+from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
+from lmi.status import INACCURATE, INFEASIBLE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
+from toolkit_common.errors import InvalidArgumentError
+
+__all__ = ["DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
+
+#: A failed cold solve is retried in coordinates balanced on its last ``Q`` (option
+#: ``rebalance``) only if its relative primal and dual residuals came below this.
+REBALANCE_MAX_RESIDUAL = 1e-3
+
+#: Settings. Tolerances: relative residuals and gap 1e-8, as for Clarabel (see
+#: :data:`lmi.backends.clarabel.DEFAULT_CLARABEL_OPTIONS`); on paper P's closed loop gamma then
+#: agrees with a converged 1e-10 Clarabel reference to 1.1e-8 relative or better (measured).
+#: The absolute gap tolerance is 1e-12, not Clarabel's 1e-8: the solver's objective is gamma at
+#: the normalised state (times ``dt`` in the delta formulations), whose size depends only on the
+#: weights, so an absolute 1e-8 meant a different relative accuracy for every problem. Measured
+#: on Kothare's example (objective 3e-3): with 1e-8 a solve stopped at a relative gap of 1.4e-6,
+#: leaving the state 3.8e-6 outside its ellipsoid (x' Q^-1 x - 1); with 1e-12 the relative gap
+#: decided (3 more iterations) and the excess was 4e-12. On paper P (objective about 2) the
+#: relative test decides in both cases.
+#: ``warm_start``: start each solve from an interior iterate of the previous one (a failed warm
+#: start is retried cold, so answers never depend on it); ``max_iter`` limits a cold start,
+#: ``warm_max_iter`` a warm one. ``fallback``: a solve that does not end ``"optimal"`` is
+#: re-solved by Clarabel, which also certifies infeasibility. ``state_scaling``: solve in the
+#: coordinates of :func:`lmi.scaling.state_scaling` (a diagonal change of state coordinates
+#: from the nominal LQR problem; answers are mapped back, and the certificate is computed in
+#: the original coordinates). Measured on the 14-state flexible satellite (2 vertices, Ts =
+#: 0.05 s): without it every cold solve stalled ("insufficient_progress" after 18-19
+#: iterations), with it every solve converged in 19-22 iterations cold, 8-11 warm.
+#: ``rebalance``: a solve that fails but comes within :data:`REBALANCE_MAX_RESIDUAL` of
+#: feasibility is retried cold once, in coordinates balanced on its last ``Q`` (see
+#: :meth:`IPMKothare.solve`); the problem keeps those coordinates. The Riccati diagonal does not
+#: see the constraints: on the flexible satellite's 8-vertex 'groups' polytope at 0.5 s
+#: (``Q1 = diag(400 I6, 0.1 I8)``, peak bound 2 N m) the input bound squeezes the optimal
+#: ellipsoid along the modal coordinates, whose ``Q~`` diagonal then spans 1e-4..20 (2e5), and
+#: the cold solves at rest 13-20 deg about the slew axis and with the modal bound at 10 deg ended
+#: "inaccurate" or "insufficient_progress" after 35-48 iterations. Rebalanced, they ended
+#: "optimal" in 48-69 iterations in all (0.4-1.4 s at load 1-2), gamma within 7e-10 of cvxpy +
+#: Clarabel at 1e-10 on the delta form at 14 deg.
+DEFAULT_IPM_OPTIONS: dict[str, Any] = {
+    "tol_feas": 1e-8,
+    "tol_gap_abs": 1e-12,
+    "tol_gap_rel": 1e-8,
+    "max_iter": 60,
+    "warm_start": True,
+    "warm_max_iter": 25,
+    "fallback": True,
+    "state_scaling": True,
+    "phase_one": True,
+    "rebalance": True,
+}
+_STATUS = {
+    "optimal": OPTIMAL,
+    "inaccurate": INACCURATE,
+    "max_iterations": MAX_ITERATIONS,
+    "numerical_error": NUMERICAL_ERROR,
+    "insufficient_progress": NUMERICAL_ERROR,
+}
+
+
+def _check_options(options: dict[str, Any]) -> dict[str, Any]:
+    unknown = sorted(set(options) - set(DEFAULT_IPM_OPTIONS))
+    if unknown:
+        raise InvalidArgumentError(
+            "solver_options", f"IPM settings ({', '.join(sorted(DEFAULT_IPM_OPTIONS))})",
+            f"unknown setting(s) {unknown}",
+        )
+    merged = {**DEFAULT_IPM_OPTIONS, **options}
+    for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel"):
+        value = merged[key]
+        if isinstance(value, bool) or not (isinstance(value, float | int) and value > 0):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(value))
+    for key in ("max_iter", "warm_max_iter"):
+        value = merged[key]
+        if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
+    for key in ("warm_start", "fallback", "state_scaling", "phase_one", "rebalance"):
+        if not isinstance(merged[key], bool):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
+    return merged
+
+
+class IPMKothare(ClarabelKothare):
+    """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`."""
+
+    name = "ipm"
+
+    def __init__(self, data: KothareData, options: dict[str, Any] | None = None) -> None:
+        merged = _check_options(dict(options or {}))
+        t = state_scaling(data) if merged.pop("state_scaling") else np.ones(data.n)
+        self.original_data = data
+        self._warm_start = merged.pop("warm_start")
+        self._fallback = merged.pop("fallback")
+        self._phase_one = merged.pop("phase_one")
+        self._rebalance = merged.pop("rebalance")
+        self._solver_options = merged
+        self._build(t)
+
+    def _build(self, t: np.ndarray) -> None:
+        """The conic data and the solver in the coordinates ``x~ = diag(t)^-1 x``."""
+        data = self.original_data
+        self._t = t
+        self._scaled = bool(np.any(t != 1.0))
+        super().__init__(scale_data(data, t) if self._scaled else data, None)
+        a_dense = self._A.toarray()
+        h = self._b_static
+        blocks: list[tuple[np.ndarray, np.ndarray]] = []
+        self._block_rows: list[slice] = []
+        for cone, start, stop in zip(self._cones, self._offsets[:-1], self._offsets[1:], strict=True):
+            g_rows, h_rows = a_dense[start:stop], h[start:stop]
+            dim = int(stop - start)
+            if isinstance(cone, clarabel.PSDTriangleConeT):
+                order = round((np.sqrt(8 * dim + 1) - 1) / 2)
+                blocks.append((smat_matrix(h_rows, order), smat_matrix(g_rows.T, order)))
+            else:  # a non-negative cone is a diagonal block
+                eye = np.eye(dim)
+                blocks.append((np.diag(h_rows), g_rows.T[:, :, None] * eye[None]))
+            self._block_rows.append(slice(int(start), int(stop)))
+        self._base_blocks = blocks
+        # the bound-scaled blocks: entry masks (k x k) per (block, bound index, kind)
+        self._scaled_blocks: list[tuple[int, list[tuple[np.ndarray, np.ndarray, str]]]] = []
+        for start, sel, bound_index, kind in self._scaled_rows:
+            j = int(np.searchsorted(self._offsets, start, side="right") - 1)
+            order = blocks[j][0].shape[0]
+            rows, cols = svec_indices(order)
+            parts = []
+            for idx in np.unique(bound_index):
+                pick = sel[bound_index == idx]
+                mask = np.zeros((order, order), dtype=bool)
+                mask[rows[pick], cols[pick]] = True
+                mask[cols[pick], rows[pick]] = True
+                parts.append((mask, idx, kind))
+            self._scaled_blocks.append((j, parts))
+        self._solver = BlockLMISolver(self._q, blocks, factors=self._block_factors(len(blocks)),
+                                      **self._solver_options)
+
+    def _block_factors(self, count: int) -> list:
+        """The cost blocks' factored coefficients (:mod:`lmi.kothare_factors`), ``None`` for the
+        state, bound and diagonal blocks (their coefficients are used as they are)."""
+        n, m = self.data.n, self.data.m
+        o_y = 1 + self._n_q
+        o_w = o_y + self._n_y + self._n_x + self._n_z if self._n_w else None
+        cost = cost_block_factors(self.data, VariableLayout.of(n, m, 1, o_y, o_w))
+        return [None, *cost, *([None] * (count - 1 - len(cost)))]
+
+    def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> None:
+        n = self.data.n
+        const = np.zeros((n + 1, n + 1))
+        const[0, 0] = 1.0
+        const[0, 1:] = x
+        const[1:, 0] = x
+        self._solver.set_block(0, const)
+        for j, parts in self._scaled_blocks:
+            const_j, coef_j = self._base_blocks[j]
+            scale = np.ones(const_j.shape)
+            for mask, idx, kind in parts:
+                bounds = u_max if kind == "u" else y_max
+                scale[mask] = 1.0 / (bounds[0] if bounds.size == 1 else bounds[idx])
+            self._solver.set_block(j, const_j, coef_j * scale)
+
+    def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+        """Solve with the IPM; a failure goes to phase one, then (unless proved infeasible) to
+        Clarabel.
+
+        A solve that does not end ``"optimal"`` runs phase one
+        (:meth:`lmi.ipm.BlockLMISolver.phase_one`). If it proves the problem infeasible and
+        the proof passes :func:`lmi.infeasibility.check_farkas` on the conic data of the
+        fallback (independent of the IPM's own packing, equilibration and factored forms), the
+        answer is ``"infeasible"`` with that certificate (``RawResult.infeasibility``) and
+        ``solver_status`` ``"ipm <word>; phase one infeasible"``. Otherwise the failed solve is
+        handed to Clarabel as before (same conic data), which classifies it or solves it;
+        ``solver_status`` then reads ``"ipm <word>; phase one <word>; clarabel <word>"``.
+        Before that, a failed solve whose relative residuals came below
+        :data:`REBALANCE_MAX_RESIDUAL` and whose last ``Q~`` has a diagonal spanning more than
+        :data:`lmi.scaling.MIN_SPREAD` is retried cold once in coordinates that balance that
+        diagonal (``rebalance``; :meth:`_rebalanced_scaling`): the method is invariant to the
+        coordinates except for its start point, which is centred only for a balanced optimum, and
+        a near-feasible iterate has about the optimum's shape. The data are rebuilt in the new
+        coordinates (about 0.05-0.1 s at 14 states, counted in ``solve_time``) and kept for the
+        next solves. ``solver_status`` then reads ``"<word>; rebalanced <word>"``. A solve that
+        ends ``"optimal"`` never gets here: paper P's answers are unchanged.
+        Times and iterations are the sums over every stage.
+        """
+        xs, us, ys, norm = self._balanced(x, u_max, y_max)
+        raw = self._solve_ipm(xs, us, ys)
+        if raw.status == OPTIMAL:
+            return self._unscale(raw, norm)
+        t_new = self._rebalanced_scaling(raw) if self._rebalance else None
+        if t_new is not None:
+            start = time.perf_counter()
+            self._build(t_new)
+            xs, us, ys, norm = self._balanced(x, u_max, y_max)
+            retry = self._solve_ipm(xs, us, ys)
+            raw = dataclasses.replace(
+                retry, solver_status=f"{raw.solver_status}; rebalanced {retry.solver_status}",
+                iterations=(raw.iterations or 0) + (retry.iterations or 0),
+                solve_time=raw.solve_time + time.perf_counter() - start,
+            )
+            if raw.status == OPTIMAL:
+                return self._unscale(raw, norm)
+        u_max, y_max = us, ys
+        if self._phase_one:
+            raw = self._decide(raw, xs, u_max, y_max)
+            if raw.status == INFEASIBLE:
+                return raw
+        if not self._fallback:
+            return self._unscale(raw, norm)
+        backup = super().solve(xs, u_max, y_max)
+        iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
+        return self._unscale(dataclasses.replace(
+            backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
+            iterations=iterations, solve_time=raw.solve_time + backup.solve_time,
+        ), norm)
+
+    def _balanced(self, x: np.ndarray, u_max: np.ndarray,
+                  y_max: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """The state in the solver's coordinates, normalised again (exact: the LMIs are
+        homogeneous), the bounds divided alike, and that norm. Unscaled, nothing is touched, so
+        the answers are bit-identical to the unscaled solver's."""
+        if not self._scaled:
+            return x, u_max, y_max, 1.0
+        xs = x / self._t
+        norm = float(np.linalg.norm(xs))
+        return xs / norm, u_max / norm, y_max / norm, norm
+
+    def _rebalanced_scaling(self, raw: RawResult) -> np.ndarray | None:
+        """Coordinates balanced on the failed solve ``raw`` (``None``: nothing to gain).
+
+        ``t_i * sqrt(Q~_ii / max_k Q~_kk)`` from the diagonal of its last ``Q~`` (the current
+        coordinates), so that ``Q~`` has a constant diagonal at the level of its largest entry;
+        no coordinate is enlarged. Only if that run came within
+        :data:`REBALANCE_MAX_RESIDUAL` of feasibility (its ``Q~`` then has about the optimum's
+        shape) and the diagonal spans more than :data:`lmi.scaling.MIN_SPREAD`.
+        """
+        if raw.Q is None or self._last_residual > REBALANCE_MAX_RESIDUAL:
+            return None
+        diag = np.diag(raw.Q)
+        if not (np.all(np.isfinite(diag)) and np.all(diag > 0.0)):
+            return None
+        top = float(np.max(diag))
+        if top <= MIN_SPREAD * float(np.min(diag)):
+            return None
+        return self._t * np.sqrt(diag / top)
+
+    def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+        """Phase one after the failed solve ``raw`` (blocks already at this state): ``raw`` as
+        ``"infeasible"`` with the checked certificate, or ``raw`` with phase one's word, time
+        and iterations added."""
+        start = time.perf_counter()
+        try:
+            with self._blas.limit():
+                res = self._solver.phase_one()
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
+            return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {err!r}",
+                                       solve_time=raw.solve_time + time.perf_counter() - start)
+        word = res.status
+        cert = None
+        if res.status == "infeasible":
+            cert = self.farkas_check(res.Z, xs, u_max, y_max)
+            if not cert.ok:
+                word = "infeasible (unchecked)"
+        iterations = (raw.iterations or 0) + res.iterations
+        elapsed = raw.solve_time + time.perf_counter() - start
+        if cert is not None and cert.ok:
+            return RawResult(INFEASIBLE, f"ipm {raw.solver_status}; phase one infeasible", np.nan, None,
+                             None, iterations, elapsed, infeasibility=cert)
+        return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {word}",
+                                   iterations=iterations, solve_time=elapsed)
+
+    def farkas_check(self, z_blocks: list[np.ndarray], xs: np.ndarray, u_max: np.ndarray,
+                     y_max: np.ndarray) -> InfeasibilityCertificate:
+        """Check multipliers ``Z`` (one block per LMI block of the solver) as a Farkas certificate
+        on the conic data Clarabel would be given at this (normalised, balanced) state and
+        bounds: ``A`` with the bound rows scaled, ``b`` with the state block."""
+        parts, cones = [], []
+        for cone, zj, rows in zip(self._cones, z_blocks, self._block_rows, strict=True):
+            if isinstance(cone, clarabel.PSDTriangleConeT):
+                parts.append(svec_matrix(0.5 * (zj + zj.T)))
+                cones.append(("psd", zj.shape[0]))
+            else:  # a non-negative cone: its IPM block is diagonal, only the diagonal of Z counts
+                parts.append(np.diag(zj).copy())
+                cones.append(("nonneg", rows.stop - rows.start))
+        return check_farkas(self._a_matrix(u_max, y_max), self._b_vector(xs), cones, np.concatenate(parts))
+
+    def _unscale(self, raw: RawResult, norm: float) -> RawResult:
+        """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,
+        ``gamma norm^2``."""
+        if raw.Q is None or raw.Y is None or not self._scaled:
+            return raw
+        t, s2 = self._t, norm**2
+        return dataclasses.replace(raw, gamma=raw.gamma * s2, Q=raw.Q * np.outer(t, t) * s2,
+                                   Y=raw.Y * t[None, :] * s2)
+
+    def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+        start = time.perf_counter()
+        try:
+            self._update_blocks(x, u_max, y_max)
+            with self._blas.limit():
+                res = self._solver.solve(warm_start=self._warm_start)
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
+            self._last_residual = np.inf
+            return RawResult(NUMERICAL_ERROR, repr(err), np.nan, None, None, None,
+                             time.perf_counter() - start)
+        elapsed = time.perf_counter() - start
+        self._last_residual = max(res.primal_residual, res.dual_residual)
+        z = res.x
+        gamma = float(z[0])
+        if self.data.formulation != "standard":
+            gamma /= self.data.dt
+        return RawResult(
+            _STATUS.get(res.status, NUMERICAL_ERROR), res.status, gamma, self._q_affine.value(z),
+            self._y_affine.value(z), res.iterations, elapsed,
+        )

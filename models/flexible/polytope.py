@@ -1,0 +1,133 @@
+"""The uncertainty polytope of the flexible satellite's linear model (seed section 9).
+
+Uncertain parameters: ``kappa`` scaling the inverse hub inertia ``J_mb^-1``, the modal
+stiffnesses ``k_i = Lambda_i^2`` (through a scale ``f`` on the frequencies, ``k_i -> f^2 k_i``)
+and the modal damping coefficients ``c_i = 2 xi_i Lambda_i`` (through the frequency scale and a
+scale ``g`` on the damping ratios, ``c_i -> f g c_i``). The continuous-time ``A`` is
+multi-affine in ``(kappa, k_i, c_i)`` and ``B`` is affine in ``kappa``
+(:func:`models.flexible.linear.linear_matrices`), so every model with parameters inside the box
+is a convex combination of the models at its corners, with the multilinear (tensor-product)
+weights. Treating ``k`` and ``c`` as independent (``c`` over ``[f_lo g_lo, f_hi g_hi]`` whatever
+``f``) over-bounds the set: valid, conservative.
+
+Modes (all ranges **assumed**, seed section 9):
+
+- ``"groups"`` (default): one scale each for ``kappa``, all ``k_i`` and all ``c_i``: 8 vertices;
+- ``"box"``: ``kappa`` and every ``k_i``, ``c_i`` independently: ``2^(1 + 2N)`` vertices (512
+  for four modes);
+- ``"effectiveness"``: the hub-torque columns of ``B`` scaled by each end of ``effectiveness``,
+  ``A`` nominal: 2 vertices (the torque-effectiveness polytope used for the LMI work).
+
+**Zero-order hold.** The discrete vertices are the ZOH of the continuous ones. ``e^{A dt}`` is
+not multi-affine in the parameters, so a discretised interior model is in the hull of the
+discretised vertices only up to a residual of order ``dt^2`` (measured in
+``tests/test_flexible_polytope.py``): verify a robust gain on a dense parameter grid.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from models.flexible.linear import ParameterPoint
+from models.linear import PolytopicModel, zoh
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_vector, check_choice, check_positive
+
+if TYPE_CHECKING:
+    from models.flexible.satellite import FlexibleSatellite
+
+__all__ = [
+    "DEFAULT_DAMPING_SCALE",
+    "DEFAULT_EFFECTIVENESS",
+    "DEFAULT_FREQUENCY_SCALE",
+    "DEFAULT_INERTIA_SCALE",
+    "PolytopeMode",
+    "flexible_polytope",
+    "vertex_parameters",
+]
+
+PolytopeMode = Literal["groups", "box", "effectiveness"]
+
+#: Range of ``kappa`` on ``J_mb^-1`` (**assumed**; +-20 %).
+DEFAULT_INERTIA_SCALE: tuple[float, float] = (0.8, 1.2)
+#: Range of the scale on the modal frequencies (**assumed**; +-10 %).
+DEFAULT_FREQUENCY_SCALE: tuple[float, float] = (0.9, 1.1)
+#: Range of the scale on the damping ratios, the least known parameter (**assumed**, seed 9).
+DEFAULT_DAMPING_SCALE: tuple[float, float] = (0.5, 2.0)
+#: Hub-torque effectiveness of the ``"effectiveness"`` mode (**assumed**).
+DEFAULT_EFFECTIVENESS: tuple[float, float] = (0.8, 1.2)
+
+
+def _interval(value: Any, name: str) -> tuple[float, float]:
+    arr = as_vector(value, name, 2)
+    lo, hi = float(arr[0]), float(arr[1])
+    check_positive(lo, f"{name}[0]")
+    if hi < lo:
+        raise InvalidArgumentError(name, "an interval (low, high) with 0 < low <= high", repr((lo, hi)))
+    return lo, hi
+
+
+def vertex_parameters(
+    sat: FlexibleSatellite,
+    mode: PolytopeMode = "groups",
+    inertia_scale: Any = DEFAULT_INERTIA_SCALE,
+    frequency_scale: Any = DEFAULT_FREQUENCY_SCALE,
+    damping_scale: Any = DEFAULT_DAMPING_SCALE,
+    effectiveness: Any = DEFAULT_EFFECTIVENESS,
+) -> list[ParameterPoint]:
+    """The parameter points at the corners of the uncertainty box, in vertex order.
+
+    Order: ``itertools.product`` over the uncertain coordinates, low end first, in the order
+    ``kappa``, then the stiffness scale(s), then the damping scale(s) (``"groups"``: 3
+    coordinates; ``"box"``: ``kappa, k_1..k_N, c_1..c_N``; ``"effectiveness"``: one).
+    """
+    check_choice(mode, "mode", ("groups", "box", "effectiveness"))
+    if mode == "effectiveness":
+        lo, hi = _interval(effectiveness, "effectiveness")
+        return [ParameterPoint(effectiveness=e) for e in (lo, hi)]
+    kap = _interval(inertia_scale, "inertia_scale")
+    f_lo, f_hi = _interval(frequency_scale, "frequency_scale")
+    g_lo, g_hi = _interval(damping_scale, "damping_scale")
+    k0 = np.diag(sat.stiffness).copy()
+    c0 = np.diag(sat.damping_matrix).copy()
+    k_scales = (f_lo**2, f_hi**2)
+    c_scales = (f_lo * g_lo, f_hi * g_hi)
+    points = []
+    if mode == "groups":
+        for kappa, sk, sc in itertools.product(kap, k_scales, c_scales):
+            points.append(ParameterPoint(kappa=kappa, stiffness=sk * k0, viscous_damping=sc * c0))
+        return points
+    n = sat.n_modes
+    for corner in itertools.product((0, 1), repeat=1 + 2 * n):
+        kappa = kap[corner[0]]
+        k = np.array([k_scales[j] for j in corner[1:1 + n]]) * k0
+        c = np.array([c_scales[j] for j in corner[1 + n:]]) * c0
+        points.append(ParameterPoint(kappa=kappa, stiffness=k, viscous_damping=c))
+    return points
+
+
+def flexible_polytope(
+    sat: FlexibleSatellite,
+    dt: float,
+    *,
+    x_op: Any = None,
+    mode: PolytopeMode = "groups",
+    inertia_scale: Any = DEFAULT_INERTIA_SCALE,
+    frequency_scale: Any = DEFAULT_FREQUENCY_SCALE,
+    damping_scale: Any = DEFAULT_DAMPING_SCALE,
+    effectiveness: Any = DEFAULT_EFFECTIVENESS,
+    attitude: Literal["euler", "quaternion"] = "euler",
+    pzt: bool = False,
+) -> PolytopicModel:
+    """The ZOH-discretised polytope; see :meth:`models.FlexibleSatellite.polytope`."""
+    dt = check_positive(dt, "dt")
+    points = vertex_parameters(sat, mode, inertia_scale, frequency_scale, damping_scale, effectiveness)
+    verts = [zoh(*sat.linearize(x_op, pzt=pzt, attitude=attitude, parameters=p), dt) for p in points]
+    nominal = zoh(*sat.linearize(x_op, pzt=pzt, attitude=attitude), dt)
+    return PolytopicModel(
+        verts, dt, nominal=nominal, state_names=sat.linear_state_names(attitude),
+        input_names=sat.input_names[: 3 + (sat.n_pzt if pzt else 0)],
+    )

@@ -1,0 +1,266 @@
+"""Linear models: zero-order-hold discretisation and polytopic discrete-time models.
+
+:func:`zoh` turns ``x' = A x + B u`` into ``x(k+1) = Ad x(k) + Bd u(k)``;
+:class:`PolytopicModel` holds ``x(k+1) = A x(k) + B u(k)`` with ``[A B] in Co{[A_j B_j]}``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.linalg import expm
+
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_positive
+
+__all__ = ["PolytopicModel", "zoh"]
+
+
+def zoh(a: np.ndarray, b: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Discretise ``x' = A x + B u`` with a zero-order hold on ``u`` over ``dt``.
+
+    Uses the exponential of the block matrix ``[[A, B], [0, 0]] dt`` (Van Loan), which gives
+    ``Ad = e^{A dt}`` and ``Bd = int_0^dt e^{A s} ds B`` exactly, also for singular ``A``.
+
+    Parameters
+    ----------
+    a : (n, n) array_like
+    b : (n, m) array_like
+    dt : float
+        Sample time in seconds, > 0.
+
+    Returns
+    -------
+    ad, bd : ndarray
+        The discrete-time matrices.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import zoh
+    >>> ad, bd = zoh([[0.0, 1.0], [0.0, 0.0]], [[0.0], [1.0]], 0.1)
+    >>> np.allclose(bd.ravel(), [0.005, 0.1])
+    True
+    """
+    a = as_matrix(a, "a")
+    n = a.shape[0]
+    a = as_matrix(a, "a", (n, n))
+    b = as_matrix(b, "b", (n, None))
+    dt = check_positive(dt, "dt")
+    m = b.shape[1]
+    block = np.zeros((n + m, n + m))
+    block[:n, :n] = a
+    block[:n, n:] = b
+    phi = expm(block * dt)
+    return phi[:n, :n], phi[:n, n:]
+
+
+class PolytopicModel:
+    """A discrete-time linear model whose ``[A B]`` lies in the convex hull of vertices.
+
+    Parameters
+    ----------
+    vertices : sequence of (A, B) pairs
+        Each ``A`` is ``(n, n)`` and each ``B`` is ``(n, m)``, all of the same sizes.
+        At least one vertex.
+    dt : float
+        Sample time in seconds (> 0). The model is discrete-time.
+    nominal : (A, B) pair, optional
+        The nominal model (for prediction, reference models, reports). Defaults to the mean
+        of the vertices, which lies inside the polytope.
+    state_names, input_names : sequence of str, optional
+        Names used in reports and in python-control conversions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import PolytopicModel
+    >>> A = np.array([[1.0, 0.1], [0.0, 1.0]])
+    >>> plant = PolytopicModel([(A, [[0.0], [0.1]]), (A, [[0.0], [0.2]])], dt=0.1)
+    >>> plant.n_states, plant.n_inputs, plant.n_vertices
+    (2, 1, 2)
+    >>> plant.nominal[1].ravel().tolist()
+    [0.0, 0.15000000000000002]
+    """
+
+    def __init__(
+        self,
+        vertices: Sequence[tuple[Any, Any]],
+        dt: float,
+        nominal: tuple[Any, Any] | None = None,
+        state_names: Sequence[str] | None = None,
+        input_names: Sequence[str] | None = None,
+    ) -> None:
+        if isinstance(vertices, np.ndarray) or not isinstance(vertices, Sequence):
+            raise ArgumentTypeError(
+                "vertices", "a sequence of (A, B) pairs", type(vertices).__name__
+            )
+        if len(vertices) == 0:
+            raise InvalidArgumentError("vertices", "at least one (A, B) pair", "an empty sequence")
+        a_list: list[np.ndarray] = []
+        b_list: list[np.ndarray] = []
+        n = m = None
+        for j, pair in enumerate(vertices):
+            if not isinstance(pair, Sequence) or len(pair) != 2:
+                raise InvalidArgumentError(
+                    f"vertices[{j}]", "an (A, B) pair", f"{type(pair).__name__}"
+                )
+            a = as_matrix(pair[0], f"vertices[{j}] A")
+            if n is None:
+                n = a.shape[0]
+            a = as_matrix(a, f"vertices[{j}] A", (n, n))
+            b = as_matrix(pair[1], f"vertices[{j}] B", (n, m))
+            if m is None:
+                m = b.shape[1]
+            a_list.append(a)
+            b_list.append(b)
+        assert n is not None and m is not None
+        self._a = np.stack(a_list)
+        self._b = np.stack(b_list)
+        self._a.setflags(write=False)
+        self._b.setflags(write=False)
+        self._dt = check_positive(dt, "dt")
+        if nominal is None:
+            a_nom, b_nom = self._a.mean(axis=0), self._b.mean(axis=0)
+        else:
+            if not isinstance(nominal, Sequence) or len(nominal) != 2:
+                raise InvalidArgumentError("nominal", "an (A, B) pair", type(nominal).__name__)
+            a_nom = as_matrix(nominal[0], "nominal A", (n, n))
+            b_nom = as_matrix(nominal[1], "nominal B", (n, m))
+        a_nom.setflags(write=False)
+        b_nom.setflags(write=False)
+        self._nominal = (a_nom, b_nom)
+        self.state_names = self._names(state_names, "state_names", n, "x")
+        self.input_names = self._names(input_names, "input_names", m, "u")
+
+    @staticmethod
+    def _names(names: Sequence[str] | None, arg: str, size: int, prefix: str) -> tuple[str, ...]:
+        if names is None:
+            return tuple(f"{prefix}[{i}]" for i in range(size))
+        names = tuple(str(s) for s in names)
+        if len(names) != size:
+            raise InvalidArgumentError(arg, f"{size} names", f"{len(names)}")
+        return names
+
+    # -- sizes and data ----------------------------------------------------------------
+    @property
+    def n_states(self) -> int:
+        """Number of states ``n``."""
+        return int(self._a.shape[1])
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of inputs ``m``."""
+        return int(self._b.shape[2])
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices of the polytope."""
+        return int(self._a.shape[0])
+
+    @property
+    def dt(self) -> float:
+        """Sample time in seconds."""
+        return self._dt
+
+    @property
+    def A(self) -> np.ndarray:
+        """Vertex state matrices, shape ``(n_vertices, n, n)`` (read-only)."""
+        return self._a
+
+    @property
+    def B(self) -> np.ndarray:
+        """Vertex input matrices, shape ``(n_vertices, n, m)`` (read-only)."""
+        return self._b
+
+    @property
+    def vertices(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The vertices as a list of ``(A, B)`` pairs."""
+        return [(self._a[j], self._b[j]) for j in range(self.n_vertices)]
+
+    @property
+    def nominal(self) -> tuple[np.ndarray, np.ndarray]:
+        """The nominal ``(A, B)``."""
+        return self._nominal
+
+    def vertex(self, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """Return vertex ``index`` as an ``(A, B)`` pair."""
+        if not isinstance(index, int | np.integer) or not -self.n_vertices <= index < self.n_vertices:
+            raise InvalidArgumentError(
+                "index", f"an integer in [0, {self.n_vertices - 1}]", repr(index)
+            )
+        return self._a[index], self._b[index]
+
+    def combination(self, weights: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Return ``sum_j w_j (A_j, B_j)`` for convex weights ``w`` (non-negative, sum 1)."""
+        w = as_vector(weights, "weights", self.n_vertices)
+        if np.any(w < -1e-12) or abs(w.sum() - 1.0) > 1e-9:
+            raise InvalidArgumentError(
+                "weights", "non-negative weights that sum to 1", f"{w.tolist()} (sum {w.sum():.6g})"
+            )
+        return np.tensordot(w, self._a, axes=1), np.tensordot(w, self._b, axes=1)
+
+    # -- python-control ----------------------------------------------------------------
+    def to_statespace(self, vertex: int | None = None) -> Any:
+        """Return a python-control ``StateSpace`` (full-state output) of a vertex or the nominal.
+
+        Parameters
+        ----------
+        vertex : int, optional
+            Vertex index; ``None`` gives the nominal model.
+        """
+        import control
+
+        a, b = self.nominal if vertex is None else self.vertex(vertex)
+        n, m = self.n_states, self.n_inputs
+        return control.ss(
+            a, b, np.eye(n), np.zeros((n, m)), self.dt,
+            states=list(self.state_names), inputs=list(self.input_names),
+            outputs=[f"y_{s}" for s in self.state_names],
+        )
+
+    def to_statespace_list(self) -> list[Any]:
+        """Return every vertex as a python-control ``StateSpace``."""
+        return [self.to_statespace(j) for j in range(self.n_vertices)]
+
+    @classmethod
+    def from_statespace(cls, systems: Any, nominal: Any | None = None) -> PolytopicModel:
+        """Build a polytope from python-control discrete-time ``StateSpace`` vertices.
+
+        Parameters
+        ----------
+        systems : StateSpace or sequence of StateSpace
+            Discrete-time systems with a common, positive ``dt`` and equal sizes. Only ``A``
+            and ``B`` are used (the polytope is in the state equation).
+        nominal : StateSpace, optional
+            The nominal system; defaults to the mean of the vertices.
+        """
+        import control
+
+        if isinstance(systems, control.StateSpace):
+            systems = [systems]
+        if not isinstance(systems, Sequence) or len(systems) == 0:
+            raise InvalidArgumentError(
+                "systems", "a StateSpace or a non-empty sequence of them", type(systems).__name__
+            )
+        dts = []
+        for j, sys in enumerate(systems):
+            if not isinstance(sys, control.StateSpace):
+                raise ArgumentTypeError(f"systems[{j}]", "a control.StateSpace", type(sys).__name__)
+            if sys.dt is None or sys.dt is True or not sys.dt > 0:
+                raise InvalidArgumentError(
+                    f"systems[{j}].dt", "a discrete-time system with a numeric dt > 0", repr(sys.dt)
+                )
+            dts.append(float(sys.dt))
+        if max(dts) - min(dts) > 1e-12 * max(dts):
+            raise InvalidArgumentError("systems", "a common dt", f"dt values {dts}")
+        nom = None if nominal is None else (nominal.A, nominal.B)
+        return cls([(s.A, s.B) for s in systems], dt=dts[0], nominal=nom)
+
+    def __repr__(self) -> str:
+        return (
+            f"PolytopicModel(n_states={self.n_states}, n_inputs={self.n_inputs}, "
+            f"n_vertices={self.n_vertices}, dt={self.dt:g})"
+        )

@@ -1,0 +1,84 @@
+"""The protocols every plant of the toolkit follows: :class:`Plant` and :class:`InputStage`.
+
+A *plant* is a continuous-time model ``x' = f(x, u, d)``: paper P's rigid satellite, paper W's
+wheel satellite, paper M's satellite in MRPs, the flexible satellite, or a user's own. The
+simulator (:func:`rmpc.simulate`) integrates any object that follows :class:`Plant`; reports
+read its attitude through :meth:`Plant.attitude_euler`, whatever the attitude representation
+of its state (Euler angles, a quaternion, MRPs).
+
+An *input stage* models what happens to the held command inside the actuators while the plant
+moves (faults, per-actuator limits, actuator noise); the simulator calls it inside the
+integration.
+
+Examples
+--------
+>>> from models import FlexibleSatellite, MRPSatellite, RigidSatellite, WheelSatellite
+>>> from models.protocols import Plant
+>>> sats = (RigidSatellite.paper_p(), WheelSatellite.paper_w(), MRPSatellite.paper_m(),
+...         FlexibleSatellite.di_gennaro())
+>>> all(isinstance(sat, Plant) for sat in sats)
+True
+>>> [(sat.n_states, sat.n_inputs) for sat in sats]
+[(6, 3), (10, 4), (6, 3), (15, 7)]
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = ["InputStage", "Plant"]
+
+
+@runtime_checkable
+class Plant(Protocol):
+    """A continuous-time plant ``x' = dynamics(x, u, d)``.
+
+    Attributes
+    ----------
+    n_states, n_inputs : int
+        Sizes of ``x`` and ``u``.
+    state_names, input_names : tuple of str
+        One name per state and per input, for reports and plots.
+
+    Notes
+    -----
+    Optional members, used when present:
+
+    - ``n_disturbances`` (int): the size of ``d`` (default ``n_inputs``);
+    - ``normalize_state(x) -> x``: applied by the integrators after every step (the MRP
+      shadow-set switch, the renormalisation of a quaternion).
+    """
+
+    n_states: int
+    n_inputs: int
+    state_names: tuple[str, ...]
+    input_names: tuple[str, ...]
+
+    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:  # pragma: no cover
+        """The state derivative at ``x`` with input ``u`` and disturbance ``d`` (both default zero)."""
+        ...
+
+    def attitude_euler(self, x: Any) -> np.ndarray:  # pragma: no cover
+        """Roll, pitch and yaw (rad, 3-2-1 sequence) of the attitude held in the state ``x``."""
+        ...
+
+
+@runtime_checkable
+class InputStage(Protocol):
+    """What the actuators do to the held command while the plant moves (faults, limits, noise).
+
+    ``stage(t, x, u)`` returns the input the plant receives at time ``t`` in state ``x`` when
+    ``u`` is the held command of the current sample. It must be a pure function of its
+    arguments and of the stage's per-sample state, since the integrator calls it many times per
+    sample. Optional methods, used when present:
+
+    - ``reset()``: called by :func:`~rmpc.simulate` before a run (re-seed noise, clear state);
+    - ``begin_sample(t, x, u) -> dict``: called once at the start of each sample, before the
+      integration (draw this sample's noise, say); the returned mapping of names to arrays or
+      numbers is logged per sample in :attr:`rmpc.Trajectory.stage_log`.
+    """
+
+    def __call__(self, t: float, x: np.ndarray, u: np.ndarray) -> np.ndarray:  # pragma: no cover
+        ...

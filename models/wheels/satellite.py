@@ -1,0 +1,461 @@
+"""The satellite (air-bearing platform) of paper W: rigid body, reaction-wheel array, imbalance torque.
+
+State ``x = [phi, theta, psi, p, q, r, h_1..h_m]`` (3-2-1 Euler angles in rad, body rates in
+rad/s, wheel momenta along their own axes in N m s), input ``u`` = the torques the ``m`` wheels
+actually apply to the platform (N m; faults and limits act before, in
+:class:`~models.WheelInputStage`), disturbance ``d`` = a body torque (3, N m). Seed
+``paper-W-wheel-faults.md`` section 2.2::
+
+    eta' = K(phi, theta) w                                   (models.attitude.euler)
+    J w' = -w x (J w) [- w x (D h)] + D (u - f) + d_g(eta) + d
+    h'   = -u + f
+
+- ``d_g = s m g (r x k(eta))``, ``k = [-sin(theta), sin(phi) cos(theta), cos(phi) cos(theta)]``
+  the gravity direction in body axes (z down at level), ``m g r`` the imbalance (N m) and
+  ``s = +1`` (``gravity="pendulous"``, default, **likely**), ``-1`` (``"inverted"``, paper W's
+  eq. 13 sign) or ``0`` (``"off"``). Paper W prints ``k_y = cos(phi) sin(theta)``, a misprint
+  (**certain**): eq. (7) needs ``sin(phi) cos(theta)``, used here.
+- ``-w x (D h)`` (the wheels' gyroscopic torque) is left out by default, as paper W does by
+  folding it into ``u`` (**assumed**); ``wheel_gyroscopic=True`` adds it to the plant only.
+- ``f_j = -b Omega_j - c sign(Omega_j)`` is the bearing friction on wheel ``j`` with
+  ``Omega_j = h_j / I_w`` (the body rate is neglected next to the wheel speed): off by default
+  (``b = c = 0``, **assumed**). Friction is internal: it slows the wheel and drags the platform
+  along, and leaves the total angular momentum unchanged.
+
+With the gyroscopic term on, gravity off and ``d = 0`` the inertial angular momentum
+``R(eta) (J w + D h)`` is conserved (:meth:`WheelSatellite.angular_momentum_inertial`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+
+from models.attitude.euler import kinematics_matrix, rotation_matrix
+from models.linear import PolytopicModel, zoh
+from models.rigid.satellite import _as_inertia, skew
+from models.wheels.array import WheelArray, _rank
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_choice, check_positive
+
+__all__ = [
+    "PAPER_W_ATTITUDE_RANGE_DEG",
+    "PAPER_W_IMBALANCE",
+    "PAPER_W_INERTIA",
+    "PAPER_W_SAMPLE_TIME",
+    "WheelSatellite",
+    "gravity_direction",
+]
+
+#: Inertia of paper W's platform, kg m^2 (**certain**); eig = 1.6491, 1.8993, 3.4326.
+PAPER_W_INERTIA: tuple[tuple[float, float, float], ...] = (
+    (1.814, -0.1185, 0.02749),
+    (-0.1185, 1.735, 0.01697),
+    (0.02749, 0.01697, 3.432),
+)
+#: Imbalance ``m g r`` of paper W, N m: ``m g r_z = 0.326`` (**certain** as printed), ``r_x = r_y = 0``.
+PAPER_W_IMBALANCE: tuple[float, float, float] = (0.0, 0.0, 0.326)
+#: Control period of paper W's hardware loop, s (**certain**).
+PAPER_W_SAMPLE_TIME: float = 0.04
+#: Attitude range of paper W's platform, deg: ``|phi|, |theta| <= 40``, ``|psi| <= 180`` (**certain**).
+PAPER_W_ATTITUDE_RANGE_DEG: tuple[float, float, float] = (40.0, 40.0, 180.0)
+
+GravityMode = Literal["pendulous", "inverted", "off"]
+EffectivenessSpec = Literal["single_outage", "box"] | str
+_GRAVITY_SIGN = {"pendulous": 1.0, "inverted": -1.0, "off": 0.0}
+
+STATE_NAMES_6: tuple[str, ...] = ("phi", "theta", "psi", "p", "q", "r")
+
+
+def gravity_direction(phi: float, theta: float) -> np.ndarray:
+    """The gravity direction in body axes, ``k = [-s_th, s_ph c_th, c_ph c_th]`` (z down at level)."""
+    s_p, c_p = np.sin(phi), np.cos(phi)
+    s_t, c_t = np.sin(theta), np.cos(theta)
+    return np.array([-s_t, s_p * c_t, c_p * c_t])
+
+
+def _check_bool(value: Any, name: str) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
+    return bool(value)
+
+
+class WheelSatellite:
+    """A rigid platform with a reaction-wheel array and an imbalance (gravity) torque.
+
+    Parameters
+    ----------
+    inertia : array_like
+        Platform inertia ``J`` (wheels included): three principal inertias or a symmetric
+        positive definite 3 x 3 matrix (kg m^2).
+    wheels : WheelArray
+        The wheel array (``D``, limits, wheel inertia).
+    imbalance : float or (3,) array_like
+        ``m g r`` in N m, ``r`` from the rotation centre to the centre of mass in body axes.
+        A scalar means ``m g r_z`` (``r_x = r_y = 0``).
+    gravity : {"pendulous", "inverted", "off"}
+        Sign of the imbalance torque (see the module notes). Default ``"pendulous"``.
+    wheel_gyroscopic : bool
+        Add ``-w x (D h)`` to the rate equation (default ``False``, as paper W).
+    viscous_friction : float or (m,) array_like
+        ``b`` in N m s/rad per wheel (default 0).
+    coulomb_friction : float or (m,) array_like
+        ``c`` in N m per wheel (default 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import WheelSatellite
+    >>> sat = WheelSatellite.paper_w()
+    >>> sat.n_states, sat.n_inputs, sat.n_disturbances
+    (10, 4, 3)
+    >>> x0 = sat.state(np.radians([40.0, 0.0, 0.0]))
+    >>> sat.gravity_torque(x0[:3]).round(4).tolist()  # restoring roll torque
+    [-0.2095, 0.0, 0.0]
+    >>> sat.polytope(dt=0.04).n_vertices  # healthy + one outage per wheel
+    5
+    """
+
+    n_disturbances = 3
+
+    def __init__(
+        self,
+        inertia: Any,
+        wheels: WheelArray,
+        imbalance: Any = PAPER_W_IMBALANCE,
+        gravity: GravityMode = "pendulous",
+        *,
+        wheel_gyroscopic: bool = False,
+        viscous_friction: Any = 0.0,
+        coulomb_friction: Any = 0.0,
+    ) -> None:
+        self._inertia = _as_inertia(inertia)
+        if not isinstance(wheels, WheelArray):
+            raise ArgumentTypeError("wheels", "a models.WheelArray", type(wheels).__name__)
+        self._wheels = wheels
+        if np.ndim(imbalance) == 0:
+            imb = np.array([0.0, 0.0, float(as_vector([imbalance], "imbalance", 1)[0])])
+        else:
+            imb = as_vector(imbalance, "imbalance", 3)
+        self._imbalance = imb
+        self._gravity = check_choice(gravity, "gravity", tuple(_GRAVITY_SIGN))
+        self._sign = _GRAVITY_SIGN[gravity]
+        self._gyroscopic = _check_bool(wheel_gyroscopic, "wheel_gyroscopic")
+        m = wheels.n_wheels
+        self._viscous = self._friction(viscous_friction, "viscous_friction", m)
+        self._coulomb = self._friction(coulomb_friction, "coulomb_friction", m)
+        self._inertia_inv = np.linalg.inv(self._inertia)
+        self._g2 = self._inertia_inv @ wheels.D
+        for arr in (
+            self._inertia,
+            self._inertia_inv,
+            self._imbalance,
+            self._viscous,
+            self._coulomb,
+            self._g2,
+        ):
+            arr.setflags(write=False)
+
+    @staticmethod
+    def _friction(value: Any, name: str, m: int) -> np.ndarray:
+        vec = (
+            np.full(m, check_positive(value, name, allow_zero=True))
+            if np.ndim(value) == 0
+            else as_vector(value, name, m)
+        )
+        if np.any(vec < 0.0):
+            raise InvalidArgumentError(name, "friction coefficients >= 0", repr(vec.tolist()))
+        return vec
+
+    @classmethod
+    def paper_w(cls, gravity: GravityMode = "pendulous", **options: Any) -> WheelSatellite:
+        """Paper W's platform: ``J`` of seed 2.6, :meth:`WheelArray.paper_w`, ``m g r_z = 0.326`` N m.
+
+        ``gravity`` and the keyword options of the constructor (``wheel_gyroscopic``,
+        ``viscous_friction``, ``coulomb_friction``) may be changed.
+        """
+        return cls(PAPER_W_INERTIA, WheelArray.paper_w(), PAPER_W_IMBALANCE, gravity, **options)
+
+    def replace(self, **changes: Any) -> WheelSatellite:
+        """A copy with some constructor arguments changed, e.g. ``replace(inertia=1.2 * sat.inertia)``."""
+        args: dict[str, Any] = {
+            "inertia": self._inertia,
+            "wheels": self._wheels,
+            "imbalance": self._imbalance,
+            "gravity": self._gravity,
+            "wheel_gyroscopic": self._gyroscopic,
+            "viscous_friction": self._viscous,
+            "coulomb_friction": self._coulomb,
+        }
+        unknown = sorted(set(changes) - set(args))
+        if unknown:
+            raise InvalidArgumentError("changes", f"constructor arguments ({', '.join(args)})", repr(unknown))
+        args.update(changes)
+        inertia, wheels, imbalance, gravity = (
+            args.pop(k) for k in ("inertia", "wheels", "imbalance", "gravity")
+        )
+        return WheelSatellite(inertia, wheels, imbalance, gravity, **args)
+
+    # -- parameters ------------------------------------------------------------------------
+    @property
+    def n_wheels(self) -> int:
+        """Number of wheels ``m``."""
+        return self._wheels.n_wheels
+
+    @property
+    def n_states(self) -> int:
+        """``6 + m``: attitude, rates and wheel momenta."""
+        return 6 + self.n_wheels
+
+    @property
+    def n_inputs(self) -> int:
+        """``m`` wheel torques."""
+        return self.n_wheels
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """Platform inertia ``J`` (kg m^2, read-only)."""
+        return self._inertia
+
+    @property
+    def inertia_inv(self) -> np.ndarray:
+        """``J^-1`` (read-only)."""
+        return self._inertia_inv
+
+    @property
+    def wheels(self) -> WheelArray:
+        """The wheel array."""
+        return self._wheels
+
+    @property
+    def imbalance(self) -> np.ndarray:
+        """``m g r`` (N m, read-only)."""
+        return self._imbalance
+
+    @property
+    def gravity(self) -> str:
+        """``"pendulous"``, ``"inverted"`` or ``"off"``."""
+        return self._gravity
+
+    @property
+    def wheel_gyroscopic(self) -> bool:
+        """Whether the plant includes ``-w x (D h)``."""
+        return self._gyroscopic
+
+    @property
+    def input_matrix(self) -> np.ndarray:
+        """``g2 = J^-1 D`` (3 x m, read-only): the rate equation's input matrix (paper W's ``g2``)."""
+        return self._g2
+
+    def nominal_gain(self, effectiveness: Any = None) -> np.ndarray:
+        """Paper W's ``G = (g2 Lambda g2')^-1`` (3 x 3); all wheels healthy by default (``G_nom``).
+
+        Raises :class:`~toolkit_common.errors.InvalidArgumentError` naming ``effectiveness`` when
+        ``rank(D Lambda) < 3`` (``G`` does not exist).
+        """
+        lam = (
+            np.ones(self.n_wheels)
+            if effectiveness is None
+            else as_vector(effectiveness, "effectiveness", self.n_wheels)
+        )
+        self._wheels.effective_matrix(lam)  # checks [0, 1]
+        if _rank(self._wheels.D * lam) < 3:
+            raise InvalidArgumentError(
+                "effectiveness", "wheels that span three axes (rank(D Lambda) = 3)", repr(lam.tolist())
+            )
+        return np.linalg.inv((self._g2 * lam) @ self._g2.T)
+
+    def __repr__(self) -> str:
+        return (
+            f"WheelSatellite(n_wheels={self.n_wheels}, gravity={self._gravity!r}, "
+            f"imbalance={self._imbalance.tolist()}, wheel_gyroscopic={self._gyroscopic})"
+        )
+
+    def state(self, attitude: Any, rates: Any = None, momenta: Any = None) -> np.ndarray:
+        """The full state from the attitude (rad), rates (default 0) and wheel momenta (default 0)."""
+        att = as_vector(attitude, "attitude", 3)
+        w = np.zeros(3) if rates is None else as_vector(rates, "rates", 3)
+        h = np.zeros(self.n_wheels) if momenta is None else as_vector(momenta, "momenta", self.n_wheels)
+        return np.concatenate((att, w, h))
+
+    # -- nonlinear model -------------------------------------------------------------------
+    def gravity_torque(self, attitude: Any) -> np.ndarray:
+        """``d_g(eta) = s m g (r x k(eta))`` in body axes (N m); yaw does not enter."""
+        att = np.asarray(attitude, dtype=float)
+        # + 0.0 turns the -0.0 of a zero component into 0.0
+        return self._sign * np.cross(self._imbalance, gravity_direction(att[0], att[1])) + 0.0
+
+    def friction_torque(self, momenta: Any) -> np.ndarray:
+        """Bearing friction ``f_j`` on each wheel (N m), zero unless friction is switched on."""
+        omega = np.asarray(momenta, dtype=float) / self._wheels.wheel_inertia
+        return -self._viscous * omega - self._coulomb * np.sign(omega)
+
+    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
+        """``x'`` for the state ``x``, applied wheel torques ``u`` (m) and body torque ``d`` (3).
+
+        Raises :class:`~toolkit_common.errors.SingularityError` at pitch = +-90 deg.
+        """
+        x = as_vector(x, "x", self.n_states)
+        u_vec = np.zeros(self.n_wheels) if u is None else as_vector(u, "u", self.n_wheels)
+        d_vec = np.zeros(3) if d is None else as_vector(d, "d", 3)
+        return self._rhs(x, u_vec, d_vec)
+
+    def _rhs(self, x: np.ndarray, u: np.ndarray, d: np.ndarray) -> np.ndarray:
+        w, h = x[3:6], x[6:]
+        dmat = self._wheels.D
+        wheel_torque = u - self.friction_torque(h) if (self._viscous.any() or self._coulomb.any()) else u
+        torque = dmat @ wheel_torque + self.gravity_torque(x[:3]) + d - np.cross(w, self._inertia @ w)
+        if self._gyroscopic:
+            torque = torque - np.cross(w, dmat @ h)
+        eta_dot = kinematics_matrix(x[0], x[1]) @ w
+        return np.concatenate((eta_dot, self._inertia_inv @ torque, -wheel_torque))
+
+    def angular_momentum_body(self, x: Any) -> np.ndarray:
+        """Total angular momentum in body axes, ``J w + D h`` (N m s)."""
+        x = as_vector(x, "x", self.n_states)
+        return self._inertia @ x[3:6] + self._wheels.D @ x[6:]
+
+    def angular_momentum_inertial(self, x: Any) -> np.ndarray:
+        """Total angular momentum in the inertial frame, ``R(eta) (J w + D h)`` (N m s)."""
+        x = as_vector(x, "x", self.n_states)
+        return rotation_matrix(x[:3]) @ self.angular_momentum_body(x)
+
+    # -- linear model at level attitude ----------------------------------------------------
+    def gravity_stiffness(self) -> np.ndarray:
+        """``K_g = -d(d_g)/d(eta)`` at level attitude (3 x 3; pendulous paper W: ``0.326 diag(1, 1, 0)``)."""
+        dk = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])  # [dk/dphi, dk/dtheta, dk/dpsi]
+        return -self._sign * skew(self._imbalance) @ dk
+
+    def linearize(
+        self, effectiveness: Any = None, inertia_scale: float = 1.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Continuous ``(A, B)`` of the attitude and rates at level attitude, zero rates and momenta.
+
+        Seed section 8: ``A = [[0, I3], [-J^-1 K_g, 0]]``, ``B = [0; J^-1 D Lambda]`` with
+        ``Lambda = diag(effectiveness)`` (default all wheels healthy) and ``J`` scaled by
+        ``inertia_scale``. The wheel momenta do not enter the attitude (``h' = -u`` is left
+        out; it is the plant's business, through the momentum limit).
+        """
+        s = check_positive(inertia_scale, "inertia_scale")
+        lam = (
+            np.ones(self.n_wheels)
+            if effectiveness is None
+            else as_vector(effectiveness, "effectiveness", self.n_wheels)
+        )
+        d_lam = self._wheels.effective_matrix(lam)
+        j_inv = self._inertia_inv / s
+        a = np.zeros((6, 6))
+        a[:3, 3:] = np.eye(3)
+        a[3:, :3] = -j_inv @ self.gravity_stiffness()
+        b = np.zeros((6, self.n_wheels))
+        b[3:, :] = j_inv @ d_lam
+        return a, b
+
+    def discretize(
+        self, dt: float, effectiveness: Any = None, inertia_scale: float = 1.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt``."""
+        a, b = self.linearize(effectiveness, inertia_scale)
+        return zoh(a, b, check_positive(dt, "dt"))
+
+    def effectiveness_vertices(
+        self, effectiveness: Any = "single_outage", lambda_min: float = 0.2
+    ) -> np.ndarray:
+        """The wheel-effectiveness vertices ``lambda`` (one row per vertex, ``(k, m)``).
+
+        Parameters
+        ----------
+        effectiveness : {"single_outage", "box"} or (k, m) array_like
+            ``"single_outage"`` (default): the healthy array and each single outage,
+            ``conv{1, 1 - e_j}`` (``m + 1`` vertices; seed 8(a)). ``"box"``:
+            ``[lambda_min, 1]^m`` (``2^m`` vertices, healthy first; 8(b), 8(c) with
+            ``lambda_min = 0``). Or explicit vertices, each in ``[0, 1]^m``.
+        lambda_min : float
+            Lower corner of the box, in ``[0, 1)`` (default 0.2, **assumed**).
+        """
+        m = self.n_wheels
+        if isinstance(effectiveness, str):
+            check_choice(effectiveness, "effectiveness", ("single_outage", "box"))
+            if effectiveness == "single_outage":
+                return np.vstack((np.ones(m), 1.0 - np.eye(m)))
+            lo = check_positive(lambda_min, "lambda_min", allow_zero=True)
+            if lo >= 1.0:
+                raise InvalidArgumentError("lambda_min", "a lower corner in [0, 1)", repr(lambda_min))
+            grid = np.array(np.meshgrid(*([[1.0, lo]] * m), indexing="ij")).reshape(m, -1).T
+            return grid
+        verts = np.array(effectiveness, dtype=float) if not isinstance(effectiveness, bytes) else None
+        if verts is None or verts.ndim != 2 or verts.shape[1] != m or verts.shape[0] == 0:
+            raise InvalidArgumentError(
+                "effectiveness",
+                f"'single_outage', 'box' or a (k, {m}) array of vertices",
+                repr(effectiveness),
+            )
+        for i, row in enumerate(verts):
+            if not np.all(np.isfinite(row)) or np.any((row < 0.0) | (row > 1.0)):
+                raise InvalidArgumentError(f"effectiveness[{i}]", "values in [0, 1]", repr(row.tolist()))
+        return verts
+
+    def polytope(
+        self,
+        dt: float = PAPER_W_SAMPLE_TIME,
+        effectiveness: Any = "single_outage",
+        *,
+        lambda_min: float = 0.2,
+        inertia_spread: float | None = None,
+    ) -> PolytopicModel:
+        """The wheel-effectiveness polytope of the linear model (seed section 8).
+
+        Parameters
+        ----------
+        dt : float
+            Sample time of the zero-order hold (default 0.04 s, paper W's loop).
+        effectiveness, lambda_min
+            The effectiveness vertices, see :meth:`effectiveness_vertices`.
+        inertia_spread : float, optional
+            Relative inertia error ``s`` in ``[0, 1)``: the product with the scalar inertia
+            polytope ``J in {(1 + s) J, (1 - s) J}`` (S4: 0.2, 2 x 5 = 10 vertices).
+
+        Returns
+        -------
+        PolytopicModel
+            ``x = [phi, theta, psi, p, q, r]``, ``m`` wheel-torque inputs; vertices ordered
+            inertia scale first (``1 + s``, then ``1 - s``), effectiveness inside; the nominal
+            model is the healthy array at the nominal inertia.
+
+        Raises
+        ------
+        InvalidArgumentError
+            Naming ``effectiveness`` and the vertex when a vertex has ``B = 0`` or
+            ``rank(D Lambda) < 3`` (seed 8(c)): there the vertex LMI is infeasible (``A`` is
+            not Schur and nothing acts on some axis), which a conic solver may hide behind an
+            "inaccurate" status with a finite gamma.
+
+        Notes
+        -----
+        ``B`` is linear in ``Lambda`` and the zero-order hold at a fixed ``A`` is linear in
+        ``B``, so the effectiveness vertices are exact. ``A`` and ``B`` are also affine in
+        ``J^-1``, but the hold is not linear in ``A``: with ``inertia_spread`` the vertex
+        products cover the continuous-time set, and their discretisations approximate the
+        discrete one.
+        """
+        dt = check_positive(dt, "dt")
+        lam = self.effectiveness_vertices(effectiveness, lambda_min)
+        for i, row in enumerate(lam):
+            rank = _rank(self._wheels.D * row)
+            if rank < 3:
+                raise InvalidArgumentError(
+                    "effectiveness",
+                    "vertices whose healthy wheels span three axes (B != 0, rank(D Lambda) = 3)",
+                    f"vertex {i} (lambda = {row.tolist()}) with rank(D Lambda) = {rank}",
+                )
+        scales = [1.0]
+        if inertia_spread is not None:
+            s = check_positive(inertia_spread, "inertia_spread", allow_zero=True)
+            if s >= 1.0:
+                raise InvalidArgumentError("inertia_spread", "a relative spread in [0, 1)", repr(s))
+            scales = [1.0 + s, 1.0 - s]
+        verts = [self.discretize(dt, row, scale) for scale in scales for row in lam]
+        nominal = self.discretize(dt)
+        names = tuple(f"u{j + 1}" for j in range(self.n_wheels))
+        return PolytopicModel(verts, dt, nominal=nominal, state_names=STATE_NAMES_6, input_names=names)

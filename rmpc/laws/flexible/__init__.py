@@ -1,0 +1,11 @@
+"""Papers S and V's laws for the flexible satellite: attitude laws, vibration control, the hybrid."""
+
+from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
+from rmpc.laws.flexible.attitude_pd import AttitudePD
+from rmpc.laws.flexible.csmc import CSMC
+from rmpc.laws.flexible.hybrid import FlexibleHybrid
+from rmpc.laws.flexible.lqr import flexible_lqr
+from rmpc.laws.flexible.mtsmc import MTSMC
+from rmpc.laws.flexible.robust_avc import RobustAVC
+
+__all__ = ["CSMC", "MTSMC", "AdaptiveSMC", "AttitudePD", "FlexibleHybrid", "RobustAVC", "flexible_lqr"]

@@ -1,0 +1,183 @@
+"""What the flexible-satellite control laws know about the plant, and the pieces they share.
+
+:class:`FlexibleTerms` reads a measured state ``x = [q, w, eta, eta']`` of
+:class:`models.FlexibleSatellite`, forms the attitude error against a reference quaternion and
+evaluates the model terms the laws cancel (seed papers-S-V-flexible.md section 4.2)::
+
+    gyroscopic:      w x (J w + delta' eta')              (w x J w without flex feed-forward)
+    modal reaction:  delta' M^-1 (C eta' + K eta - Gamma_a v)   (zero without flex feed-forward)
+
+so that ``J_mb w' = -gyroscopic + modal reaction + u + d - delta' M^-1 d_f`` on the plant.
+:func:`switching` is the switching function of the sliding-mode laws.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from models import FlexibleSatellite
+from models.attitude.quaternion import cross3, quat_error, unit_quaternion
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_choice, check_positive
+
+__all__ = ["AttitudeError", "FlexibleTerms", "SwitchKind", "gain_matrix", "switching"]
+
+SwitchKind = Literal["sign", "tanh"]
+
+
+def switching(sigma: np.ndarray, eps: float, kind: SwitchKind) -> np.ndarray:
+    """``tanh(sigma / eps)`` (a boundary layer of width ``eps``) or ``sign(sigma)``."""
+    if kind == "tanh":
+        return np.tanh(sigma / eps)
+    return np.sign(sigma)
+
+
+def gain_matrix(value: Any, name: str) -> np.ndarray:
+    """A gain given as a scalar, three per-axis values or a 3 x 3 matrix, returned as 3 x 3."""
+    arr = np.asarray(value, dtype=float) if not isinstance(value, str | bytes) else None
+    if arr is None or arr.ndim > 2:
+        raise ArgumentTypeError(name, "a scalar, 3 values or a 3 x 3 matrix", type(value).__name__)
+    if arr.ndim == 0:
+        mat = check_positive(float(arr), name, allow_zero=True) * np.eye(3)
+    elif arr.ndim == 1:
+        vec = as_vector(arr, name, 3)
+        if np.any(vec < 0.0):
+            raise InvalidArgumentError(name, "gains >= 0", repr(vec.tolist()))
+        mat = np.diag(vec)
+    else:
+        if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
+            raise InvalidArgumentError(name, "a finite 3 x 3 matrix", f"shape {arr.shape}")
+        mat = arr.copy()
+    mat.setflags(write=False)
+    return mat
+
+
+@dataclass(frozen=True)
+class AttitudeError:
+    """The attitude error of one measured state.
+
+    Attributes
+    ----------
+    q0 : float
+        Scalar part of the error quaternion ``q_ref^-1 * q`` (``>= 0``).
+    qv : (3,) ndarray
+        Its vector part, ``sin(a/2) e``.
+    qv_dot : (3,) ndarray
+        ``q_v' = (q0 I + [q_v x]) w / 2`` (the reference is at rest).
+    angle : float
+        The rotation error ``a`` (rad).
+    """
+
+    q0: float
+    qv: np.ndarray
+    qv_dot: np.ndarray
+    angle: float
+
+
+class FlexibleTerms:
+    """The model terms of a :class:`models.FlexibleSatellite` used by the control laws.
+
+    Parameters
+    ----------
+    satellite : FlexibleSatellite
+        The controller's model (nominal parameters).
+    q_ref : (4,) array_like, optional
+        Reference attitude (unit quaternion, at rest); default the identity.
+    flex_feedforward : bool
+        Use the modal state (``eta, eta'``, idealised full-state measurement as in paper V) to
+        cancel the modal reaction; ``False`` drops every ``eta`` term.
+    """
+
+    def __init__(
+        self, satellite: FlexibleSatellite, q_ref: Any = None, flex_feedforward: bool = True
+    ) -> None:
+        if not isinstance(satellite, FlexibleSatellite):
+            raise ArgumentTypeError("satellite", "a models.FlexibleSatellite", type(satellite).__name__)
+        if not isinstance(flex_feedforward, bool):
+            raise ArgumentTypeError("flex_feedforward", "a bool", type(flex_feedforward).__name__)
+        self.satellite = satellite
+        self.q_ref = np.array([1.0, 0.0, 0.0, 0.0]) if q_ref is None else unit_quaternion(q_ref, "q_ref")
+        self.flex_feedforward = flex_feedforward
+        self.n_modes = satellite.n_modes
+        self.n_pzt = satellite.n_pzt
+        self.inertia = satellite.inertia
+        self.hub_inertia = satellite.hub_inertia
+        self._delta_t = satellite.coupling.T
+        self._couple = satellite.coupling.T @ np.linalg.inv(satellite.modal_mass) if self.n_modes else (
+            np.zeros((3, 0)))
+        self._c = np.diag(satellite.damping_matrix)
+        self._k = np.diag(satellite.stiffness)
+        self._gamma = satellite.pzt_matrix
+
+    def split(self, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(q, w, eta, eta')`` of a measured state (checked: length ``7 + 2N``, finite)."""
+        x = as_vector(x, "x", self.satellite.n_states)
+        n = self.n_modes
+        return x[:4], x[4:7], x[7:7 + n], x[7 + n:]
+
+    def error(self, q: np.ndarray, w: np.ndarray) -> AttitudeError:
+        """The attitude error of ``q`` against the reference and its rate."""
+        err = quat_error(q / np.linalg.norm(q), self.q_ref)
+        q0, qv = float(err[0]), err[1:]
+        qv_dot = 0.5 * (q0 * w + cross3(qv, w))
+        angle = 2.0 * float(np.arctan2(np.linalg.norm(qv), q0))
+        return AttitudeError(q0=q0, qv=qv, qv_dot=qv_dot, angle=angle)
+
+    def gyroscopic(self, w: np.ndarray, eta_dot: np.ndarray) -> np.ndarray:
+        """``w x (J w + delta' eta')`` (``w x J w`` without flex feed-forward)."""
+        h = self.inertia @ w
+        if self.flex_feedforward and self.n_modes:
+            h = h + self._delta_t @ eta_dot
+        return cross3(w, h)
+
+    def modal_reaction(self, eta: np.ndarray, eta_dot: np.ndarray, v: np.ndarray | None) -> np.ndarray:
+        """``delta' M^-1 (C eta' + K eta - Gamma_a v)`` (zero without flex feed-forward)."""
+        if not self.flex_feedforward or self.n_modes == 0:
+            return np.zeros(3)
+        force = self._c * eta_dot + self._k * eta
+        if v is not None:
+            force = force - self._gamma @ v
+        return self._couple @ force
+
+    def sliding_torque(
+        self,
+        w: np.ndarray,
+        eta: np.ndarray,
+        eta_dot: np.ndarray,
+        v: np.ndarray | None,
+        sigma: np.ndarray,
+        surface_rate: np.ndarray,
+        k_s: np.ndarray,
+        w_s: float,
+        eps: float,
+        switch: SwitchKind,
+    ) -> np.ndarray:
+        """The sliding-mode torque of seed section 4.2 (before saturation)::
+
+            u = w x (J w + delta' eta') - delta' M^-1 (C eta' + K eta - Gamma_a v)
+                - J_mb surface_rate - K_s sigma - W_s switch(sigma, eps)
+
+        ``surface_rate`` is ``sigma' - w'`` (``alpha' q_v + alpha q_v' + k_I z'``), so that on
+        the exact model ``J_mb sigma' = -K_s sigma - W_s switch(sigma) + d - delta' M^-1 d_f``.
+        """
+        return (
+            self.gyroscopic(w, eta_dot)
+            - self.modal_reaction(eta, eta_dot, v)
+            - self.hub_inertia @ surface_rate
+            - k_s @ sigma
+            - w_s * switching(sigma, eps, switch)
+        )
+
+    def pzt(self, pzt: Any) -> np.ndarray | None:
+        """Check this sample's PZT command (``None``: no command)."""
+        if pzt is None:
+            return None
+        return as_vector(pzt, "pzt", self.n_pzt)
+
+
+def check_switch(value: Any) -> SwitchKind:
+    """``"sign"`` or ``"tanh"``."""
+    return check_choice(value, "switch", ("sign", "tanh"))

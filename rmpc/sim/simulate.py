@@ -1,0 +1,270 @@
+"""The closed-loop simulator: a sampled controller with zero-order hold on a plant."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from models import ReactionWheelActuator, TorqueLimiter
+from rmpc.sim.disturbances import as_disturbance
+from rmpc.sim.plants import disturbance_at, make_plant
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_positive
+
+__all__ = ["Trajectory", "simulate"]
+
+
+@dataclass
+class Trajectory:
+    """A closed-loop run.
+
+    Attributes
+    ----------
+    t : (N + 1,) ndarray
+        Sample times (s), ``t[0] = 0``.
+    x : (N + 1, n) ndarray
+        States at the sample times.
+    u_cmd : (N, m) ndarray
+        Controller outputs.
+    u_applied : (N, m) ndarray
+        Inputs applied to the plant (after the limiter, the actuator and, for a
+        :class:`~rmpc.sim.plants.NonlinearPlant` with an input stage, the stage evaluated at the
+        start of the sample), without ``d``.
+    d : (N, n_d) ndarray
+        Disturbance at the start of each sample.
+    status : list of str
+        Each step's controller status.
+    solve_time : (N,) ndarray
+        Each step's optimiser time as reported by the controller (s).
+    step_time : (N,) ndarray
+        Wall time of each ``controller.step`` call (s).
+    gamma : (N,) ndarray
+        Each step's cost bound where the controller has one, NaN elsewhere.
+    info : list
+        The controller's ``last`` object after each step.
+    plant : str
+        ``"linear"`` or ``"nonlinear"``.
+    dt : float
+        Sample time (s).
+    stage_log : dict of ndarray
+        What the input stage reported at the start of each sample (``begin_sample``), one
+        array per name with the samples along the first axis; empty without a stage.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    u_cmd: np.ndarray
+    u_applied: np.ndarray
+    d: np.ndarray
+    status: list[str]
+    solve_time: np.ndarray
+    step_time: np.ndarray
+    gamma: np.ndarray
+    info: list[Any] = field(repr=False)
+    plant: str
+    dt: float
+    stage_log: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of controller steps."""
+        return int(self.u_cmd.shape[0])
+
+    @property
+    def attitude_deg(self) -> np.ndarray:
+        """Roll, pitch, yaw in degrees, shape ``(N + 1, 3)`` (satellite states only)."""
+        return np.degrees(self.x[:, :3])
+
+    def status_counts(self) -> dict[str, int]:
+        """How many steps ended with each status."""
+        counts: dict[str, int] = {}
+        for s in self.status:
+            counts[s] = counts.get(s, 0) + 1
+        return counts
+
+    def save_npz(self, path: str) -> None:
+        """Write the numeric arrays (and statuses) to a ``.npz`` file."""
+        np.savez_compressed(
+            path, t=self.t, x=self.x, u_cmd=self.u_cmd, u_applied=self.u_applied, d=self.d,
+            solve_time=self.solve_time, step_time=self.step_time, gamma=self.gamma,
+            status=np.asarray(self.status), plant=self.plant, dt=self.dt,
+        )
+
+
+def simulate(
+    controller: Any,
+    plant: Any,
+    x0: Any,
+    duration: float | None = None,
+    *,
+    n_steps: int | None = None,
+    dt: float | None = None,
+    true_plant: Any = None,
+    actuator: ReactionWheelActuator | None = None,
+    limiter: TorqueLimiter | None = None,
+    disturbance: Any = None,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+    reset: bool = True,
+    progress: Any = None,
+    sensor: Any = None,
+) -> Trajectory:
+    """Run ``controller`` in closed loop on ``plant`` from ``x0``.
+
+    At each sample ``t_k = k dt`` the controller gets the measured state and returns
+    ``u_cmd``; the limiter (if any) clips it, the actuator (if any) turns it into the torque,
+    and the plant advances one sample with that torque held (zero-order hold) plus the
+    disturbance.
+
+    Parameters
+    ----------
+    controller : object with ``step(x)``
+        Any controller of the toolkit (see :class:`rmpc.controller.Controller`).
+    plant : PolytopicModel, RigidSatellite, NonlinearPlant or a model with ``dynamics``
+        A polytope (the linear plant; ``true_plant`` picks the member), the nonlinear
+        satellite or any model with ``dynamics(x, u, d=None)`` (``dt`` required), or a
+        :class:`~rmpc.sim.plants.NonlinearPlant` that fixes the integrator and an input stage
+        (faults, actuator limits; see :class:`~models.protocols.InputStage`).
+    x0 : array_like
+        Initial state.
+    duration : float, optional
+        Simulated time (s); ``n_steps = round(duration / dt)``. Give this or ``n_steps``.
+    n_steps : int, optional
+        Number of controller steps.
+    dt : float, optional
+        Sample time; for a polytope it defaults to (and must equal) ``plant.dt``.
+    true_plant : None, int, weights or (A, B), optional
+        For a polytope: the nominal model (default), a vertex, a convex combination, or an
+        explicit pair. See :func:`rmpc.sim.plants.make_plant`.
+    actuator : ReactionWheelActuator, optional
+        Actuator dynamics between command and torque; reset at the start.
+    limiter : TorqueLimiter, optional
+        Saturation applied to the controller output.
+    disturbance : callable, optional
+        Disturbance torque ``d(t)`` (e.g. :class:`rmpc.StepDisturbance`), or ``d(t, x)`` for an
+        object whose ``state_dependent`` attribute is true.
+    rtol, atol : float
+        Tolerances of the nonlinear integrator.
+    reset : bool
+        Call ``controller.reset()`` first (default).
+    progress : callable, optional
+        Called as ``progress(k, n_steps)`` after each step.
+    sensor : callable, optional
+        ``sensor(t, x) -> y``: what the controller measures (sensor noise, say); the
+        trajectory keeps the true state. Its ``reset()`` is called before the run when present.
+        Default: the controller sees the true state.
+
+    Returns
+    -------
+    Trajectory
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import RigidSatellite
+    >>> from rmpc import LQR, simulate
+    >>> sat = RigidSatellite.paper_p()
+    >>> x0 = sat.initial_state()
+    >>> lqr = LQR(sat.linear_model(x0, 0.01), Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]), R=np.eye(3))
+    >>> traj = simulate(lqr, sat, x0, duration=20.0, dt=0.01)
+    >>> bool(np.all(np.abs(traj.x[-1, :3]) < 1e-3))
+    True
+    """
+    if not callable(getattr(controller, "step", None)):
+        raise ArgumentTypeError("controller", "an object with a step(x) method", type(controller).__name__)
+    sim_plant = make_plant(plant, dt, true_plant, rtol=rtol, atol=atol)
+    step_dt = sim_plant.dt
+    n, m = sim_plant.n_states, sim_plant.n_inputs
+    x = as_vector(x0, "x0", n)
+    if (duration is None) == (n_steps is None):
+        raise InvalidArgumentError(
+            "duration", "exactly one of duration or n_steps", f"duration={duration}, n_steps={n_steps}"
+        )
+    if duration is not None:
+        duration = check_positive(duration, "duration")
+        n_steps = round(duration / step_dt)
+    if not isinstance(n_steps, int | np.integer) or n_steps < 1:
+        raise InvalidArgumentError("n_steps", "a positive integer", repr(n_steps))
+    n_d = int(getattr(sim_plant, "n_disturbances", m))
+    d_fn = as_disturbance(disturbance, n_d, x)
+    stage = getattr(sim_plant, "input_stage", None)
+    if stage is not None and callable(getattr(stage, "reset", None)):
+        stage.reset()
+    begin_sample = getattr(stage, "begin_sample", None) if stage is not None else None
+    stage_rows: list[dict[str, Any]] = []
+    if actuator is not None:
+        if not isinstance(actuator, ReactionWheelActuator) or actuator.n_axes != m:
+            raise InvalidArgumentError(
+                "actuator", f"a ReactionWheelActuator with {m} axes", repr(actuator)
+            )
+        actuator.reset()
+    if limiter is not None and not callable(limiter):
+        raise ArgumentTypeError("limiter", "a TorqueLimiter or callable", type(limiter).__name__)
+    if reset and callable(getattr(controller, "reset", None)):
+        controller.reset()
+    if sensor is not None:
+        if not callable(sensor):
+            raise ArgumentTypeError("sensor", "None or a callable sensor(t, x)", type(sensor).__name__)
+        if callable(getattr(sensor, "reset", None)):
+            sensor.reset()
+
+    xs = np.empty((n_steps + 1, n))
+    u_cmd = np.empty((n_steps, m))
+    u_app = np.empty((n_steps, m))
+    d_log = np.zeros((n_steps, n_d))
+    solve_time = np.empty(n_steps)
+    step_time = np.empty(n_steps)
+    gamma = np.full(n_steps, np.nan)
+    status: list[str] = []
+    info: list[Any] = []
+    xs[0] = x
+    for k in range(n_steps):
+        t = k * step_dt
+        measured = x if sensor is None else np.asarray(sensor(t, x), dtype=float)
+        start = time.perf_counter()
+        u = np.asarray(controller.step(measured), dtype=float).reshape(-1)
+        step_time[k] = time.perf_counter() - start
+        if u.shape != (m,) or not np.all(np.isfinite(u)):
+            raise InvalidArgumentError(
+                "controller", f"step(x) returning {m} finite values", f"{u!r} at step {k}"
+            )
+        last = getattr(controller, "last", None)
+        status.append(str(getattr(last, "status", "unknown")))
+        solve_time[k] = float(getattr(last, "solve_time", step_time[k]))
+        g = getattr(last, "gamma", None)
+        if g is not None:
+            gamma[k] = float(g)
+        info.append(last)
+        u_cmd[k] = u
+        applied = limiter(u) if limiter is not None else u
+        if actuator is not None:
+            applied = actuator.step(applied)
+        if callable(begin_sample):
+            stage_rows.append(dict(begin_sample(t, x, applied) or {}))
+        u_app[k] = applied if stage is None else sim_plant.applied(t, x, applied)
+        if d_fn is not None:
+            d_log[k] = disturbance_at(d_fn, t, x)
+        x = sim_plant.advance(x, applied, t, d_fn)
+        xs[k + 1] = x
+        if progress is not None:
+            progress(k + 1, n_steps)
+    return Trajectory(
+        t=np.arange(n_steps + 1) * step_dt, x=xs, u_cmd=u_cmd, u_applied=u_app, d=d_log,
+        status=status, solve_time=solve_time, step_time=step_time, gamma=gamma, info=info,
+        plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows),
+    )
+
+
+def _stack_rows(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+    """Per-sample mappings of the input stage, stacked into one array per name."""
+    if not rows:
+        return {}
+    names = sorted({name for row in rows for name in row})
+    out = {}
+    for name in names:
+        if all(name in row for row in rows):
+            out[name] = np.asarray([row[name] for row in rows])
+    return out
