@@ -38,7 +38,10 @@ __all__ = [
 
 
 class Status(StrEnum):
-    """A word of the status vocabulary (see :data:`STATUS_TABLE` for the meanings)."""
+    """A word of the status vocabulary (see :data:`STATUS_TABLE` for the meanings).
+
+    Its ``repr`` is its word's (``'optimal'``), so a status prints as the string it stands for.
+    """
 
     OPTIMAL = "optimal"
     INACCURATE = "inaccurate"
@@ -58,6 +61,9 @@ class Status(StrEnum):
     SINGULAR = "singular"
     DIVERGED = "diverged"
     UNKNOWN = "unknown"
+
+    def __repr__(self) -> str:
+        return repr(self.value)
 
 
 @dataclass(frozen=True)
