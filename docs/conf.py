@@ -35,7 +35,7 @@ extensions = [
     "sphinx.ext.doctest",
     "numpydoc",
 ]
-exclude_patterns = ["_build", "examples", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_generated", "examples", "figures", "Thumbs.db", ".DS_Store"]
 root_doc = "index"
 language = "en"
 default_role = "literal"  # a single-backtick `x` is code, as in the docstrings' double ones
@@ -64,3 +64,26 @@ html_theme_options = {
     "sidebar_width": "240px",
 }
 html_sidebars = {"**": ["about.html", "navigation.html", "relations.html", "searchbox.html"]}
+
+
+# -- Figures drawn from code at build time ----------------------------------------------
+# Each module of docs/figures has ``write(path)``; its PNG goes to docs/_generated/ (not
+# tracked), which the pages include with ``.. figure:: _generated/<name>.png``.
+FIGURES = ("architecture",)
+
+
+def _write_figures(app: object) -> None:
+    import importlib.util
+
+    out = Path(__file__).resolve().parent / "_generated"
+    for name in FIGURES:
+        source = out.parent / "figures" / f"{name}.py"
+        spec = importlib.util.spec_from_file_location(f"docs_figure_{name}", source)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        module.write(out / f"{name}.png")
+
+
+def setup(app: object) -> None:
+    app.connect("builder-inited", _write_figures)  # type: ignore[attr-defined]
