@@ -162,14 +162,18 @@ def flexible_problem(backend: str, options: dict) -> tuple[KothareProblem, np.nd
 
 
 def test_flexible_satellite_converges_in_the_ipm_without_the_fallback():
-    """The issue's stalling case. At ``x0`` (cold) and, warm-started, at the state one
-    closed-loop step later (``x1 = A_0 x0 + B_0 F x0``, the 0.8 vertex), the IPM ends optimal
-    (certified) without Clarabel, and ``gamma`` agrees with Clarabel at 1e-9 (at 1e-10 Clarabel
-    ends "AlmostSolved") within 1e-7 relative, ten times the IPM's gap tolerance (measured:
-    1.7e-8). Before the state scaling both solves ended
-    ``"insufficient_progress"``."""
+    """The stalling case of the 14-state flexible satellite. At ``x0`` (cold) and,
+    warm-started, at the state one closed-loop step later (``x1 = A_0 x0 + B_0 F x0``, the 0.8
+    vertex), the IPM ends optimal (certified) without Clarabel, and ``gamma`` agrees with
+    Clarabel at 3e-9 within 2e-7 relative. Before the state scaling both solves ended
+    ``"insufficient_progress"``.
+
+    The agreement depends on the CPU's floating-point kernels: measured 1.7e-8 on one machine
+    and 9.9e-8 (x0) / 3.3e-8 (x1) on another, where Clarabel at 1e-9 ends "AlmostSolved" at
+    x0 and the IPM, asked for 1e-10, stalls at 513.28386 (relative 1e-7 above Clarabel's
+    513.28381): both solvers' accuracy floor on this problem is about 1e-7 relative there."""
     ipm, x0 = flexible_problem("ipm", {"fallback": False})
-    ref, _ = flexible_problem("clarabel", {"tol_feas": 1e-9, "tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9})
+    ref, _ = flexible_problem("clarabel", {"tol_feas": 3e-9, "tol_gap_abs": 3e-9, "tol_gap_rel": 3e-9})
     first = ipm.solve(x0)
     assert first.status == "optimal" and first.certificate.ok
     a, b = ipm.data.A[0], ipm.data.B[0]
@@ -179,7 +183,7 @@ def test_flexible_satellite_converges_in_the_ipm_without_the_fallback():
     for got, x in ((first, x0), (second, x1)):
         want = ref.solve(x)
         assert want.status == "optimal"
-        assert abs(got.gamma - want.gamma) <= 1e-7 * want.gamma
+        assert abs(got.gamma - want.gamma) <= 2e-7 * want.gamma
 
 
 def test_rigid_hub_converges_with_the_state_scaling():
