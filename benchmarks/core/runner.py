@@ -1,7 +1,9 @@
 """Run one scenario through its plant family (build, simulate, measure) and make its record.
 
-:func:`run_case` is the function worker processes (or Dask workers) execute; it never raises
-for a failing case but returns the error, so a sweep can record it and go on.
+:func:`run_scenario` gives the record of one scenario; :func:`simulate_scenario` also the time
+series. :func:`run_case` is the function worker processes (or Dask workers) execute; it never
+raises for a failing case but returns the error, so a sweep can record it and go on. The
+runner uses :mod:`benchmarks.core.scenario`, which does not import it back.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ import numpy as np
 
 from benchmarks.core.scenario import Scenario
 
-__all__ = ["run_case", "simulate_scenario"]
+__all__ = ["run_case", "run_scenario", "simulate_scenario"]
 
 
 def _json_safe(value: Any) -> Any:
@@ -73,6 +75,12 @@ def simulate_scenario(
     }
     trace = result.trace if keep_trace else None
     return _json_safe(record), trace
+
+
+def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:
+    """Simulate ``scenario`` and return its record (see :func:`simulate_scenario`)."""
+    record, _ = simulate_scenario(scenario, experiment=experiment)
+    return record
 
 
 def run_case(payload: dict[str, Any]) -> dict[str, Any]:

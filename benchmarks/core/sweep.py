@@ -47,9 +47,10 @@ import numpy as np
 
 from benchmarks.core.execute import ExecOutcome, Task, execute
 from benchmarks.core.executors import make_executor
-from benchmarks.core.family import PlantFamily, get_family
+from benchmarks.core.family import PlantFamily
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.progress import CaseProgress
+from benchmarks.core.registry import get_family
 from benchmarks.core.scenario import DEFAULT_FAMILY, Scenario
 from benchmarks.core.store import STORE_NAME, CaseStore
 from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
