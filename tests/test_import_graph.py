@@ -34,7 +34,7 @@ def test_the_graph_sees_every_module_and_sorts_imports_by_level(graph: ImportGra
     assert "benchmarks.core.registry" in graph.targets("benchmarks.core.scenario", ["module"])
     assert "benchmarks.suites.paper" in graph.targets("benchmarks.cli", ["function"])
     assert "benchmarks.suites.paper" not in graph.targets("benchmarks.cli", ["module"])
-    assert "benchmarks.core.progress" in graph.targets("benchmarks.timing.suite", ["typing"])
+    assert "benchmarks.timing.config" in graph.targets("benchmarks.timing.rmpc", ["typing"])
 
 
 def test_no_module_level_import_cycle(graph: ImportGraph) -> None:

@@ -14,22 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.jsonable import json_safe
 from benchmarks.core.scenario import Scenario
 
 __all__ = ["run_case", "run_scenario", "simulate_scenario"]
-
-
-def _json_safe(value: Any) -> Any:
-    """Replace NaN/inf by ``None`` and numpy scalars by Python numbers, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
 
 
 def simulate_scenario(
@@ -74,7 +62,7 @@ def simulate_scenario(
         "cpu_time_s": time.process_time() - cpu_start,
     }
     trace = result.trace if keep_trace else None
-    return _json_safe(record), trace
+    return json_safe(record), trace
 
 
 def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:
