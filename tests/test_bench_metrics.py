@@ -191,7 +191,18 @@ def test_tables_in_every_format_hold_the_same_values():
 
 
 @pytest.mark.parametrize(
-    "module", ["core.metrics", "reports.tables", "core.scenario", "core.store", "suites.paper", "core.sweep"]
+    "module",
+    [
+        "core.metrics",
+        "reports.tables",
+        "reports.sections",
+        "core.scenario",
+        "core.store",
+        "core.suite",
+        "core.registry",
+        "suites.paper",
+        "core.sweep_spec",
+    ],
 )
 def test_docstring_examples_run(module):
     import doctest

@@ -8,11 +8,11 @@ solver or a controller, so the ``rmpc`` command line can load it at start-up.
 
 Examples
 --------
->>> from benchmarks.timing.common import rel_err, statuses
+>>> from benchmarks.timing.common import ms, rel_err
 >>> rel_err([1.0, 2.2, float("nan")], [1.0, 2.0, 3.0])
 0.10000000000000009
->>> statuses({"optimal": 3, "inaccurate": 1})
-'inaccurate 1, optimal 3'
+>>> ms(0.0123), ms(None)
+('12.30', 'n/a')
 """
 
 from __future__ import annotations
@@ -42,7 +42,6 @@ __all__ = [
     "rel_err",
     "sample_key",
     "sci",
-    "statuses",
     "tally",
     "us",
 ]
@@ -140,9 +139,3 @@ def us(value: float | None) -> str:
 def sci(value: float | None) -> str:
     """Two significant digits in scientific notation, ``n/a`` for ``None``."""
     return "n/a" if value is None else f"{value:.1e}"
-
-
-def statuses(counts: dict[str, int]) -> str:
-    """Status counts as ``word n, word n`` in alphabetical order."""
-    return ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
-

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from benchmarks.timing.common import ms, sci, statuses, us
+from benchmarks.reports.sections import statuses
+from benchmarks.timing.common import ms, sci, us
 
 __all__ = ["format_markdown"]
 

@@ -30,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.machine import percentiles
-from benchmarks.timing.common import SCS_OPTIONS, statuses
+from benchmarks.reports.sections import statuses
+from benchmarks.timing.common import SCS_OPTIONS
 
 __all__ = ["SCALE_SIZES", "SCALE_VERTICES", "plot_scale", "scale_problem", "time_scale"]
 
