@@ -28,7 +28,7 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,6 +47,7 @@ __all__ = [
     "check_choice",
     "check_number",
     "check_real",
+    "controller_specs",
 ]
 
 #: Fields every family must declare.
@@ -93,6 +94,21 @@ class ControllerSpec:
     build: Callable[[Any, Any, Mapping[str, Any]], BuiltController]
     defaults: Mapping[str, Any]
     constrained: bool = True
+
+
+def controller_specs(
+    builders: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltController]],
+    defaults: Mapping[str, Mapping[str, Any]],
+    constrained: Collection[str],
+) -> dict[str, ControllerSpec]:
+    """One :class:`ControllerSpec` per controller of ``builders``, in their order.
+
+    ``defaults[name]`` are its settings' defaults; it can enforce the input limit itself when its
+    name is in ``constrained``.
+    """
+    return {
+        name: ControllerSpec(build, defaults[name], name in constrained) for name, build in builders.items()
+    }
 
 
 @dataclass(frozen=True)

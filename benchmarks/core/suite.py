@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks.core.execute import ExecOutcome, Task, execute
-from benchmarks.core.executors import make_executor
+from benchmarks.core.executors import make_executor_and_out
 from benchmarks.core.progress import CaseProgress
 from benchmarks.core.scenario import Scenario
 from toolkit_common.errors import ConfigError
@@ -120,13 +120,7 @@ def run_suite_cases(
     runs : list of (case, record, trace)
         The cases that finished, with their time series.
     """
-    executor = make_executor(workers, scheduler)
-    out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        executor.close()
-        raise
+    executor, out = make_executor_and_out(workers, scheduler, out)
     start = time.perf_counter()
     results: dict[str, dict[str, Any]] = {}
     ordered = sorted(cases, key=cost, reverse=True) if cost is not None else list(cases)

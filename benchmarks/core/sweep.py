@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from benchmarks.core.execute import ExecOutcome, Task, execute
-from benchmarks.core.executors import make_executor
+from benchmarks.core.executors import make_executor_and_out
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.progress import CaseProgress
 from benchmarks.core.scenario import Scenario
@@ -92,13 +92,7 @@ def run_sweep(
     """
     spec = load_sweep(config)
     cases = expand(spec)
-    executor = make_executor(workers, scheduler)  # a bad --scheduler fails before anything is written
-    out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        executor.close()
-        raise
+    executor, out = make_executor_and_out(workers, scheduler, out)  # a bad --scheduler fails first
     start = time.perf_counter()
     position = {sc.case_id: i for i, sc in enumerate(cases)}
     with CaseStore(out / STORE_NAME) as store:
