@@ -73,18 +73,7 @@ def _cmd_bench_paper(args: argparse.Namespace) -> int:
         experiments=args.experiments,
         progress=None if not args.no_progress else False,
     )
-    ex = outcome.execution
-    done, failed = len(outcome.records), len(outcome.failures)
-    print(
-        f"rmpc bench paper: {done} cases done, {failed} failed in {outcome.wall_time_s:.1f} s; "
-        f"results in {args.out}/results.md"
-    )
-    for failure in outcome.failures:
-        print(f"  failed: {failure['key']}: {failure['error']}", file=sys.stderr)
-    if ex is not None and ex.interrupted:
-        print("rmpc: interrupted; the files hold the cases that finished", file=sys.stderr)
-        return 130
-    return 1 if failed or (ex is not None and ex.unfinished) else 0
+    return _report_suite("paper", outcome, args.out)
 
 
 def _report_suite(name: str, outcome: Any, out: str) -> int:

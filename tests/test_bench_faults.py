@@ -8,7 +8,8 @@ import math
 import pytest
 
 from benchmarks.cli import main
-from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.runner import run_scenario
+from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import expand, load_sweep
 from benchmarks.families.wheel.family import case_faults
 from benchmarks.suites.faults import fault_cases

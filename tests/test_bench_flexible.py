@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from benchmarks.cli import main
-from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.runner import run_scenario
+from benchmarks.core.scenario import Scenario
 from benchmarks.families.flexible.family import eta1_frequency
 from benchmarks.suites.flexible import F4_MODAL_BOUND, MODAL_BOUND_POLYTOPE, flexible_cases, inconsistencies
 from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS

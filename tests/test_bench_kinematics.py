@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.runner import run_scenario
+from benchmarks.core.scenario import Scenario
 from benchmarks.families.rigid.family import initial_attitude
 from toolkit_common.errors import ConfigError
 

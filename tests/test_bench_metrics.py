@@ -8,7 +8,16 @@ import math
 import numpy as np
 import pytest
 
-from benchmarks.core.metrics import compute_metrics, iae, ise, overshoot, settling_time
+from benchmarks.core.metrics import (
+    compute_metrics,
+    iae,
+    ise,
+    last_time_above,
+    overshoot,
+    recovery_time,
+    settle_index,
+    settling_time,
+)
 from benchmarks.core.scenario import Scenario
 from benchmarks.reports.tables import metric_table, to_csv, to_json, to_latex, to_markdown
 from rmpc import StepInfo, Trajectory
@@ -37,6 +46,28 @@ def test_settling_time_is_the_first_sample_after_the_last_exit_from_the_2_percen
     assert settling_time(t, [0.0, 1.0, 0.5, 0.01, 0.0, 0.0]) == 1.5
     # the band is closed: 0.05 lies inside a 5 % band
     assert settling_time(t, [1.0, 0.5, 0.1, 0.05, 0.04, 0.03], band=0.05) == 1.5
+
+
+def test_the_two_readings_of_settling_on_one_signal():
+    """Relative band, first sample inside vs absolute threshold, last sample outside."""
+    t = np.arange(6) * 0.5
+    e = [1.0, -0.5, 0.01, 0.03, 0.019, 0.0]
+    assert settle_index(e, 0.02) == 4  # |e| <= 0.02 from index 4 (0.019) on; the sign does not count
+    assert settling_time(t, e) == 2.0  # 2 % of |e(0)| = 1: the sample after the last exit
+    assert last_time_above(t, e, 0.02) == 1.5  # the same limit, absolute: the last sample outside
+    double = 2.0 * np.asarray(e)
+    assert last_time_above(t, double, 0.02) == 2.0  # absolute: 2 x 0.019 is outside now
+    assert settling_time(t, double) == 2.0  # relative: the band doubles with e(0)
+    assert last_time_above(t, np.zeros(6), 0.02) == 0.0 and settle_index(np.zeros(6), 0.02) == 0
+    assert last_time_above(t, [1.0, 0.0, 0.0, 0.0, 0.0, 0.5], 0.02) == math.inf
+    assert settle_index(np.column_stack([e, np.zeros(6)]), 0.02) == 4  # the largest column counts
+
+
+def test_recovery_time_counts_from_the_event():
+    rec = recovery_time([2.0, 2.5, 3.0, 3.5], [0.2, 0.1, 0.0, 0.0], t_on=1.9, band=0.05)
+    assert rec == pytest.approx(1.1)
+    assert recovery_time([2.0, 2.5], [0.01, 0.0], t_on=2.0, band=0.05) == 0.0
+    assert recovery_time([2.0, 2.5], [0.0, 0.1], t_on=2.0, band=0.05) is None
 
 
 def test_overshoot_is_the_excursion_past_zero_in_percent_of_the_initial_error():
@@ -160,7 +191,18 @@ def test_tables_in_every_format_hold_the_same_values():
 
 
 @pytest.mark.parametrize(
-    "module", ["core.metrics", "reports.tables", "core.scenario", "core.store", "suites.paper", "core.sweep"]
+    "module",
+    [
+        "core.metrics",
+        "reports.tables",
+        "reports.sections",
+        "core.scenario",
+        "core.store",
+        "core.suite",
+        "core.registry",
+        "suites.paper",
+        "core.sweep_spec",
+    ],
 )
 def test_docstring_examples_run(module):
     import doctest

@@ -7,7 +7,8 @@ import json
 import pytest
 
 from benchmarks.cli import main
-from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.runner import run_scenario
+from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import expand, load_sweep
 from benchmarks.suites.mrp import mrp_cases
 from toolkit_common.errors import ConfigError

@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.families.flexible.metrics import flexible_metrics, settling_time
+from benchmarks.core.metrics import last_time_above
+from benchmarks.families.flexible.metrics import flexible_metrics
 from models import FlexibleSatellite
 from models.attitude.quaternion import rotation_angle
 from models.flexible.scenario import (
@@ -48,11 +49,11 @@ def _run(sat, u, x0, horizon=2.0):
                     limiter=sat.input_limiter(2.0))
 
 
-def test_settling_time_edges():
+def test_t_s_is_the_last_time_above_the_threshold_edges():
     t = np.arange(4.0)
-    assert settling_time(t, np.zeros(4), 1.0) == 0.0
-    assert settling_time(t, np.array([2.0, 0.0, 0.0, 2.0]), 1.0) == np.inf
-    assert settling_time(t, np.array([2.0, 2.0, 0.5, 0.5]), 1.0) == 1.0
+    assert last_time_above(t, np.zeros(4), 1.0) == 0.0
+    assert last_time_above(t, np.array([2.0, 0.0, 0.0, 2.0]), 1.0) == np.inf
+    assert last_time_above(t, np.array([2.0, 2.0, 0.5, 0.5]), 1.0) == 1.0
 
 
 def test_input_metrics_of_a_clipped_constant_command(sat):

@@ -88,7 +88,8 @@ def test_modal_bound_holds_on_the_linear_polytope_and_binds():
 
 
 def test_modal_bound_on_the_nonlinear_plant_short_run():
-    from benchmarks.core.scenario import Scenario, run_scenario
+    from benchmarks.core.runner import run_scenario
+    from benchmarks.core.scenario import Scenario
 
     data = {"family": "flexible", "controller": "RMPC", "experiment": "small", "duration": 15.0}
     data.update(modal_bound=0.02, settings={"polytope": "effectiveness"})

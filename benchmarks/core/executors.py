@@ -24,6 +24,7 @@ import socket
 import time
 from collections.abc import Callable
 from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
 from typing import Any, Protocol
 
 from toolkit_common.errors import ConfigError
@@ -35,6 +36,7 @@ __all__ = [
     "ProcessExecutor",
     "WorkerLost",
     "make_executor",
+    "make_executor_and_out",
 ]
 
 
@@ -269,6 +271,24 @@ def make_executor(workers: int | None, scheduler: str | None) -> CaseExecutor:
     if workers == 0:
         return InlineExecutor()
     return ProcessExecutor(workers)
+
+
+def make_executor_and_out(
+    workers: int | None, scheduler: str | None, out: str | Path
+) -> tuple[CaseExecutor, Path]:
+    """The executor, then the output directory ``out`` (created), in that order.
+
+    A bad ``--scheduler`` fails before anything is written; if ``out`` cannot be created the
+    executor is closed before the error propagates.
+    """
+    executor = make_executor(workers, scheduler)
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        executor.close()
+        raise
+    return executor, out
 
 
 def default_workers() -> int:

@@ -1,13 +1,17 @@
-"""Plant families: what the harness core needs to know about a kind of plant, and their registry.
+"""Plant families: what the harness core needs to know about a kind of plant (the protocol).
 
 A :class:`PlantFamily` brings everything that is particular to one kind of plant (paper P's
 rigid satellite, the four-wheel satellite with faults, ...): its scenario fields with their
 defaults and checks, its controllers with their settings, the checks that involve several
 fields, how one case is built, simulated and measured, and (optionally) what a Monte-Carlo draw
 changes. The core (scenarios, sweeps, runner, store, executors) only talks to this interface,
-so a new family is a new sub-package of :mod:`benchmarks.families` that calls
-:func:`register_family`, or a user's own object registered the same way: nothing in the core
-is edited.
+so a new family is a new sub-package of :mod:`benchmarks.families` listed in its
+``SHIPPED_FAMILIES``, or a user's own object registered with
+:func:`benchmarks.core.registry.register_family`: nothing in the core is edited.
+
+This module is the bottom of the harness: it imports nothing of :mod:`benchmarks`, and the
+families import it (with :mod:`benchmarks.core.metrics`) and nothing else of the core. Looking a
+family up by name is :mod:`benchmarks.core.registry`'s job.
 
 Every family has at least the fields ``plant``, ``saturation``, ``duration`` and ``dt`` (the
 record of a case names its plant and saturation; a ``duration`` of ``None`` lets the family pick
@@ -16,17 +20,15 @@ scenario fields ``family``, ``controller`` and ``settings`` are the core's.
 
 Examples
 --------
->>> from benchmarks.core.family import family_names, get_family
->>> "rigid" in family_names()
-True
->>> get_family("rigid").fields["plant"].default
-'nonlinear'
+>>> from benchmarks.core.family import check_real
+>>> check_real(0.5, "spread", low=0.0, high=1.0, high_open=True)
+0.5
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -45,9 +47,7 @@ __all__ = [
     "check_choice",
     "check_number",
     "check_real",
-    "family_names",
-    "get_family",
-    "register_family",
+    "controller_specs",
 ]
 
 #: Fields every family must declare.
@@ -94,6 +94,21 @@ class ControllerSpec:
     build: Callable[[Any, Any, Mapping[str, Any]], BuiltController]
     defaults: Mapping[str, Any]
     constrained: bool = True
+
+
+def controller_specs(
+    builders: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltController]],
+    defaults: Mapping[str, Mapping[str, Any]],
+    constrained: Collection[str],
+) -> dict[str, ControllerSpec]:
+    """One :class:`ControllerSpec` per controller of ``builders``, in their order.
+
+    ``defaults[name]`` are its settings' defaults; it can enforce the input limit itself when its
+    name is in ``constrained``.
+    """
+    return {
+        name: ControllerSpec(build, defaults[name], name in constrained) for name, build in builders.items()
+    }
 
 
 @dataclass(frozen=True)
@@ -278,70 +293,6 @@ class PlantFamily:
         """Build the scenario's controller on ``model`` with its effective settings."""
         settings = self.effective_settings(scenario.controller, scenario.settings)
         return self.controllers[scenario.controller].build(model, scenario, settings)
-
-
-class _Registry:
-    """The families by name (one instance, filled by :func:`register_family`)."""
-
-    def __init__(self) -> None:
-        self._families: dict[str, PlantFamily] = {}
-        self._loaded = False
-
-    def _load_builtin(self) -> None:
-        if not self._loaded:
-            self._loaded = True
-            import benchmarks.families  # noqa: F401  (registers the shipped families)
-
-    def add(self, family: PlantFamily, replace: bool) -> None:
-        if not isinstance(family, PlantFamily):
-            raise ConfigError("family", "a benchmarks.core.family.PlantFamily", type(family).__name__)
-        missing = [f for f in REQUIRED_FIELDS if f not in family.fields]
-        if missing:
-            raise ConfigError(
-                f"family {family.name!r}",
-                "the fields " + ", ".join(REQUIRED_FIELDS),
-                "no " + ", ".join(missing),
-            )
-        clash = {"family", "controller", "settings"} & set(family.fields)
-        if clash:
-            raise ConfigError(f"family {family.name!r}", "no core field among its fields", ", ".join(clash))
-        if family.name in self._families and not replace and self._families[family.name] is not family:
-            raise ConfigError("family", "a name not registered yet", repr(family.name))
-        self._families[family.name] = family
-
-    def get(self, name: str) -> PlantFamily:
-        self._load_builtin()
-        return self._families[name]
-
-    def names(self) -> tuple[str, ...]:
-        self._load_builtin()
-        return tuple(self._families)
-
-
-_REGISTRY = _Registry()
-
-
-def register_family(family: PlantFamily, replace: bool = False) -> PlantFamily:
-    """Make ``family`` available to scenarios (``family = "<name>"``), sweeps and suites.
-
-    Registering another family under a name already taken raises unless ``replace``.
-    """
-    _REGISTRY.add(family, replace)
-    return family
-
-
-def get_family(name: str, where: str = "family") -> PlantFamily:
-    """The registered family ``name``; a :class:`ConfigError` naming ``where`` otherwise."""
-    try:
-        return _REGISTRY.get(name)
-    except (KeyError, TypeError):
-        names = ", ".join(repr(n) for n in _REGISTRY.names())
-        raise ConfigError(where, f"one of {names}", repr(name)) from None
-
-
-def family_names() -> tuple[str, ...]:
-    """The names of the registered families."""
-    return _REGISTRY.names()
 
 
 # -- field checks families share ---------------------------------------------------------

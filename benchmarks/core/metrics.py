@@ -11,6 +11,9 @@ The attitude error is the attitude itself (every experiment regulates it to zero
 - ``settling_time``: the first sample time after which ``|e|`` stays within a band of 2 %
   of ``|e_0|`` (of ``max |e|`` when ``e_0 = 0``) until the end of the run; ``None`` when the
   last sample is outside the band (not settled within the run).
+  :func:`last_time_above` is the other reading some families record (paper V's ``t_s``): the
+  last sample time at which ``|e|`` exceeds an absolute threshold. Both, and the recovery
+  times, rest on :func:`settle_index`.
 - ``overshoot``: how far ``e`` crosses zero to the side opposite to ``e_0``, in % of
   ``|e_0|``; ``None`` when ``e_0 = 0``.
 
@@ -32,14 +35,20 @@ from typing import Any
 
 import numpy as np
 
+from toolkit_common.errors import ArgumentTypeError
+
 __all__ = [
     "AXES",
     "FAILURE_FREE_STATUSES",
+    "check_trajectory",
     "compute_metrics",
     "iae",
     "ise",
+    "last_time_above",
     "overshoot",
     "recovery",
+    "recovery_time",
+    "settle_index",
     "settling_time",
     "step_timing",
 ]
@@ -82,11 +91,33 @@ def ise(t: Any, e: Any) -> float:
     return _trapezoid(e * e, np.asarray(t, dtype=float))
 
 
+def settle_index(e: Any, limit: float) -> int:
+    """The first sample index from which ``|e| <= limit`` holds to the end.
+
+    ``0`` when ``|e|`` never exceeds ``limit``; ``len(e)`` when even the last sample does (not
+    settled). With several columns the largest ``|e_i|`` of a sample counts.
+
+    Examples
+    --------
+    >>> settle_index([3.0, 2.0, 0.5, 1.5, 0.2], 1.0)
+    4
+    >>> settle_index([0.5, 0.2], 1.0), settle_index([0.5, 2.0], 1.0)
+    (0, 2)
+    """
+    mag = np.abs(np.asarray(e, dtype=float))
+    if mag.ndim == 2:
+        mag = mag.max(axis=1)
+    outside = np.flatnonzero(mag > limit)
+    return 0 if outside.size == 0 else int(outside[-1]) + 1
+
+
 def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
     """First time after which ``|e|`` stays within ``band * |e(0)|`` (``None`` if never).
 
-    The reference is ``|e(0)|``, or ``max |e|`` when ``e(0) = 0``; a signal that is zero
-    throughout settles at ``t[0]``.
+    A band relative to the start: the reference is ``|e(0)|``, or ``max |e|`` when
+    ``e(0) = 0``; a signal that is zero throughout settles at ``t[0]``. The time is that of the
+    first sample inside the band after the last one outside it. For an absolute threshold and
+    the time of the last sample outside, see :func:`last_time_above`.
 
     Examples
     --------
@@ -100,13 +131,31 @@ def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
     ref = mag[0] if mag[0] > 0 else float(np.max(mag))
     if ref == 0.0:
         return float(t[0])
-    outside = np.flatnonzero(mag > band * ref)
-    if outside.size == 0:
-        return float(t[0])
-    last = int(outside[-1])
-    if last == mag.size - 1:
-        return None
-    return float(t[last + 1])
+    k = settle_index(mag, band * ref)
+    return None if k == mag.size else float(t[k])
+
+
+def last_time_above(t: Any, e: Any, threshold: float) -> float:
+    """The last sample time at which ``|e|`` exceeds the absolute ``threshold``.
+
+    ``0.0`` when it never does; ``inf`` when the last sample still does (not settled within the
+    run). Paper V's settling time ``t_s`` (:mod:`benchmarks.families.flexible.metrics`). Unlike
+    :func:`settling_time`, the threshold is absolute and the time is that of the last sample
+    outside it, not of the first inside.
+
+    Examples
+    --------
+    >>> last_time_above([0.0, 1.0, 2.0, 3.0, 4.0], [3.0, 2.0, 0.5, 1.5, 0.2], 1.0)
+    3.0
+    >>> last_time_above([0.0, 1.0], [0.5, 2.0], 1.0)
+    inf
+    """
+    k = settle_index(e, threshold)
+    if k == 0:
+        return 0.0
+    if k == len(e):
+        return float("inf")
+    return float(np.asarray(t, dtype=float)[k - 1])
 
 
 def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = None) -> dict[str, Any]:
@@ -148,14 +197,39 @@ def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = Non
         return {"peak_error": None, "recovery_time": None, "band": float(band)}
     idx = np.flatnonzero(inside)
     window = mag[idx]
-    outside = np.flatnonzero(window > band)
-    if outside.size == 0:
-        rec: float | None = 0.0
-    elif outside[-1] == window.size - 1:
-        rec = None
-    else:
-        rec = float(t[idx[outside[-1] + 1]] - t_on)
-    return {"peak_error": float(window.max()), "recovery_time": rec, "band": float(band)}
+    return {
+        "peak_error": float(window.max()),
+        "recovery_time": recovery_time(t[idx], window, t_on, band),
+        "band": float(band),
+    }
+
+
+def recovery_time(t: Any, e: Any, t_on: float, band: float) -> float | None:
+    """Time from ``t_on`` after which ``|e|`` stays within the absolute ``band`` until the last sample.
+
+    ``t`` and ``e`` are the samples of the window after the event; ``0.0`` when ``|e|`` never
+    leaves the band in it, ``None`` when the last sample is outside (not recovered).
+
+    Examples
+    --------
+    >>> recovery_time([1.0, 2.0, 3.0, 4.0], [0.5, 0.2, 0.01, 0.0], t_on=1.0, band=0.05)
+    2.0
+    """
+    k = settle_index(e, band)
+    if k == 0:
+        return 0.0
+    if k == len(e):
+        return None
+    return float(np.asarray(t, dtype=float)[k] - t_on)
+
+
+def check_trajectory(traj: Any, name: str = "traj") -> Any:
+    """``traj`` if it is an :class:`rmpc.Trajectory`; an ``ArgumentTypeError`` naming ``name`` otherwise."""
+    from rmpc.sim.simulate import Trajectory  # here: the metrics above load without the controllers
+
+    if not isinstance(traj, Trajectory):
+        raise ArgumentTypeError(name, "an rmpc.Trajectory", type(traj).__name__)
+    return traj
 
 
 def step_timing(traj: Any) -> dict[str, Any]:

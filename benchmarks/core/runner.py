@@ -1,7 +1,9 @@
 """Run one scenario through its plant family (build, simulate, measure) and make its record.
 
-:func:`run_case` is the function worker processes (or Dask workers) execute; it never raises
-for a failing case but returns the error, so a sweep can record it and go on.
+:func:`run_scenario` gives the record of one scenario; :func:`simulate_scenario` also the time
+series. :func:`run_case` is the function worker processes (or Dask workers) execute; it never
+raises for a failing case but returns the error, so a sweep can record it and go on. The
+runner uses :mod:`benchmarks.core.scenario`, which does not import it back.
 """
 
 from __future__ import annotations
@@ -12,22 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.jsonable import json_safe
 from benchmarks.core.scenario import Scenario
 
-__all__ = ["run_case", "simulate_scenario"]
-
-
-def _json_safe(value: Any) -> Any:
-    """Replace NaN/inf by ``None`` and numpy scalars by Python numbers, recursively."""
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
+__all__ = ["run_case", "run_scenario", "simulate_scenario"]
 
 
 def simulate_scenario(
@@ -72,7 +62,13 @@ def simulate_scenario(
         "cpu_time_s": time.process_time() - cpu_start,
     }
     trace = result.trace if keep_trace else None
-    return _json_safe(record), trace
+    return json_safe(record), trace
+
+
+def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:
+    """Simulate ``scenario`` and return its record (see :func:`simulate_scenario`)."""
+    record, _ = simulate_scenario(scenario, experiment=experiment)
+    return record
 
 
 def run_case(payload: dict[str, Any]) -> dict[str, Any]:

@@ -2,10 +2,11 @@
 
 A :class:`Scenario` is an immutable, validated description of one closed-loop run. Its fields
 are the core's (``family``, ``controller``, ``settings``) and those of its plant family
-(:mod:`benchmarks.core.family`; paper P's rigid satellite by default, whose fields are listed in
-:mod:`benchmarks.families.rigid.family`). :attr:`Scenario.case_id` is a stable hash of
-:meth:`Scenario.to_dict`, so the same case gets the same id in every sweep and every run.
-:func:`run_scenario` simulates it and returns the record that ``results.json`` holds.
+(:mod:`benchmarks.core.family`, looked up in :mod:`benchmarks.core.registry`; paper P's rigid
+satellite by default, whose fields are listed in :mod:`benchmarks.families.rigid.family`).
+:attr:`Scenario.case_id` is a stable hash of :meth:`Scenario.to_dict`, so the same case gets the
+same id in every sweep and every run. :func:`benchmarks.core.runner.run_scenario` simulates it
+and returns the record that ``results.json`` holds.
 
 Examples
 --------
@@ -25,10 +26,11 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
-from benchmarks.core.family import PlantFamily, get_family
+from benchmarks.core.family import PlantFamily
+from benchmarks.core.registry import get_family
 from toolkit_common.errors import ConfigError
 
-__all__ = ["CORE_FIELDS", "DEFAULT_FAMILY", "Scenario", "run_scenario"]
+__all__ = ["CORE_FIELDS", "DEFAULT_FAMILY", "Scenario"]
 
 #: The family of a scenario that does not name one: paper P's rigid satellite.
 DEFAULT_FAMILY = "rigid"
@@ -229,10 +231,3 @@ class Scenario:
             return fam.label(self)
         return " ".join([self._controller, self.plant, self.saturation])
 
-
-def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str, Any]:
-    """Simulate ``scenario`` and return its record (see :func:`benchmarks.core.runner.simulate_scenario`)."""
-    from benchmarks.core.runner import simulate_scenario
-
-    record, _ = simulate_scenario(scenario, experiment=experiment)
-    return record

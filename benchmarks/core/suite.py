@@ -9,19 +9,22 @@ the suite writes its own report from that.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from benchmarks.core.execute import ExecOutcome, Task, execute
-from benchmarks.core.executors import make_executor
+from benchmarks.core.executors import make_executor_and_out
 from benchmarks.core.progress import CaseProgress
 from benchmarks.core.scenario import Scenario
+from toolkit_common.errors import ConfigError
 
 __all__ = [
     "SuiteCase",
     "SuiteOutcome",
+    "check_time_scale",
+    "chosen_experiments",
     "run_suite_cases",
     "write_records",
     "write_rows_csv",
@@ -62,6 +65,28 @@ class SuiteOutcome:
     executor: str = ""
 
 
+def chosen_experiments(known: Collection[str], experiments: Sequence[str] | None) -> list[str]:
+    """The experiments a run asks for (all of ``known`` by default), each checked.
+
+    Examples
+    --------
+    >>> chosen_experiments(["E1", "E2"], None), chosen_experiments(["E1", "E2"], ["E2"])
+    (['E1', 'E2'], ['E2'])
+    """
+    chosen = list(known) if experiments is None else list(experiments)
+    for name in chosen:
+        if name not in known:
+            raise ConfigError("--experiments", "names among " + ", ".join(known), repr(name))
+    return chosen
+
+
+def check_time_scale(time_scale: float) -> float:
+    """``time_scale`` if it is a factor in ``(0, 1]`` (a suite's run lengths are multiplied by it)."""
+    if not 0.0 < time_scale <= 1.0:
+        raise ConfigError("time_scale", "a factor in (0, 1]", repr(time_scale))
+    return time_scale
+
+
 def run_suite_cases(
     cases: Sequence[Any],
     out: str | Path,
@@ -95,13 +120,7 @@ def run_suite_cases(
     runs : list of (case, record, trace)
         The cases that finished, with their time series.
     """
-    executor = make_executor(workers, scheduler)
-    out = Path(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        executor.close()
-        raise
+    executor, out = make_executor_and_out(workers, scheduler, out)
     start = time.perf_counter()
     results: dict[str, dict[str, Any]] = {}
     ordered = sorted(cases, key=cost, reverse=True) if cost is not None else list(cases)

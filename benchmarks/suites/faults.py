@@ -31,6 +31,8 @@ from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
     SuiteOutcome,
+    check_time_scale,
+    chosen_experiments,
     run_suite_cases,
     write_records,
     write_rows_csv,
@@ -38,8 +40,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.wheel import defaults
-from benchmarks.reports.tables import to_markdown
-from toolkit_common.errors import ConfigError
+from benchmarks.reports.sections import failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "fault_cases", "run_faults"]
 
@@ -75,12 +76,8 @@ def fault_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = Non
     >>> len(cases), sorted({c.experiment for c in cases})
     (20, ['W1', 'W2', 'W3', 'W4'])
     """
-    if not 0.0 < time_scale <= 1.0:
-        raise ConfigError("time_scale", "a factor in (0, 1]", repr(time_scale))
-    chosen = list(EXPERIMENTS) if experiments is None else list(experiments)
-    for name in chosen:
-        if name not in EXPERIMENTS:
-            raise ConfigError("--experiments", "names among " + ", ".join(EXPERIMENTS), repr(name))
+    check_time_scale(time_scale)
+    chosen = chosen_experiments(EXPERIMENTS, experiments)
     cases = []
     for exp in chosen:
         scenario = EXPERIMENTS[exp][0]
@@ -177,7 +174,7 @@ def case_row(rec: dict[str, Any]) -> dict[str, Any]:
         "max |h| (N m s)": f"{max(f['max_abs_h']):.3f}",
         "momentum-limit samples": str(mom.get("samples", "-")),
         "step p50 / p95 (ms)": f"{1e3 * m['step_time_p50']:.2f} / {1e3 * m['step_time_p95']:.2f}",
-        "statuses": ", ".join(f"{k} {v}" for k, v in sorted(m["status_counts"].items())),
+        "statuses": statuses(m["status_counts"]),
     }
 
 
@@ -330,21 +327,12 @@ def _markdown(
     info: dict[str, Any],
     out: Path,
 ) -> str:
-    m = info["machine"]
+    smoke = " (a smoke run: durations and fault windows shortened, no measurement)"
+    scale = f"time scale {info['time_scale']:g}" + (smoke if info["time_scale"] < 1 else "")
     lines = [
         "# Benchmark suite `faults`: paper W's scenarios S1-S4 (W1-W4)",
         "",
-        f"Wall time {info['wall_time_s']:.1f} s on {info['executor']}; time scale {info['time_scale']:g}"
-        + (
-            " (a smoke run: durations and fault windows shortened, no measurement)"
-            if info["time_scale"] < 1
-            else ""
-        )
-        + f"; {info['done']} of {info['cases']} cases done, {info['failed']} failed"
-        + (" (interrupted)" if info["interrupted"] else "")
-        + ".",
-        f"Machine: {m['platform']}, {m['cpu_count']} CPUs, load average {m['load_average']} at the end; "
-        "package versions in `run.json`.",
+        *run_lines(info, scale, versions_in_run_json=True),
         "",
         "Nonlinear four-wheel satellite (records: `plant` = \"wheel\"), RK4 at 5 ms inside the 40 ms hold; "
         "every wheel's torque "
@@ -359,24 +347,15 @@ def _markdown(
             continue
         lines += [f"## {exp} (paper W's {scenario})", "", text, ""]
         if recs:
-            rows = [case_row(r) for r in recs]
-            header = list(rows[0])
-            lines += [to_markdown(header, [[row[h] for h in header] for row in rows]), ""]
+            lines += [rows_table([case_row(r) for r in recs]), ""]
         for path in figures.get(exp, []):
             lines += [f"![{path.stem}]({path.relative_to(out).as_posix()})", ""]
     lines += paper_w_results(records)
     lines += inconsistencies(records)
-    if outcome.failures:
-        lines += ["## Failed cases", ""]
-        lines += [f"- {f['key']}: {f['error']}" for f in outcome.failures]
-        lines.append("")
-    lines += [
-        "## Settings",
-        "",
+    lines += failed_cases(outcome.failures)
+    intro = (
         "Every value paper W leaves out is the toolkit's choice "
-        "(`benchmarks/families/wheel/defaults.py`; each is a scenario field or controller setting).",
-        "",
-    ]
-    lines += [to_markdown(["setting", "value", "source"], [list(r) for r in defaults.settings_rows()]), ""]
-    lines += ["Why these values:", "", defaults.rationale(), ""]
+        "(`benchmarks/families/wheel/defaults.py`; each is a scenario field or controller setting)."
+    )
+    lines += settings_section(intro, defaults.settings_rows(), defaults.rationale())
     return "\n".join(lines)

@@ -26,6 +26,8 @@ from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
     SuiteOutcome,
+    check_time_scale,
+    chosen_experiments,
     run_suite_cases,
     write_records,
     write_rows_csv,
@@ -33,8 +35,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.mrp import defaults
-from benchmarks.reports.tables import to_markdown
-from toolkit_common.errors import ConfigError
+from benchmarks.reports.sections import dash, failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "mrp_cases", "run_mrp"]
 
@@ -77,12 +78,8 @@ def mrp_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = None)
     >>> len(cases), sorted({c.experiment for c in cases})
     (20, ['M1', 'M2', 'M3'])
     """
-    if not 0.0 < time_scale <= 1.0:
-        raise ConfigError("time_scale", "a factor in (0, 1]", repr(time_scale))
-    chosen = list(EXPERIMENTS) if experiments is None else list(experiments)
-    for name in chosen:
-        if name not in EXPERIMENTS:
-            raise ConfigError("--experiments", "names among " + ", ".join(EXPERIMENTS), repr(name))
+    check_time_scale(time_scale)
+    chosen = chosen_experiments(EXPERIMENTS, experiments)
     cases = []
     for exp in chosen:
         scales = (1.3, 0.7) if exp == "M3" else (None,)
@@ -127,10 +124,6 @@ def run_mrp(
     return outcome
 
 
-def _fmt(value: float | None, spec: str = ".4g") -> str:
-    return "-" if value is None else format(value, spec)
-
-
 def case_row(rec: dict[str, Any]) -> dict[str, str]:
     """The table row of one record."""
     m = rec["metrics"]
@@ -140,14 +133,14 @@ def case_row(rec: dict[str, Any]) -> dict[str, str]:
         "saturation": rec["saturation"],
         "plant J": f"x{rec['settings']['inertia_scale_used']:g}",
         "max / RMS error on the window (deg)": (
-            f"{_fmt(m['err_angle_ss_max_deg'])} / {_fmt(m['err_angle_rms_deg'])}"
+            f"{dash(m['err_angle_ss_max_deg'])} / {dash(m['err_angle_rms_deg'])}"
         ),
-        "final error (deg)": _fmt(m["err_angle_final_deg"]),
+        "final error (deg)": dash(m["err_angle_final_deg"]),
         "max |u| (N m)": f"{m['max_abs_u']:.3f}",
-        "max |Td est - Td| (N m)": _fmt(m.get("td_est_err_max"), ".2e"),
+        "max |Td est - Td| (N m)": dash(m.get("td_est_err_max"), ".2e"),
         "step p50 / p95 (ms)": f"{1e3 * m['step_time_p50']:.2f} / {1e3 * m['step_time_p95']:.2f}",
         "LMI solve p50 (ms)": "-" if solve is None else f"{1e3 * solve:.1f}",
-        "statuses": ", ".join(f"{k} {v}" for k, v in sorted(m["status_counts"].items())),
+        "statuses": statuses(m["status_counts"]),
     }
 
 
@@ -167,24 +160,24 @@ def paper_m_comparison(records: list[dict[str, Any]]) -> list[str]:
         return None if rec is None else rec["metrics"]["err_angle_ss_max_deg"]
 
     measured = {
-        "R1": f"M1 max error on the window: BS {_fmt(err('M1', 'BS'))} deg, MAB {_fmt(err('M1', 'MAB'))} deg",
+        "R1": f"M1 max error on the window: BS {dash(err('M1', 'BS'))} deg, MAB {dash(err('M1', 'MAB'))} deg",
         "R2": "largest torque in M1 (at time): "
         + ", ".join(
             f"{c} {r['metrics']['max_abs_u']:.2f} N m ({r['metrics']['max_abs_u_time']:g} s)"
             for c in CONTROLLERS
             if (r := _find(records, "M1", c))
         ),
-        "R3": f"M2: BS {_fmt(err('M2', 'BS'))} deg, MAB {_fmt(err('M2', 'MAB'))} deg; NESO error "
-        + _fmt((_find(records, "M2", "MAB") or {}).get("metrics", {}).get("td_est_err_max"), ".2e")
+        "R3": f"M2: BS {dash(err('M2', 'BS'))} deg, MAB {dash(err('M2', 'MAB'))} deg; NESO error "
+        + dash((_find(records, "M2", "MAB") or {}).get("metrics", {}).get("td_est_err_max"), ".2e")
         + " N m after the window start",
-        "R4": f"M2: MAB {_fmt(err('M2', 'MAB'))} deg vs TF-AB {_fmt(err('M2', 'TFAB'))} deg (the ranking "
+        "R4": f"M2: MAB {dash(err('M2', 'MAB'))} deg vs TF-AB {dash(err('M2', 'TFAB'))} deg (the ranking "
         "depends on the tuning: TF-AB with Gamma = 100 beats MAB with w_o = 10, seed 8(c); the sweep "
         "mrp_gains varies both)",
     }
     for key, text in PAPER_M_RESULTS:
         lines.append(f"- **{key}** {text} Measured: {measured[key]}.")
     robust = [
-        f"{c} {_fmt(err('M2', c))} deg" for c in ("RMPC", "CRMPC") if _find(records, "M2", c) is not None
+        f"{c} {dash(err('M2', c))} deg" for c in ("RMPC", "CRMPC") if _find(records, "M2", c) is not None
     ]
     if robust:
         lines.append(
@@ -235,16 +228,11 @@ def _write(
     info = write_run_info(
         out, "rmpc bench mrp", outcome, len(cases), workers, scheduler, ("time_scale", time_scale)
     )
-    m = info["machine"]
+    scale = f"time scale {time_scale:g}" + (" (a smoke run, no measurement)" if time_scale < 1 else "")
     lines = [
         "# Benchmark suite `mrp`: paper M's scenarios M1-M3",
         "",
-        f"Wall time {info['wall_time_s']:.1f} s on {info['executor']}; time scale {time_scale:g}"
-        + (" (a smoke run, no measurement)" if time_scale < 1 else "")
-        + f"; {info['done']} of {info['cases']} cases done, {info['failed']} failed"
-        + (" (interrupted)" if info["interrupted"] else "")
-        + ".",
-        f"Machine: {m['platform']}, {m['cpu_count']} CPUs, load average {m['load_average']} at the end.",
+        *run_lines(info, scale),
         "",
         f"Every controller at a {CONTROL_PERIOD:g} s period on the same truth plant "
         f"(RK4 at {PLANT_STEP:g} s, "
@@ -257,22 +245,13 @@ def _write(
         if not recs:
             continue
         lines += [f"## {exp}", "", text, ""]
-        table = [case_row(r) for r in recs]
-        header = list(table[0])
-        lines += [to_markdown(header, [[row[h] for h in header] for row in table]), ""]
+        lines += [rows_table([case_row(r) for r in recs]), ""]
         for path in figures.get(exp, []):
             lines += [f"![{path.stem}]({path.relative_to(out).as_posix()})", ""]
     lines += paper_m_comparison(records)
-    if outcome.failures:
-        lines += ["## Failed cases", ""] + [f"- {f['key']}: {f['error']}" for f in outcome.failures] + [""]
-    lines += [
-        "## Settings",
-        "",
-        "Every value paper M leaves out is the toolkit's choice (`benchmarks/families/mrp/defaults.py`).",
-        "",
-    ]
-    lines += [to_markdown(["setting", "value", "source"], [list(r) for r in defaults.settings_rows()]), ""]
-    lines += ["Why these values:", "", defaults.rationale(), ""]
+    lines += failed_cases(outcome.failures)
+    intro = "Every value paper M leaves out is the toolkit's choice (`benchmarks/families/mrp/defaults.py`)."
+    lines += settings_section(intro, defaults.settings_rows(), defaults.rationale())
     (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
     files += [out / n for n in ("results.json", "run.json", "results.md")]
     return files

@@ -27,12 +27,14 @@ from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
     SuiteOutcome,
+    chosen_experiments,
     run_suite_cases,
     write_records,
     write_run_info,
     write_traces,
 )
 from benchmarks.families.rigid import defaults
+from benchmarks.reports.sections import failed_cases, run_lines, settings_section
 from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
@@ -69,10 +71,7 @@ def paper_cases(duration_scale: float = 1.0, experiments: Sequence[str] | None =
     """
     if not duration_scale > 0:
         raise ConfigError("--duration-scale", "a number > 0", repr(duration_scale))
-    chosen = list(EXPERIMENTS) if experiments is None else list(experiments)
-    for name in chosen:
-        if name not in EXPERIMENTS:
-            raise ConfigError("--experiments", "names among " + ", ".join(EXPERIMENTS), repr(name))
+    chosen = chosen_experiments(EXPERIMENTS, experiments)
     base = {
         "duration": defaults.DURATION * duration_scale,
         "disturbance_start": defaults.DISTURBANCE_START * duration_scale,
@@ -214,15 +213,8 @@ def _markdown(
     from benchmarks.suites.paper_claims import assess_claims, claims_markdown
 
     lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", ""]
-    m = info["machine"]
     lines += [
-        f"Wall time {info['wall_time_s']:.1f} s on {info['executor']}; "
-        f"duration scale {info['duration_scale']:g}; "
-        f"{info['done']} of {info['cases']} cases done, {info['failed']} failed"
-        + (" (interrupted)" if info["interrupted"] else "")
-        + ".",
-        f"Machine: {m['platform']}, {m['cpu_count']} CPUs, load average {m['load_average']} at the end; "
-        "package versions in `run.json`.",
+        *run_lines(info, f"duration scale {info['duration_scale']:g}", versions_in_run_json=True),
         "",
         "Errors are the attitude angles (rad); `sum|e|` is paper P's `sum_k |e(k)|` over all samples; "
         "settling and overshoot are the worst axis (`-`: not settled within the run); `per-solve` times are "
@@ -250,17 +242,10 @@ def _markdown(
             f"![gamma]({gamma.relative_to(out).as_posix()})",
             "",
         ]
-    if outcome.failures:
-        lines += ["## Failed cases", ""]
-        lines += [f"- {f['key']}: {f['error']}" for f in outcome.failures]
-        lines.append("")
-    lines += [
-        "## Settings",
-        "",
+    lines += failed_cases(outcome.failures)
+    intro = (
         "Every value paper P leaves out is the toolkit's choice "
-        "(`benchmarks/families/rigid/defaults.py`; each is a scenario field or controller setting).",
-        "",
-    ]
-    lines += [to_markdown(["setting", "value", "source"], [list(r) for r in settings_rows()]), ""]
-    lines += ["Why these values:", "", rationale(), ""]
+        "(`benchmarks/families/rigid/defaults.py`; each is a scenario field or controller setting)."
+    )
+    lines += settings_section(intro, settings_rows(), rationale())
     return "\n".join(lines)

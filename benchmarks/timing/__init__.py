@@ -1,9 +1,13 @@
 """The solver timing reports of ``rmpc timing``: one module per problem and the report around them.
 
-- :mod:`benchmarks.timing.suite`: the command, its configuration and the report (``timing.json``,
-  ``timing.md``);
+- :mod:`benchmarks.timing.suite`: the command, the run and the files (``timing.json``,
+  ``timing.md``, ``timing.png``, ``timing_samples.npz``);
+- :mod:`benchmarks.timing.config`: the options and their checks;
+- :mod:`benchmarks.timing.common`: paper P's timing problem, its polytopes, the record helpers;
 - :mod:`benchmarks.timing.rmpc`, :mod:`benchmarks.timing.offline`, :mod:`benchmarks.timing.gipc`:
-  the timed paths of each problem;
+  the timed paths of each problem (the report's section and a stand-alone script each);
+- :mod:`benchmarks.timing.scale`: the opt-in scale section (the flexible satellite, 6-20 states);
+- :mod:`benchmarks.timing.markdown`: ``timing.md``;
 - :mod:`benchmarks.timing.plots`: the time-distribution figures.
 """
 

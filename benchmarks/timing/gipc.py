@@ -1,7 +1,11 @@
 """Per-step time of GIPC with each QP back-end, against the same QP through cvxpy, in one run.
 
-Run as ``python -m benchmarks.timing.gipc [--steps N] [--plant linear|nonlinear] [--json FILE]``.
+**The section of** ``rmpc timing`` (:func:`time_gipc`, called by :mod:`benchmarks.timing.suite`):
+the QPs of one GIPC closed loop (with E4's step disturbance half-way), solved by every back-end
+of :data:`GIPC_BACKENDS`, interleaved, against cvxpy + Clarabel at 1e-10, with the KKT residual.
 
+**The stand-alone script**: run as
+``python -m benchmarks.timing.gipc [--steps N] [--plant linear|nonlinear] [--json FILE]``.
 Each back-end drives its own closed loop of paper P's problem: the satellite from paper P's
 initial attitude, ``Ts = 0.01`` s, GIPC with its defaults (``Np = 400``, ``Nc = 4``,
 ``|u| <= 1``, ``|du| <= 0.01``) and experiment E4's 0.5 N m step disturbance from t = 10 s,
@@ -29,19 +33,105 @@ import json
 import sys
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from benchmarks.core.machine import machine_info, package_versions, percentiles
+from benchmarks.timing.common import finite, median_int, rel_err, sample_key, tally
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import GIPC, StepDisturbance, simulate
-from rmpc.qp import reference_solution
+from rmpc.qp import QP, kkt_residuals, make_backend, reference_solution
 
-__all__ = ["main", "run"]
+if TYPE_CHECKING:
+    from benchmarks.core.progress import CaseProgress
+    from benchmarks.timing.config import TimingConfig
+
+__all__ = ["GIPC_BACKENDS", "main", "run", "time_gipc"]
 
 BACKENDS = ("proxqp", "osqp", "clarabel", "cvxpy")
+#: The bound on the input increments ``|du| <= DU_MAX`` (N m per step), in both parts.
 DU_MAX = 0.01
+#: The reference of the section: cvxpy + Clarabel at this tolerance.
+TIGHT = 1e-10
+#: The section's back-ends: (label in the report, back-end name, its settings).
+GIPC_BACKENDS: tuple[tuple[str, str, dict[str, Any]], ...] = (
+    ("proxqp", "proxqp", {}),
+    ("osqp", "osqp", {}),
+    ("clarabel", "clarabel", {}),
+    ("cvxpy:CLARABEL", "cvxpy", {"tol": 1e-8}),
+)
+
+
+# -- the section of rmpc timing -------------------------------------------------------------------
+def time_gipc(cfg: TimingConfig, bar: CaseProgress | None = None) -> dict[str, Any]:
+    """Time ``update + solve`` of every QP back-end on the QPs of one GIPC closed loop."""
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    model = sat.linear_model(x0, PAPER_P_SAMPLE_TIME)
+    ctrl = GIPC(model, du_max=DU_MAX)
+    n = cfg.cheap_steps
+    t_dist = min(10.0, 0.5 * n * PAPER_P_SAMPLE_TIME)
+    traj = simulate(ctrl, model, x0, n_steps=n, disturbance=StepDisturbance([0.5, 0.5, 0.5], t_dist))
+    qps: list[QP] = []
+    for k in range(traj.n_steps):
+        prev = (None, None) if k == 0 else (traj.x[k - 1], traj.u_cmd[k - 1])
+        qps.append(ctrl.qp_at(traj.x[k], *prev))
+    vectors = [{"g": qp.g, "l": qp.l, "u": qp.u, "lb": qp.lb, "ub": qp.ub} for qp in qps]
+    ref = make_backend("cvxpy", solver="CLARABEL", tol=TIGHT)
+    ref.setup(qps[0])
+    ref_obj, ref_status = [], {}
+    for vec in vectors:
+        ref.update(**vec)
+        res = ref.solve()
+        ref_obj.append(res.objective if res.status == "optimal" else float("nan"))
+        tally(ref_status, res.status)
+    warm = ctrl.qp_at(1.3 * x0)  # warm-up QP (not timed), unlike the first one: no free warm start
+    backends = []
+    for label, name, settings in GIPC_BACKENDS:
+        be = make_backend(name, **settings)
+        start = time.perf_counter()
+        be.setup(warm)
+        be.solve()
+        backends.append({"label": label, "be": be, "setup_s": time.perf_counter() - start, "times": [],
+                         "solver": [], "iters": [], "obj": [], "kkt": [], "status": {}})
+    for k, vec in enumerate(vectors):
+        shift = k % len(backends)
+        for b in backends[shift:] + backends[:shift]:
+            t0 = time.perf_counter()
+            b["be"].update(**vec)
+            res = b["be"].solve()
+            b["times"].append(time.perf_counter() - t0)
+            b["solver"].append(res.solve_time)
+            b["iters"].append(res.iterations)
+            b["obj"].append(res.objective)
+            tally(b["status"], res.status)
+            if res.status in ("optimal", "inaccurate"):
+                b["kkt"].append(kkt_residuals(qps[k], res).max())
+    if bar is not None:
+        bar.advance("GIPC")
+    records, samples = [], {}
+    for b in backends:
+        rec = {
+            "problem": "GIPC", "formulation": f"velocity-form QP (Np={ctrl.Np}, Nc={ctrl.Nc})",
+            "backend": b["label"], "vertices": 1, "polytope": "nominal", "steps": len(b["times"]),
+            **percentiles(b["times"]),
+            "solver_p50_s": percentiles(b["solver"])["p50_s"],
+            "iterations_p50": median_int(b["iters"]),
+            "status_counts": b["status"],
+            "max_rel_err": rel_err(b["obj"], ref_obj, floor=1e-12),
+            "max_kkt_residual": finite(max(b["kkt"])) if b["kkt"] else None,
+            "setup_s": b["setup_s"],
+            "settings": repr(b["be"].settings),
+        }
+        records.append(rec)
+        samples[sample_key(rec)] = np.asarray(b["times"])
+    reference = {"backend": "cvxpy:CLARABEL", "tol": TIGHT, "status_counts": ref_status,
+                 "disturbance_start_s": t_dist, "controller": ctrl.settings()}
+    return {"records": records, "samples": samples, "reference": reference}
+
+
+# -- the stand-alone script -----------------------------------------------------------------------
 
 
 def _one(backend: str, steps: int, plant: str, check_every: int) -> dict[str, Any]:

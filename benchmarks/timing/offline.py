@@ -1,8 +1,13 @@
 """Per-step lookup time and design time of off-line robust MPC on paper P's satellite.
 
-Run as ``python -m benchmarks.timing.offline [--steps N] [--repeats R] [--out FILE]``. For
-2 and 8 vertices (inertia spread 0.3, ``||u|| <= 1``, Ts = 0.01 s, ``Q1 = diag(1, 1, 1, 0.1,
-0.1, 0.1)``, ``R = I``) it designs :class:`rmpc.OfflineRMPC` from paper P's initial state (15
+**The section of** ``rmpc timing`` (:func:`time_offline`, called by :mod:`benchmarks.timing.suite`):
+the table designed at ``x0`` on the report's polytope, its lookups timed at the states of its own
+closed loop with and without interpolation, and ``gamma_1`` against the online ``gamma(x0)``.
+
+**The stand-alone script**: run as
+``python -m benchmarks.timing.offline [--steps N] [--repeats R] [--out FILE]``. For 2 and 8
+vertices (inertia spread 0.3, ``||u|| <= 1``, Ts = 0.01 s, ``Q1 = diag(1, 1, 1, 0.1, 0.1,
+0.1)``, ``R = I``) it designs :class:`rmpc.OfflineRMPC` from paper P's initial state (15
 ellipsoids along its ray; the design time is the wall time of the construction), runs one closed
 loop of the nominal linear model, and then times ``step(x)`` at the loop's states, ``R`` passes
 over all of them, with and without interpolation. Reported per step: median, p95 and max of the
@@ -17,22 +22,29 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from benchmarks.core.machine import machine_info, package_versions, percentiles
+from benchmarks.timing.common import POLYTOPE_NAMES, Q1, U_MAX, R, finite, sample_key, tally
+from benchmarks.timing.rmpc import reference_gamma_at
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import OfflineRMPC, simulate
 
-Q1 = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
-R = np.eye(3)
-U_MAX = 1.0
+if TYPE_CHECKING:
+    from benchmarks.timing.config import TimingConfig
+    from models import PolytopicModel
+
+__all__ = ["format_table", "lookup_times", "main", "reference_u", "run", "time_lookup", "time_offline"]
+
 LEVEL_TOL = 1e-6
 
 
+# -- lookups, timed and checked (both parts) ------------------------------------------------------
 def reference_u(ctrl: OfflineRMPC, x: np.ndarray) -> np.ndarray:
     """``u`` computed the slow, obvious way from the stored table."""
     assert ctrl.table is not None
@@ -48,8 +60,14 @@ def reference_u(ctrl: OfflineRMPC, x: np.ndarray) -> np.ndarray:
     return (alpha * ells[i].F + (1.0 - alpha) * ells[i + 1].F) @ x
 
 
-def time_lookup(ctrl: OfflineRMPC, states: np.ndarray, repeats: int) -> dict[str, Any]:
-    """Wall time of each ``step`` call and the controller's own ``solve_time``."""
+def lookup_times(
+    ctrl: OfflineRMPC, states: np.ndarray, repeats: int, check_u: bool = True
+) -> tuple[list[float], list[float], dict[str, int], float | None]:
+    """Time ``step`` at ``states``, ``repeats`` passes; then check ``u`` against :func:`reference_u`.
+
+    Returns the wall time of each call, the controller's own ``solve_time`` of each, the status
+    counts and the largest relative error of ``u`` (``None`` without ``check_u``).
+    """
     ctrl.step(states[0])  # the first step of a run (reset by simulate) is not a plain lookup
     wall, reported, statuses = [], [], {}
     for _ in range(repeats):
@@ -58,16 +76,61 @@ def time_lookup(ctrl: OfflineRMPC, states: np.ndarray, repeats: int) -> dict[str
             ctrl.step(x)
             wall.append(time.perf_counter() - start)
             reported.append(ctrl.last.solve_time)
-            statuses[ctrl.last.status] = statuses.get(ctrl.last.status, 0) + 1
+            tally(statuses, ctrl.last.status)
+    if not check_u:
+        return wall, reported, statuses, None
     err = 0.0
     for x in states:
         u, ref = ctrl.step(x), reference_u(ctrl, x)
         err = max(err, float(np.linalg.norm(u - ref) / max(np.linalg.norm(ref), 1e-300)))
+    return wall, reported, statuses, err
+
+
+def time_lookup(ctrl: OfflineRMPC, states: np.ndarray, repeats: int) -> dict[str, Any]:
+    """Wall time of each ``step`` call and the controller's own ``solve_time``."""
+    wall, reported, statuses, err = lookup_times(ctrl, states, repeats)
     rep = percentiles(reported)
     return {**percentiles(wall), "reported_p50_s": rep["p50_s"], "reported_p95_s": rep["p95_s"],
             "status_counts": statuses, "max_rel_err": err, "calls": len(wall)}
 
 
+# -- the section of rmpc timing -------------------------------------------------------------------
+def time_offline(poly: PolytopicModel, cfg: TimingConfig, gamma_x0: float | None) -> dict[str, Any]:
+    """Design OfflineRMPC at ``x0``, then time its lookups at the states of its own closed loop."""
+    x0 = RigidSatellite.initial_state()
+    start = time.perf_counter()
+    ctrl = OfflineRMPC(poly, Q1, R, u_max=U_MAX, x_design=x0, n_ellipsoids=cfg.n_ellipsoids)
+    design_time = time.perf_counter() - start
+    if gamma_x0 is None or not math.isfinite(gamma_x0):
+        gamma_x0 = reference_gamma_at(poly, x0)
+    table = ctrl.table
+    gamma_1 = float(table.gammas[0]) if table is not None and table.n_ellipsoids else float("nan")
+    err = abs(gamma_1 / gamma_x0 - 1.0) if math.isfinite(gamma_1) and math.isfinite(gamma_x0) else None
+    states = simulate(ctrl, poly, x0, n_steps=cfg.cheap_steps).x[:-1]
+    records, samples = [], {}
+    for interpolate in (True, False):
+        ctrl.interpolate = interpolate
+        wall, reported, statuses, err_u = lookup_times(ctrl, states, cfg.lookup_repeats, table is not None)
+        rec = {
+            "problem": "OfflineRMPC", "formulation": "lookup" + ("+interpolation" if interpolate else ""),
+            "backend": "numpy", "vertices": poly.n_vertices, "polytope": POLYTOPE_NAMES[poly.n_vertices],
+            "steps": len(wall), **percentiles(wall),
+            "solver_p50_s": percentiles(reported)["p50_s"], "iterations_p50": None,
+            "status_counts": statuses, "max_rel_err": finite(err),
+            "max_rel_err_u_lookup": finite(err_u),
+            "design_time_s": design_time,
+            "n_ellipsoids": table.n_ellipsoids if table is not None else 0,
+            "gamma_1": finite(gamma_1), "gamma_ref_x0": finite(gamma_x0),
+            "settings": f"{cfg.n_ellipsoids} ellipsoids along the ray of x0 (shrink 0.5), design by "
+                        "cvxpy + Clarabel (delta_shared); lookups at the states of its closed loop, "
+                        f"{cfg.lookup_repeats} passes",
+        }
+        records.append(rec)
+        samples[sample_key(rec)] = np.asarray(wall)
+    return {"records": records, "samples": samples}
+
+
+# -- the stand-alone script -----------------------------------------------------------------------
 def run(steps: int = 1000, repeats: int = 5, n_ellipsoids: int = 15,
         modes: Sequence[str] = ("scalar", "box")) -> dict[str, Any]:
     """Run the benchmark and return ``{"machine", "versions", "records"}``."""

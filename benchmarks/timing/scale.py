@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.machine import percentiles
+from benchmarks.reports.sections import statuses
+from benchmarks.timing.common import SCS_OPTIONS
 
 __all__ = ["SCALE_SIZES", "SCALE_VERTICES", "plot_scale", "scale_problem", "time_scale"]
 
@@ -40,7 +42,6 @@ U_PEAK = 2.0
 #: Modes 5-7 (**assumed**, for the 20-state size only): frequency (rad/s), damping, coupling row
 #: of the published mode it halves.
 EXTRA_MODES: tuple[tuple[float, float, int], ...] = ((3.3, 0.03, 1), (4.2, 0.03, 2), (5.1, 0.03, 3))
-SCS_OPTIONS: dict[str, Any] = {"eps_abs": 1e-4, "eps_rel": 1e-4}
 #: SCS only up to this size: one solve took 4.4 s at 6 states and 29 s at 14 (2 vertices, load ~7).
 SCS_MAX_STATES = 10
 #: cvxpy + Clarabel only up to this size: one solve took 250-270 s at 20 states, 8 vertices (load ~1).
@@ -191,11 +192,11 @@ def format_scale_markdown(records: Sequence[dict[str, Any]], plot_name: str | No
         it = "n/a" if r["iterations_p50"] is None else f"{r['iterations_p50']:g}"
         err = "n/a" if r["max_rel_err"] is None else f"{r['max_rel_err']:.1e}"
         ratio = r["p50_s"] / fast[(r["n_states"], r["vertices"])]
-        statuses = ", ".join(f"{k} {v}" for k, v in sorted(r["status_counts"].items()))
+        counts = statuses(r["status_counts"])
         lines.append(
             f"| {r['n_states']} | {r['vertices']} | {r['backend']} | {r['formulation']} | {r['steps']} "
             f"| {1e3 * r['p50_s']:.1f} "
-            f"| {1e3 * r['p95_s']:.1f} | {1e3 * r['max_s']:.1f} | {it} | {statuses} | {err} | {ratio:.1f}x |")
+            f"| {1e3 * r['p95_s']:.1f} | {1e3 * r['max_s']:.1f} | {it} | {counts} | {err} | {ratio:.1f}x |")
     lines.append("")
     if plot_name:
         lines += [f"![time per solve against state dimension]({plot_name})", ""]

@@ -10,9 +10,10 @@ from benchmarks.core.family import (
     PlantFamily,
     check_choice,
     check_real,
-    register_family,
 )
-from benchmarks.core.scenario import Scenario, run_scenario
+from benchmarks.core.registry import register_family
+from benchmarks.core.runner import run_scenario
+from benchmarks.core.scenario import Scenario
 from models import PolytopicModel
 from rmpc import LQR, simulate
 

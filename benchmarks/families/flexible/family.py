@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import CaseResult, ControllerSpec, Field, PlantFamily, check_choice, check_real
+from benchmarks.core.family import CaseResult, Field, PlantFamily, check_choice, check_real, controller_specs
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import CONSTRAINED, CONTROLLERS, FlexibleModel, settings_check
@@ -322,10 +322,7 @@ FLEXIBLE = PlantFamily(
     name="flexible",
     description="paper V's flexible satellite (4 modes, PZT channel): the V-slew, steady error, small slew",
     fields=FIELDS,
-    controllers={
-        name: ControllerSpec(build, defaults.CONTROLLER_DEFAULTS[name], name in CONSTRAINED)
-        for name, build in CONTROLLERS.items()
-    },
+    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
     simulate=simulate_case,
     check=_check,
     label=_label,

@@ -4,7 +4,8 @@ Seed ``papers-S-V-flexible.md`` sections 4.4 and 6 (definitions where paper V gi
 toolkit's, **assumed**):
 
 - ``t_s``: the last time the rotation error exceeds ``threshold`` (default 1 deg; 0 if it never
-  does, ``inf`` if the final error exceeds it);
+  does, ``inf`` if the final error exceeds it): :func:`benchmarks.core.metrics.last_time_above`,
+  an absolute threshold, unlike the core's relative-band ``settling_time``;
 - ``final_error``: the rotation error at the end (rad);
 - ``rms_error_tail``: RMS rotation error over the last ``tail`` seconds (paper V's "accuracy");
 - ``peak_u``: largest applied hub torque component (N m); ``saturated_fraction``: share of
@@ -26,31 +27,14 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.metrics import check_trajectory, last_time_above
 from models import FlexibleSatellite
 from models.attitude.quaternion import rotation_angle
 from rmpc.sim.simulate import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_positive
 
-__all__ = ["flexible_metrics", "power_fraction_above", "settling_time"]
-
-
-def settling_time(t: np.ndarray, error: np.ndarray, threshold: float) -> float:
-    """The last time ``error`` exceeds ``threshold`` (0 if never, ``inf`` if at the end).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from benchmarks.families.flexible.metrics import settling_time
-    >>> settling_time(np.arange(5.0), np.array([3.0, 2.0, 0.5, 1.5, 0.2]), 1.0)
-    3.0
-    """
-    above = np.flatnonzero(np.asarray(error) > threshold)
-    if above.size == 0:
-        return 0.0
-    if above[-1] == len(error) - 1:
-        return float("inf")
-    return float(np.asarray(t)[above[-1]])
+__all__ = ["flexible_metrics", "power_fraction_above"]
 
 
 def power_fraction_above(u: np.ndarray, dt: float, frequency: float) -> float:
@@ -110,8 +94,7 @@ def flexible_metrics(
     dict
         The metrics by name.
     """
-    if not isinstance(traj, Trajectory):
-        raise ArgumentTypeError("traj", "an rmpc.Trajectory", type(traj).__name__)
+    check_trajectory(traj)
     if not isinstance(satellite, FlexibleSatellite):
         raise ArgumentTypeError("satellite", "a models.FlexibleSatellite", type(satellite).__name__)
     if traj.x.shape[1] != satellite.n_states:
@@ -128,7 +111,7 @@ def flexible_metrics(
     v = traj.u_applied[:, 3:]
     eta = np.abs(traj.x[:, 7:7 + n])
     out: dict[str, Any] = {
-        "t_s": settling_time(traj.t, error, threshold),
+        "t_s": last_time_above(traj.t, error, threshold),
         "final_error": float(error[-1]),
         "rms_error_tail": float(np.sqrt(np.mean(error[in_tail] ** 2))),
         "peak_u": float(np.abs(u).max()) if u.size else 0.0,

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import CaseResult, ControllerSpec, Field, PlantFamily, check_choice, check_real
+from benchmarks.core.family import CaseResult, Field, PlantFamily, check_choice, check_real, controller_specs
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
@@ -181,10 +181,7 @@ MRP = PlantFamily(
     name="mrp",
     description="paper M's rigid satellite in MRPs on its orbit, with the spinning disk (M1-M3)",
     fields=FIELDS,
-    controllers={
-        name: ControllerSpec(build, defaults.CONTROLLER_DEFAULTS[name], name in CONSTRAINED)
-        for name, build in CONTROLLERS.items()
-    },
+    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
     simulate=simulate_case,
     check=_check,
     label=_label,

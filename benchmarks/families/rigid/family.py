@@ -55,13 +55,13 @@ import numpy as np
 
 from benchmarks.core.family import (
     CaseResult,
-    ControllerSpec,
     Field,
     MonteCarlo,
     PlantFamily,
     check_choice,
     check_number,
     check_real,
+    controller_specs,
 )
 from benchmarks.core.metrics import AXES, compute_metrics, recovery
 from benchmarks.families.rigid import defaults
@@ -245,10 +245,7 @@ RIGID = PlantFamily(
     name="rigid",
     description="paper P's rigid satellite (3-2-1 Euler angles, inertia polytope), linear or nonlinear",
     fields=FIELDS,
-    controllers={
-        name: ControllerSpec(build, defaults.CONTROLLER_DEFAULTS[name], name in CONSTRAINED)
-        for name, build in CONTROLLERS.items()
-    },
+    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
     simulate=simulate_case,
     check=_check,
     label=_label,

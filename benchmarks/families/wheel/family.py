@@ -57,11 +57,11 @@ import numpy as np
 
 from benchmarks.core.family import (
     CaseResult,
-    ControllerSpec,
     Field,
     PlantFamily,
     check_choice,
     check_real,
+    controller_specs,
 )
 from benchmarks.core.metrics import compute_metrics
 from benchmarks.families.wheel import defaults
@@ -269,10 +269,7 @@ WHEEL = PlantFamily(
     name="wheel",
     description="paper W's satellite with four reaction wheels and wheel faults (S1-S4)",
     fields=FIELDS,
-    controllers={
-        name: ControllerSpec(build, defaults.CONTROLLER_DEFAULTS[name], name in CONSTRAINED)
-        for name, build in CONTROLLERS.items()
-    },
+    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
     simulate=simulate_case,
     check=_check,
     label=_label,

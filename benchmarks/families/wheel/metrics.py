@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.metrics import AXES, check_trajectory, recovery_time
 from models import FaultSchedule, WheelArray, rank_deficient_windows
 from rmpc.sim.simulate import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
@@ -39,18 +40,9 @@ __all__ = [
 #: Recovery threshold: ``max_i |eta_i| <= 2 deg`` (seed 6.10, **assumed**), in rad.
 RECOVERY_THRESHOLD: float = math.radians(2.0)
 
-_AXES = ("roll", "pitch", "yaw")
-
-
-def _check_traj(traj: Any) -> Trajectory:
-    if not isinstance(traj, Trajectory):
-        raise ArgumentTypeError("traj", "an rmpc.Trajectory", type(traj).__name__)
-    return traj
-
-
 def attitude_error(traj: Trajectory) -> np.ndarray:
     """``|eta|`` per sample and axis (rad), yaw wrapped to ``(-pi, pi]``; shape ``(N + 1, 3)``."""
-    eta = np.array(_check_traj(traj).x[:, :3], dtype=float)
+    eta = np.array(check_trajectory(traj).x[:, :3], dtype=float)
     eta[:, 2] = np.remainder(eta[:, 2] + np.pi, 2.0 * np.pi) - np.pi
     return np.abs(eta)
 
@@ -71,7 +63,7 @@ def recovery_times(
         ``wheel``, ``kind``, ``horizon`` (s, the next event or the run's end) and
         ``recovery_time`` (s after ``t_event``, or ``None``).
     """
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     if not isinstance(faults, FaultSchedule):
         raise ArgumentTypeError("faults", "a models.FaultSchedule", type(faults).__name__)
     threshold = check_positive(threshold, "threshold")
@@ -90,14 +82,7 @@ def recovery_times(
         later = [t for t in times if t > t_ev]
         horizon = later[0] if later else t_end
         in_window = (traj.t >= t_ev - 1e-12) & (traj.t <= horizon + 1e-12)
-        idx = np.flatnonzero(in_window)
-        above = idx[err[idx] > threshold]
-        if above.size == 0:
-            rec: float | None = 0.0
-        elif above[-1] == idx[-1]:
-            rec = None
-        else:
-            rec = float(traj.t[above[-1] + 1] - t_ev)
+        rec = recovery_time(traj.t[in_window], err[in_window], t_ev, threshold)
         out.append(
             {
                 "t_event": float(t_ev),
@@ -116,7 +101,7 @@ def peak_abs_error(traj: Trajectory, windows: Sequence[tuple[float, float]]) -> 
 
     Windows are cut at the end of the run; an empty window gives ``None`` peaks.
     """
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     err = attitude_error(traj)
     out = []
     for i, window in enumerate(windows):
@@ -127,7 +112,7 @@ def peak_abs_error(traj: Trajectory, windows: Sequence[tuple[float, float]]) -> 
         if not t1 > t0:
             raise InvalidArgumentError(f"windows[{i}]", "t_end > t_start", repr(window))
         mask = (traj.t >= t0) & (traj.t < t1)
-        peak = {ax: (float(err[mask, a].max()) if mask.any() else None) for a, ax in enumerate(_AXES)}
+        peak = {ax: (float(err[mask, a].max()) if mask.any() else None) for a, ax in enumerate(AXES)}
         out.append({"t_start": t0, "t_end": t1, "peak": peak})
     return out
 
@@ -138,7 +123,7 @@ def saturated_fraction(traj: Trajectory, torque_max: Any = None) -> dict[str, An
     Uses the stage log's ``torque_clipped`` when present; otherwise compares the commands
     with ``torque_max`` (required then).
     """
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     if "torque_clipped" in traj.stage_log:
         clipped = np.asarray(traj.stage_log["torque_clipped"], dtype=bool)
     else:
@@ -152,7 +137,7 @@ def saturated_fraction(traj: Trajectory, torque_max: Any = None) -> dict[str, An
 
 def max_abs_momentum(traj: Trajectory, momentum_index: int = 6) -> list[float]:
     """``max_k |h_j(t_k)|`` per wheel (N m s)."""
-    h = _check_traj(traj).x[:, momentum_index:]
+    h = check_trajectory(traj).x[:, momentum_index:]
     if h.shape[1] == 0:
         raise InvalidArgumentError(
             "traj", "a run of the wheel satellite (wheel momenta in the state)", f"{traj.x.shape[1]} states"
@@ -167,7 +152,7 @@ def momentum_limit_events(traj: Trajectory) -> dict[str, Any]:
     ``{"t", "wheel"}``, wheels from 1) and ``fault_altered`` (samples in which an active
     fault's torque was changed by a limit: "fault output altered by momentum limit").
     """
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     if "momentum_limited" not in traj.stage_log:
         raise InvalidArgumentError(
             "traj",
@@ -189,7 +174,7 @@ def momentum_limit_events(traj: Trajectory) -> dict[str, Any]:
 
 def torque_summary(traj: Trajectory) -> dict[str, Any]:
     """Commanded vs applied torque: the largest of each (N m, overall and per wheel)."""
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     cmd, app = np.abs(traj.u_cmd), np.abs(traj.u_applied)
     return {
         "max_abs_u_cmd": float(cmd.max()),
@@ -214,7 +199,7 @@ def fault_metrics(
     (``[t_start, t_end, rank, wheels]``), ``max_abs_angle_deg`` (per axis, for the +-40 deg
     range of the platform) and ``status_counts``.
     """
-    traj = _check_traj(traj)
+    traj = check_trajectory(traj)
     if not isinstance(wheels, WheelArray):
         raise ArgumentTypeError("wheels", "a models.WheelArray", type(wheels).__name__)
     err = attitude_error(traj)
@@ -223,7 +208,7 @@ def fault_metrics(
     rank_windows = rank_deficient_windows(faults, wheels, t_end)
     torques = torque_summary(traj)
     out: dict[str, Any] = {
-        "final_abs_err": {ax: float(err[-1, a]) for a, ax in enumerate(_AXES)},
+        "final_abs_err": {ax: float(err[-1, a]) for a, ax in enumerate(AXES)},
         "max_abs_u": torques["max_abs_u"],
         "max_abs_u_cmd": torques["max_abs_u_cmd"],
         "recovery_time": recovery_times(traj, faults, threshold),
@@ -234,7 +219,7 @@ def fault_metrics(
         "sat_fraction": saturated_fraction(traj, wheels.torque_max),
         "max_abs_h": max_abs_momentum(traj),
         "rank_deficient_windows": [[w.t_start, w.t_end, w.rank, list(w.wheels)] for w in rank_windows],
-        "max_abs_angle_deg": {ax: float(np.degrees(err[:, a].max())) for a, ax in enumerate(_AXES)},
+        "max_abs_angle_deg": {ax: float(np.degrees(err[:, a].max())) for a, ax in enumerate(AXES)},
         "status_counts": traj.status_counts(),
     }
     if "momentum_limited" in traj.stage_log:
