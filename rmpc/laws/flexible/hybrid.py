@@ -28,7 +28,8 @@ class FlexibleHybrid:
         The attitude law, returning ``[u; v]``. A law whose ``accepts`` holds ``"pzt"``
         (:class:`~rmpc.MTSMC`, :class:`~rmpc.CSMC`, :class:`~rmpc.AttitudePD`,
         :class:`~rmpc.AdaptiveSMC`) gets this sample's PZT command through the step channel,
-        ``step(x, StepInputs(pzt=v))``, and cancels its reaction on the hub. Any other law
+        ``step(x, StepInputs(pzt=v))``, and cancels its reaction on the hub (PD passes it
+        through). Any other law
         (:func:`~rmpc.flexible_lqr`, or one without ``accepts``) is called with ``x`` alone and
         its PZT entries are replaced by ``v``.
     vibration : Controller, optional
