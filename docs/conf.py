@@ -17,6 +17,8 @@ from pathlib import Path
 # Document the checkout this file belongs to, also when an older copy is installed.
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+# The project's own directives (``status-table``: the status vocabulary's table).
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 # -- Project -------------------------------------------------------------------------
 project = "rmpc-satellite"
@@ -34,6 +36,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx.ext.doctest",
     "numpydoc",
+    "status_table",
 ]
 exclude_patterns = ["_build", "_generated", "examples", "figures", "Thumbs.db", ".DS_Store"]
 root_doc = "index"

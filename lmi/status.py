@@ -1,30 +1,51 @@
-"""One status vocabulary for every LMI back-end.
+"""The words of the one status vocabulary an LMI back-end reports, and its solvers' maps into it.
 
-``"optimal"`` means the solver converged **and** the certificate (every LMI recomputed in numpy
-from the returned ``Q``, ``Y``, ``gamma``) holds. Every other word is a failure the caller has to
-handle; none is ever raised as an exception by :meth:`lmi.KothareProblem.solve`.
+The words are members of :class:`toolkit_common.status.Status` (the vocabulary of the whole
+toolkit, which the QP back-ends and every controller use too); this module names the ones
+:meth:`lmi.KothareProblem.solve` can return. ``"optimal"`` means the solver converged **and**
+the certificate (every LMI recomputed in numpy from the returned ``Q``, ``Y``, ``gamma``) holds.
+Every other word is a failure the caller has to handle; none is ever raised as an exception.
+
+Examples
+--------
+>>> from lmi.status import CLARABEL_STATUS_MAP, OPTIMAL, STATUSES
+>>> OPTIMAL == "optimal", CLARABEL_STATUS_MAP["AlmostSolved"], STATUSES[0]
+(True, 'inaccurate', 'optimal')
 """
 
 from __future__ import annotations
 
+from toolkit_common.status import Status
+
 __all__ = [
+    "CLARABEL_STATUS_MAP",
+    "CVXPY_STATUS_MAP",
     "FAILURE_STATUSES",
+    "INACCURATE",
+    "INFEASIBLE",
+    "MAX_ITERATIONS",
+    "NUMERICAL_ERROR",
     "OPTIMAL",
+    "SOLVER_ERROR",
     "STATUSES",
+    "TIME_LIMIT",
+    "UNBOUNDED",
+    "UNCERTIFIED",
 ]
 
-OPTIMAL = "optimal"
+OPTIMAL = Status.OPTIMAL
 #: Converged, but a recomputed LMI margin is below the certificate tolerance.
-UNCERTIFIED = "uncertified"
-INFEASIBLE = "infeasible"
-UNBOUNDED = "unbounded"
-INACCURATE = "inaccurate"
-MAX_ITERATIONS = "max_iterations"
-TIME_LIMIT = "time_limit"
-NUMERICAL_ERROR = "numerical_error"
-SOLVER_ERROR = "solver_error"
+UNCERTIFIED = Status.UNCERTIFIED
+INFEASIBLE = Status.INFEASIBLE
+UNBOUNDED = Status.UNBOUNDED
+INACCURATE = Status.INACCURATE
+MAX_ITERATIONS = Status.MAX_ITERATIONS
+TIME_LIMIT = Status.TIME_LIMIT
+NUMERICAL_ERROR = Status.NUMERICAL_ERROR
+SOLVER_ERROR = Status.SOLVER_ERROR
 
-STATUSES: tuple[str, ...] = (
+#: Every word an LMI solve can end with, ``"optimal"`` first.
+STATUSES: tuple[Status, ...] = (
     OPTIMAL,
     UNCERTIFIED,
     INFEASIBLE,
@@ -35,10 +56,11 @@ STATUSES: tuple[str, ...] = (
     NUMERICAL_ERROR,
     SOLVER_ERROR,
 )
-FAILURE_STATUSES: frozenset[str] = frozenset(STATUSES) - {OPTIMAL}
+#: Every word of :data:`STATUSES` except ``"optimal"``.
+FAILURE_STATUSES: frozenset[Status] = frozenset(STATUSES) - {OPTIMAL}
 
 #: Clarabel's ``SolverStatus`` names mapped to the vocabulary.
-CLARABEL_STATUS_MAP: dict[str, str] = {
+CLARABEL_STATUS_MAP: dict[str, Status] = {
     "Solved": OPTIMAL,
     "AlmostSolved": INACCURATE,
     "PrimalInfeasible": INFEASIBLE,
@@ -54,7 +76,7 @@ CLARABEL_STATUS_MAP: dict[str, str] = {
 }
 
 #: cvxpy's status strings mapped to the vocabulary.
-CVXPY_STATUS_MAP: dict[str, str] = {
+CVXPY_STATUS_MAP: dict[str, Status] = {
     "optimal": OPTIMAL,
     "optimal_inaccurate": INACCURATE,
     "infeasible": INFEASIBLE,

@@ -1,9 +1,12 @@
 """Controllers and the closed loop: robust MPC, baselines and the simulator.
 
-Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`).
+Every controller follows the ``step(x)`` protocol (:class:`rmpc.controller.Controller`): ``reset()``,
+``step(x, inputs=None) -> u``, ``last`` (a :class:`StepInfo` whose ``status`` is a word of the one
+status vocabulary, :class:`Status`), ``name`` and ``accepts`` (the :class:`StepInputs` fields it
+uses).
 """
 
-from rmpc.controller import Controller, StepInfo
+from rmpc.controller import Controller, Status, StepInfo, StepInputs
 from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
 from rmpc.laws.flexible.attitude_pd import AttitudePD
 from rmpc.laws.flexible.csmc import CSMC
@@ -49,8 +52,10 @@ __all__ = [
     "RobustAVC",
     "ScheduledRMPC",
     "SineDisturbance",
+    "Status",
     "StepDisturbance",
     "StepInfo",
+    "StepInputs",
     "Trajectory",
     "TuningFunctionAB",
     "flexible_lqr",

@@ -116,8 +116,27 @@ class Controller(Protocol):
 
     A controller is built once, ``reset()`` before a run, and called once per sample with the
     measured state; it returns the control to apply now. After each call ``last`` describes
-    that step (see :class:`StepInfo`); ``name`` is its short name in reports (``"RMPC"``,
-    ``"MAB"``, ``"CSMC+AVC"``). ``accepts`` names the :class:`StepInputs` fields it uses.
+    that step (see :class:`StepInfo`; its status is a word of the one vocabulary,
+    :class:`~toolkit_common.status.Status`); ``name`` is its short name in reports
+    (``"RMPC"``, ``"MAB"``, ``"CSMC+AVC"``). ``accepts`` names the :class:`StepInputs` fields
+    it uses (a class attribute; a wrapper such as :class:`~rmpc.MappedController` takes its
+    inner controller's); ``step`` checks ``inputs`` with :func:`check_step_inputs`, so a field
+    outside ``accepts`` is an error naming it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import RigidSatellite
+    >>> from rmpc import LQR, Controller, StepInputs
+    >>> sat = RigidSatellite.paper_p()
+    >>> lqr = LQR(sat.linear_model(sat.initial_state(), 0.01), Q=np.eye(6), R=np.eye(3))
+    >>> isinstance(lqr, Controller), lqr.name, lqr.accepts
+    (True, 'LQR', frozenset())
+    >>> try:
+    ...     lqr.step(sat.initial_state(), StepInputs(pzt=[0.1]))
+    ... except ValueError as err:
+    ...     print(err)
+    inputs.pzt: expected only the step inputs LQR uses (none), but found pzt set to a value
     """
 
     name: str

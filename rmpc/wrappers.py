@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from rmpc.controller import StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 __all__ = ["MappedController"]
@@ -24,20 +25,24 @@ class MappedController:
 
     Parameters
     ----------
-    controller : object with ``step`` and ``reset``
-        The inner controller.
+    controller : Controller
+        The inner controller (at least ``step``; ``reset``, ``last``, ``name`` and ``accepts``
+        are used when it has them).
     measure : sequence of int or callable
         Indices of the states the inner controller sees (``x[indices]``), or a function
         ``measure(x) -> z``. An object with a ``reset()`` method is reset with the controller.
     output : callable, optional
         ``output(u) -> u_plant`` applied to the inner controller's output (default: none).
     name : str, optional
-        Short name for reports (default: the inner controller's class name).
+        Short name for reports (default: the inner controller's ``name``, else its class name).
 
     Attributes
     ----------
     last : object
         The inner controller's ``last`` (its :class:`~rmpc.StepInfo`).
+    accepts : frozenset of str
+        The inner controller's ``accepts`` (none when it has none): the step inputs are passed
+        on unchanged.
 
     Examples
     --------
@@ -83,7 +88,8 @@ class MappedController:
         self._output = output
         self.controller = controller
         self.measure = measure
-        self.name = name or type(controller).__name__
+        self.name = name or getattr(controller, "name", None) or type(controller).__name__
+        self.accepts: frozenset[str] = frozenset(getattr(controller, "accepts", frozenset()))
 
     def _select(self, x: np.ndarray) -> np.ndarray:
         assert self.indices is not None
@@ -105,10 +111,15 @@ class MappedController:
         if callable(getattr(self.measure, "reset", None)):
             self.measure.reset()
 
-    def step(self, x: Any) -> np.ndarray:
-        """``output(controller.step(measure(x)))``."""
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+        """``output(controller.step(measure(x), inputs))`` (``inputs`` only when given)."""
+        if inputs is not None:
+            check_step_inputs(inputs, self.accepts, self.name)
         z = self._measure(np.asarray(x, dtype=float))
-        u = np.asarray(self.controller.step(z), dtype=float)
+        if inputs is None:
+            u = np.asarray(self.controller.step(z), dtype=float)
+        else:
+            u = np.asarray(self.controller.step(z, inputs), dtype=float)
         return u if self._output is None else np.asarray(self._output(u), dtype=float)
 
     def __repr__(self) -> str:

@@ -118,4 +118,4 @@ def test_quickstart_regulates_the_attitude(run_example: Any) -> None:
     assert namespace["plant"].n_vertices == 2
     assert traj.plant == "nonlinear"
     assert np.all(np.abs(traj.attitude_deg[-1]) < 0.1)
-    assert traj.status_counts() == {"optimal": traj.n_steps}
+    assert traj.status_counts() == {"ok": traj.n_steps}  # LQR: a fixed gain, nothing solved

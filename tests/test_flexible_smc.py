@@ -26,7 +26,7 @@ from benchmarks.families.flexible.metrics import flexible_metrics
 from models import FlexibleSatellite
 from models.attitude.quaternion import quat_from_axis_angle, rotation_angle
 from models.flexible.scenario import PaperVDisturbance, paper_v_scenario, steady_error_scenario
-from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, simulate
+from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, StepInputs, simulate
 from rmpc.sim.disturbances import ConstantDisturbance
 from rmpc.sim.plants import NonlinearPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
@@ -297,7 +297,7 @@ def test_non_square_pzt_matrix_warns_and_uses_the_pseudo_inverse(sat):
         (lambda s: CSMC(s, switch="sat"), "switch"),
         (lambda s: CSMC(s, lam=-0.1), "lam"),
         (lambda s: RobustAVC(s, K_v=[1.0, 2.0]), "K_v"),
-        (lambda s: RobustAVC(s.with_modes(0)), "satellite"),
+        (lambda s: RobustAVC(s.with_modes(0)), "plant"),
     ],
 )
 def test_bad_arguments_name_the_argument(sat, make, name):
@@ -306,11 +306,11 @@ def test_bad_arguments_name_the_argument(sat, make, name):
 
 
 def test_wrong_types_and_state_sizes(sat):
-    with pytest.raises(ArgumentTypeError, match="satellite"):
+    with pytest.raises(ArgumentTypeError, match=r"^plant:"):
         MTSMC("satellite")
     with pytest.raises(ArgumentTypeError, match="attitude"):
         FlexibleHybrid(None)
     with pytest.raises(InvalidArgumentError, match="x"):
         CSMC(sat).step(np.zeros(14))
     with pytest.raises(InvalidArgumentError, match="pzt"):
-        CSMC(sat).step(sat.state(), pzt=[1.0, 2.0])
+        CSMC(sat).step(sat.state(), StepInputs(pzt=[1.0, 2.0]))

@@ -219,8 +219,8 @@ def test_solver_failure_holds_the_previous_input(
         ({"x_ref": np.zeros(5)}, "x_ref"),
         ({"u0": [2.0, 0.0, 0.0]}, "u0"),                          # outside u_max
         ({"backend": "gurobi"}, "name"),
-        ({"backend_settings": {"eps": 1.0}}, "settings 'eps'"),
-        ({"backend": ProxQPBackend(), "backend_settings": {"eps_abs": 1e-6}}, "backend_settings"),
+        ({"solver_options": {"eps": 1.0}}, "settings 'eps'"),
+        ({"backend": ProxQPBackend(), "solver_options": {"eps_abs": 1e-6}}, "solver_options"),
     ],
 )
 def test_bad_arguments_name_themselves(lin: PolytopicModel, kwargs: dict, argument: str) -> None:
@@ -241,7 +241,7 @@ def test_bad_types_and_states(lin: PolytopicModel) -> None:
         ctrl.step([0.0, 0.0, np.nan, 0.0, 0.0, 0.0])
 
 
-def test_backend_settings_reach_the_backend(lin: PolytopicModel) -> None:
-    ctrl = GIPC(lin, backend="osqp", backend_settings={"eps_abs": 1e-7})
+def test_solver_options_reach_the_backend(lin: PolytopicModel) -> None:
+    ctrl = GIPC(lin, backend="osqp", solver_options={"eps_abs": 1e-7})
     assert ctrl.backend.name == "osqp" and ctrl.backend.settings.eps_abs == 1e-7
     assert isinstance(ctrl.backend, QPBackend)

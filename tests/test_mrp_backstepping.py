@@ -235,7 +235,7 @@ def test_estimators_are_pluggable(m2) -> None:
 
 def test_bad_input_names_the_argument() -> None:
     sat = MRPSatellite.paper_m()
-    with pytest.raises(ArgumentTypeError, match="model"):
+    with pytest.raises(ArgumentTypeError, match=r"^plant:"):
         CFBackstepping(np.eye(3))
     for cls in CONTROLLERS.values():
         with pytest.raises(InvalidArgumentError, match="c1"):

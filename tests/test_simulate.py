@@ -79,7 +79,7 @@ def test_lqr_on_a_vertex_and_with_a_reference(sat, x0):
     ref_ctrl = LQR(poly, Q=Q, R=R, x_ref=x_ref)
     x = np.array([0.2, 0.1, 0.0, 0.01, 0.0, 0.0])
     np.testing.assert_allclose(ref_ctrl.step(x), ref_ctrl.F @ (x - x_ref), rtol=1e-15)
-    assert isinstance(ref_ctrl.last, StepInfo) and ref_ctrl.last.status == "optimal"
+    assert isinstance(ref_ctrl.last, StepInfo) and ref_ctrl.last.status == "ok"
     ref_ctrl.reset()
     assert ref_ctrl.last is None
 
@@ -134,7 +134,7 @@ def test_trajectory_shapes_statuses_and_progress(sat, x0, lqr, tmp_path):
     assert len(traj.status) == len(traj.info) == n
     np.testing.assert_allclose(traj.t, DT * np.arange(n + 1), rtol=0, atol=1e-12)
     np.testing.assert_array_equal(traj.x[0], x0)
-    assert traj.status == ["optimal"] * n and traj.status_counts() == {"optimal": n}
+    assert traj.status == ["ok"] * n and traj.status_counts() == {"ok": n}
     assert all(isinstance(i, StepInfo) for i in traj.info)
     assert np.all(np.isnan(traj.gamma))  # LQR has no cost bound
     assert np.all(traj.solve_time >= 0) and np.all(traj.step_time >= 0)

@@ -5,16 +5,19 @@ cvxpy's strings, OSQP's and ProxQP's codes), and every controller reports one wo
 ``last.status`` (:class:`rmpc.StepInfo`). A :class:`Status` is a ``str``: it compares equal to
 its word (``Status.OPTIMAL == "optimal"``) and is written to JSON records as the word.
 
-:data:`STATUS_TABLE` says what each word means and whether the answer that comes with it may be
-applied (:func:`is_usable`); the documentation's status table is generated from it.
+:data:`STATUS_TABLE` says what each word means, whether the answer that comes with it may be
+applied (:func:`is_usable`) and what the controllers do with it (:func:`describe`); the
+documentation's status table is generated from it.
 
 Examples
 --------
->>> from toolkit_common.status import Status, is_usable
+>>> from toolkit_common.status import Status, describe, is_usable
 >>> Status("optimal") is Status.OPTIMAL, Status.OPTIMAL == "optimal"
 (True, True)
 >>> is_usable("reused"), is_usable("infeasible")
 (True, False)
+>>> describe("outside").source, Status.OUTSIDE      # the repr is the word
+('controller', 'outside')
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ __all__ = [
     "Status",
     "StatusInfo",
     "as_status",
+    "describe",
     "is_usable",
 ]
 
@@ -68,7 +72,7 @@ class Status(StrEnum):
 
 @dataclass(frozen=True)
 class StatusInfo:
-    """What a status word means.
+    """What a status word means and what a controller does with it.
 
     Attributes
     ----------
@@ -80,55 +84,84 @@ class StatusInfo:
         Who reports it: ``"solver"`` (an LMI or QP back-end, and the controller that passes its
         word on), or ``"controller"`` (a controller's own step).
     meaning : str
-        One sentence.
+        What happened, in one or two sentences.
+    action : str
+        What the controllers of :mod:`rmpc` do when they get or report it.
     """
 
     status: Status
     usable: bool
     source: str
     meaning: str
+    action: str
 
+
+_SOLVER_FAILURE = (
+    "Robust MPC keeps its last certified gain (zero before the first; ``on_failure=\"raise\"`` "
+    "raises instead), GIPC holds the previous input; both flag the step as a fallback."
+)
 
 #: Every word with its meaning, in the order the documentation's table lists them.
 STATUS_TABLE: tuple[StatusInfo, ...] = (
     StatusInfo(Status.OPTIMAL, True, "solver",
                "The solver converged to its tolerances; for an LMI problem its certificate (every "
-               "LMI recomputed in numpy) holds too."),
+               "LMI recomputed in numpy) holds too. Off-line robust MPC reports it for a state "
+               "inside its table of certified ellipsoids.",
+               "Applies the answer: robust MPC the gain ``F = Y Q^-1``, GIPC the first input "
+               "increment, off-line robust MPC the (interpolated) gain of the ellipsoid."),
     StatusInfo(Status.INACCURATE, True, "solver",
-               "The solver met only reduced tolerances. An LMI answer is applied only when its "
-               "certificate holds; a QP answer is applied, flagged."),
+               "The solver met only reduced tolerances. An LMI answer comes with its certificate; "
+               "a QP answer with its ``x``, flagged.",
+               "Robust MPC applies the gain when its certificate holds (a fallback otherwise); "
+               "GIPC holds the previous input."),
     StatusInfo(Status.UNCERTIFIED, False, "solver",
                "The LMI solver converged, but a recomputed LMI margin is below the certificate's "
-               "tolerance: the answer is not applied."),
+               "tolerance (or ``F`` could not be formed).",
+               _SOLVER_FAILURE),
     StatusInfo(Status.INFEASIBLE, False, "solver",
                "The problem has no solution (for the toolkit's LMI solver: proved by a checked "
-               "Farkas certificate)."),
-    StatusInfo(Status.UNBOUNDED, False, "solver", "The objective is unbounded below."),
-    StatusInfo(Status.MAX_ITERATIONS, False, "solver", "The iteration limit was reached first."),
-    StatusInfo(Status.TIME_LIMIT, False, "solver", "The time limit was reached first."),
+               "Farkas certificate), e.g. an input bound too tight for the state.",
+               _SOLVER_FAILURE + " Off-line robust MPC reports the design's failure word when no "
+               "ellipsoid could be designed, and applies zero."),
+    StatusInfo(Status.UNBOUNDED, False, "solver",
+               "The objective is unbounded below (dual infeasible).", _SOLVER_FAILURE),
+    StatusInfo(Status.MAX_ITERATIONS, False, "solver", "The iteration limit was reached first.",
+               _SOLVER_FAILURE),
+    StatusInfo(Status.TIME_LIMIT, False, "solver", "The time limit was reached first.", _SOLVER_FAILURE),
     StatusInfo(Status.NUMERICAL_ERROR, False, "solver",
-               "The solver stopped on a numerical difficulty (a failed factorisation, no progress)."),
-    StatusInfo(Status.SOLVER_ERROR, False, "solver", "The solver failed in another way or raised."),
-    StatusInfo(Status.INTERRUPTED, False, "solver", "The QP solver was interrupted (a signal, a callback)."),
-    StatusInfo(Status.NOT_SOLVED, False, "solver", "The QP solver returned without solving."),
+               "The solver stopped on a numerical difficulty (a failed factorisation, no progress, "
+               "a non-finite answer).", _SOLVER_FAILURE),
+    StatusInfo(Status.SOLVER_ERROR, False, "solver",
+               "The LMI solver failed in another way: it raised, or returned a status outside the "
+               "vocabulary.", _SOLVER_FAILURE),
+    StatusInfo(Status.INTERRUPTED, False, "solver",
+               "The QP solver was interrupted (a signal, a callback).", _SOLVER_FAILURE),
+    StatusInfo(Status.NOT_SOLVED, False, "solver", "The QP solver returned without solving.",
+               _SOLVER_FAILURE),
     StatusInfo(Status.REUSED, True, "controller",
                "No solve at this step: the controller kept a gain certified earlier (near the "
-               "origin, or inside the invariant ellipsoid of that gain)."),
+               "origin, or inside the invariant ellipsoid of that gain).",
+               "Applies the kept gain; its guarantees hold inside its ellipsoid."),
     StatusInfo(Status.OK, True, "controller",
-               "A control law evaluated in closed form (a fixed gain, a sliding-mode or "
-               "backstepping law): there is nothing to converge."),
+               "A control law evaluated in closed form (a fixed gain such as LQR, a sliding-mode "
+               "or backstepping law): there is nothing to converge.",
+               "Applies the law's output."),
     StatusInfo(Status.OUTSIDE, False, "controller",
-               "Off-line robust MPC: the state lies outside the largest precomputed ellipsoid; "
-               "the outermost gain is applied as a fallback."),
+               "Off-line robust MPC: the state lies outside the largest precomputed ellipsoid.",
+               "Applies the outermost gain ``F_1`` without a guarantee, flagged as a fallback."),
     StatusInfo(Status.BOUND_VIOLATION, False, "controller",
-               "GIPC: the QP answer violates the input bounds by more than the tolerance; the "
-               "previous input is held as a fallback."),
+               "GIPC: the QP answer violates the input bounds by more than the tolerance.",
+               "Holds the previous input (``du = 0``), flagged as a fallback."),
     StatusInfo(Status.SINGULAR, False, "controller",
                "A law met the singularity of its attitude coordinates (Euler pitch near "
-               "+-90 deg): zero command, adaptation frozen."),
+               "+-90 deg).",
+               "Zero command; the adaptation is frozen."),
     StatusInfo(Status.DIVERGED, False, "controller",
-               "A law's adaptive states are no longer finite or exceed their bound: zero command."),
-    StatusInfo(Status.UNKNOWN, False, "controller", "The controller reported nothing for this step."),
+               "A law's adaptive states are no longer finite or exceed their bound.",
+               "Zero command from then on."),
+    StatusInfo(Status.UNKNOWN, False, "controller",
+               "The controller reported nothing for this step (no ``last``).",
+               "Whatever it returned is applied; the simulator records the word."),
 )
 
 _INFO: dict[Status, StatusInfo] = {row.status: row for row in STATUS_TABLE}

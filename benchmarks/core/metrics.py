@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import ArgumentTypeError
+from toolkit_common.status import USABLE_STATUSES, Status
 
 __all__ = [
     "AXES",
@@ -57,9 +58,12 @@ __all__ = [
 AXES: tuple[str, str, str] = ("roll", "pitch", "yaw")
 #: Largest number of (t, gamma) points kept in ``metrics["gamma"]`` (evenly thinned).
 GAMMA_POINTS = 200
-#: Step statuses that are not failures: solved, solved less accurately, a kept gain, or a
-#: control law without an optimiser that computed its output (``"ok"``).
-FAILURE_FREE_STATUSES: frozenset[str] = frozenset({"optimal", "inaccurate", "reused", "ok"})
+#: Step statuses that are not failures: the usable words of the status vocabulary
+#: (:data:`toolkit_common.status.USABLE_STATUSES`): solved, solved less accurately, a kept gain,
+#: or a control law without an optimiser that computed its output (``"ok"``).
+FAILURE_FREE_STATUSES: frozenset[Status] = USABLE_STATUSES
+#: Step statuses of a step that solved nothing: a kept gain or a law evaluated in closed form.
+_NO_SOLVE: tuple[Status, ...] = (Status.OK, Status.REUSED)
 
 
 def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
@@ -240,8 +244,8 @@ def step_timing(traj: Any) -> dict[str, Any]:
     """
     step = np.asarray(traj.step_time, dtype=float)
     solve = np.asarray(traj.solve_time, dtype=float)
-    statuses = [getattr(info, "status", "ok") if info is not None else "ok" for info in traj.info]
-    solved = np.array([s for s, st in zip(solve, statuses, strict=False) if st not in ("ok", "reused")])
+    statuses = [getattr(info, "status", Status.OK) if info is not None else Status.OK for info in traj.info]
+    solved = np.array([s for s, st in zip(solve, statuses, strict=False) if st not in _NO_SOLVE])
     return {
         "step_time_p50": float(np.percentile(step, 50)),
         "step_time_p95": float(np.percentile(step, 95)),
@@ -311,7 +315,7 @@ def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, An
     u_cmd = np.abs(np.asarray(traj.u_cmd, dtype=float))
     status = list(traj.status)
     solve = np.asarray(traj.solve_time, dtype=float)
-    solved = np.array([s != "reused" for s in status], dtype=bool)
+    solved = np.array([s != Status.REUSED for s in status], dtype=bool)
     excess = np.max(u_app, axis=1) - u_max if u_app.size else np.zeros(0)
     gamma_all = np.asarray(traj.gamma, dtype=float)
     solved_at = np.flatnonzero(np.isfinite(gamma_all))

@@ -3,11 +3,15 @@
 import numpy as np
 
 from models import PAPER_P_TORQUE_LIMIT, ReactionWheelActuator, RigidSatellite, TorqueLimiter
-from rmpc import StepDisturbance, StepInfo, simulate
+from rmpc import Controller, Status, StepDisturbance, StepInfo, StepInputs, simulate
+from rmpc.controller import check_step_inputs
 
 
 class AttitudePD:
     """u = -kp * attitude - kd * rates, the same gains on every axis."""
+
+    name = "PD"                 # the short name in reports
+    accepts = frozenset()       # the StepInputs fields it uses: none
 
     def __init__(self, kp: float, kd: float) -> None:
         self.kp, self.kd = kp, kd
@@ -16,10 +20,14 @@ class AttitudePD:
     def reset(self) -> None:
         self.last = None
 
-    def step(self, x: np.ndarray) -> np.ndarray:
+    def step(self, x: np.ndarray, inputs: StepInputs | None = None) -> np.ndarray:
+        check_step_inputs(inputs, self.accepts, self.name)  # a field it does not use is an error
         u = -self.kp * x[:3] - self.kd * x[3:]
-        self.last = StepInfo(status="optimal", solve_time=0.0, extra={"u_unclipped": u})
+        self.last = StepInfo(status=Status.OK, solve_time=0.0, extra={"u_unclipped": u})  # closed form
         return u
+
+
+assert isinstance(AttitudePD(2.0, 3.0), Controller)
 
 
 sat = RigidSatellite.paper_p()

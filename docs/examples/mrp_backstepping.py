@@ -19,8 +19,8 @@ for ctrl in (
     phi = np.degrees([mrp_error_angle(x[:3], m2.sigma_ref) for x in traj.x])
     steady = phi[traj.t >= m2.steady_window[0]].max()
     peak = np.abs(traj.u_applied).max()
-    line = f"{ctrl.short_name:4s}  max error {steady:.4f} deg  peak torque {peak:.2f} N m"
-    if ctrl.short_name != "BS":
+    line = f"{ctrl.name:4s}  max error {steady:.4f} deg  peak torque {peak:.2f} N m"
+    if ctrl.name != "BS":
         estimate = np.array([info.extra["torque_estimate"] for info in traj.info])
         late = traj.t[:-1] >= 20.0
         line += f"  |Tdhat - Td| {np.abs(estimate[late] - traj.d[late]).max():.1e} N m"

@@ -19,11 +19,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.sim.plants import disturbance_at
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_pd, check_positive
@@ -92,9 +92,17 @@ class ContinuousTimeController:
         internal dynamics the clipped value.
     n_states : int
         Size of the measured state.
+
+    Attributes
+    ----------
+    name : str
+        The short name in reports (each law sets its own: ``"BS"``, ``"MAB"``, ``"TFAB"``).
+    accepts : frozenset of str
+        The :class:`~rmpc.StepInputs` fields :meth:`step` uses (none).
     """
 
-    short_name = "controller"
+    name = "controller"
+    accepts: ClassVar[frozenset[str]] = frozenset()
     n_internal = 0
 
     def __init__(self, dt: float, u_max: Any, n_states: int = 6) -> None:
@@ -126,7 +134,7 @@ class ContinuousTimeController:
 
     def settings(self) -> dict[str, Any]:
         """Every parameter of the controller, for reports."""
-        return {"controller": self.short_name, "dt": self.dt,
+        return {"controller": self.name, "dt": self.dt,
                 "u_max": None if self.u_max is None else self.u_max.tolist()}
 
     # -- pure continuous-time functions --------------------------------------------------------
@@ -187,7 +195,7 @@ class ContinuousTimeController:
         self._z = None
         self.last = None
 
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``u_k`` for the measured ``x_k``, then advance the internal state by ``dt``.
 
         The advance is one classical RK4 step of :meth:`internal_derivative` with ``x_k`` and
@@ -197,6 +205,7 @@ class ContinuousTimeController:
         ``"saturated"``: whether the clip acted).
         """
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         x = as_vector(x, "x", self.n_states)
         if self._z is None:
             self._z = self.initial_internal(x)
@@ -211,5 +220,5 @@ class ContinuousTimeController:
         self._z = self.project_internal(z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4))
         extra = dict(out.extra)
         extra["saturated"] = bool(np.any(out.u != out.u_unclipped))
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
         return u.copy()

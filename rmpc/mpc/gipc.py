@@ -39,12 +39,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import PolytopicModel
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.qp import QP, QPBackend, make_backend
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_pd, check_psd, check_real
@@ -154,12 +154,22 @@ class GIPC:
         else all states.
     backend : {"proxqp", "osqp", "clarabel", "cvxpy"} or QPBackend
         The QP back-end (default ``"proxqp"``: dense, warm-started, duality gap checked).
-    backend_settings : mapping, optional
-        Settings passed to :func:`rmpc.qp.make_backend` (unknown names raise).
+    solver_options : mapping, optional
+        The back-end's settings, passed to :func:`rmpc.qp.make_backend` (unknown names
+        raise; ``None`` with a ``QPBackend`` instance, which carries its own).
     x_ref : (n,) array_like, optional
         Reference state; the output reference is ``C x_ref`` (default the origin).
     u0 : (m,) array_like, optional
         The input assumed applied before the first step (default zero).
+
+    Attributes
+    ----------
+    name : str
+        ``"GIPC"``, the short name in reports.
+    last : StepInfo or None
+        The last step: the back-end's status (or ``"bound_violation"``), ``solve_time``,
+        ``iterations``, ``fallback`` and ``extra`` (``du``, ``objective``, ``backend``,
+        ``raw_status``, ``step_time``).
 
     Notes
     -----
@@ -198,6 +208,9 @@ class GIPC:
     (True, 'optimal')
     """
 
+    name = "GIPC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
+
     def __init__(
         self,
         plant: PolytopicModel,
@@ -209,7 +222,7 @@ class GIPC:
         du_max: Any = 0.01,
         C: Any = None,
         backend: str | QPBackend = "proxqp",
-        backend_settings: Mapping[str, Any] | None = None,
+        solver_options: Mapping[str, Any] | None = None,
         x_ref: Any = None,
         u0: Any = None,
     ) -> None:
@@ -232,19 +245,19 @@ class GIPC:
         self.u0 = np.zeros(m) if u0 is None else as_vector(u0, "u0", m)
         if self.u_max is not None and np.any(np.abs(self.u0) > self.u_max):
             raise InvalidArgumentError("u0", f"|u0| <= u_max = {self.u_max.tolist()}", f"{self.u0.tolist()}")
-        if backend_settings is not None and not isinstance(backend_settings, Mapping):
+        if solver_options is not None and not isinstance(solver_options, Mapping):
             raise ArgumentTypeError(
-                "backend_settings", "a mapping of setting names", type(backend_settings).__name__
+                "solver_options", "a mapping of setting names", type(solver_options).__name__
             )
         if isinstance(backend, QPBackend):
-            if backend_settings:
+            if solver_options:
                 raise InvalidArgumentError(
-                    "backend_settings", "None when backend is a QPBackend instance",
-                    repr(dict(backend_settings)),
+                    "solver_options", "None when backend is a QPBackend instance",
+                    repr(dict(solver_options)),
                 )
             self.backend = backend
         elif isinstance(backend, str):
-            self.backend = make_backend(backend, **dict(backend_settings or {}))
+            self.backend = make_backend(backend, **dict(solver_options or {}))
         else:
             raise ArgumentTypeError(
                 "backend", "a back-end name or a rmpc.qp.QPBackend", type(backend).__name__
@@ -321,9 +334,10 @@ class GIPC:
         """The input applied at the previous step (``u0`` after :meth:`reset`)."""
         return self._u_prev.copy()
 
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``u(k) = u(k-1) + du(k)`` for the measured state ``x``."""
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         x = as_vector(x, "x", self._n)
         vec = self._vectors(self.augmented_state(x, self._x_prev), self._u_prev)
         if not self._setup_done:
@@ -334,14 +348,14 @@ class GIPC:
         res = self.backend.solve()
         status, fallback = res.status, False
         du = np.zeros(self._m)
-        if res.status == "optimal":
+        if res.status == Status.OPTIMAL:
             # du(k)'s box already holds both bounds: |du| <= du_max and |u(k-1) + du| <= u_max
             lo, hi = vec["lb"][: self._m], vec["ub"][: self._m]
             cand = res.x[: self._m]
             if ((cand >= lo - self._slack) & (cand <= hi + self._slack)).all():
                 du = np.minimum(np.maximum(cand, lo), hi)
             else:
-                status, fallback = "bound_violation", True
+                status, fallback = Status.BOUND_VIOLATION, True
         else:
             fallback = True
         u = self._u_prev + du

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import control
 import numpy as np
 
 from models import PolytopicModel
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_pd, check_psd
 
@@ -32,6 +32,14 @@ class LQR:
     x_ref : (n,) array_like, optional
         Reference state (default: the origin).
 
+    Attributes
+    ----------
+    name : str
+        ``"LQR"``, the short name in reports.
+    last : StepInfo or None
+        The last step: status ``"ok"`` (a fixed gain, nothing solved), ``solve_time`` the
+        step's wall time.
+
     Examples
     --------
     >>> import numpy as np
@@ -41,7 +49,13 @@ class LQR:
     >>> lqr = LQR(sat.linear_model(sat.initial_state(), 0.01), Q=np.eye(6), R=np.eye(3))
     >>> lqr.F.shape
     (3, 6)
+    >>> u = lqr.step(sat.initial_state())
+    >>> lqr.last.status
+    'ok'
     """
+
+    name = "LQR"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,
@@ -83,10 +97,11 @@ class LQR:
         """Nothing to forget but the last step's info."""
         self.last = None
 
-    def step(self, x: Any) -> np.ndarray:
-        """Return ``F (x - x_ref)``."""
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+        """Return ``F (x - x_ref)``; ``last.status`` is ``"ok"`` (a fixed gain: nothing is solved)."""
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         x = as_vector(x, "x", self._n)
         u = self.F @ (x - self.x_ref)
-        self.last = StepInfo(status="optimal", solve_time=time.perf_counter() - start)
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start)
         return u

@@ -14,13 +14,13 @@ controller finds the smallest ``E_i`` that contains ``x`` and applies ``u = F x`
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 
 from lmi.status import INFEASIBLE, OPTIMAL
 from models import PolytopicModel
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
 
@@ -30,7 +30,7 @@ if TYPE_CHECKING:  # lmi.offline imports cvxpy (~0.5 s); it is imported when a c
 __all__ = ["OUTSIDE", "OfflineRMPC"]
 
 #: Status of a step whose state lies outside the largest ellipsoid (``F_1`` applied, no guarantee).
-OUTSIDE = "outside"
+OUTSIDE = Status.OUTSIDE
 #: A state with ``x' Q_i^-1 x <= 1 + LEVEL_TOL`` counts as inside ``E_i``. Each design state lies on
 #: the boundary of its own ellipsoid (the LMI ``[[1, x'], [x, Q]] >= 0`` is tight at the optimum),
 #: and the solver's accuracy (1e-8) puts it at levels up to ``1 + 9e-8`` (measured on paper P's
@@ -75,6 +75,8 @@ class OfflineRMPC:
 
     Attributes
     ----------
+    name : str
+        ``"OfflineRMPC"``, the short name in reports.
     table : OfflineTable or None
         The designed sequence (certified entries only).
     last : StepInfo or None
@@ -100,6 +102,9 @@ class OfflineRMPC:
     >>> ctrl.last.status, ctrl.last.extra["index"], bool(np.linalg.norm(u) <= 1.0)
     ('optimal', 0, True)
     """
+
+    name = "OfflineRMPC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,
@@ -226,9 +231,10 @@ class OfflineRMPC:
         self._fresh = True
 
     # -- on-line -----------------------------------------------------------------------------
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Look up the gain for ``x`` and return ``u = F x``."""
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         z = np.asarray(x, dtype=float) if not isinstance(x, str) else None
         if z is None or z.shape != (self._n,) or not np.isfinite(z).all():
             z = as_vector(x, "x", self._n)  # raises naming the argument, or accepts a column

@@ -6,7 +6,7 @@ applies ``u = F x`` with ``F = Y Q^-1`` (sign convention ``u = +F x``).
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -62,6 +62,8 @@ class RMPC:
 
     Attributes
     ----------
+    name : str
+        ``"RMPC"``, the short name in reports.
     last : StepInfo or None
         The last step: ``status``, ``solve_time``, ``gamma``, ``iterations``, ``fallback``, and
         ``extra["solution"]`` (the :class:`lmi.LMISolution`, ``None`` if no solve was made).
@@ -79,6 +81,9 @@ class RMPC:
     >>> sol.status, bool(np.linalg.norm(sol.F @ x0) <= 1.0 + 1e-6)
     ('optimal', True)
     """
+
+    name = "RMPC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,

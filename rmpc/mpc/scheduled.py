@@ -19,14 +19,14 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from lmi import KothareProblem, LMISolution
 from lmi.status import INACCURATE, OPTIMAL
 from models import PolytopicModel, RigidSatellite
-from rmpc.controller import StepInfo
+from rmpc.controller import StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
 from toolkit_common.validation import as_vector, check_choice, check_positive
 
@@ -55,6 +55,8 @@ class ScheduledRMPC:
 
     Attributes
     ----------
+    name : str
+        ``"ScheduledRMPC"``, the short name in reports.
     last : StepInfo or None
         As for :class:`~rmpc.RMPC`; ``extra["build_time"]`` is the time spent building the
         polytope and the problem (s), which ``solve_time`` does not include.
@@ -71,6 +73,9 @@ class ScheduledRMPC:
     >>> ctrl.last.status, bool(np.linalg.norm(u) <= 1.0 + 1e-6)
     ('optimal', True)
     """
+
+    name = "ScheduledRMPC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,
@@ -160,8 +165,9 @@ class ScheduledRMPC:
         x = as_vector(x, "x")
         return self.problem_at(x).solve(x)
 
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Rebuild the polytope at ``x``, solve, and return ``u = F x``."""
+        check_step_inputs(inputs, self.accepts, self.name)
         x = as_vector(x, "x", self.n_states)
         if float(np.linalg.norm(x)) <= self.hold_radius:
             gain = self._current_gain(x)

@@ -2,9 +2,11 @@
 
 Every back-end follows ``setup(qp) -> update(g=, l=, u=, lb=, ub=) -> solve()``, is
 warm-started where its solver allows, uses explicit (tightened) tolerances, and maps its
-solver's statuses into the shared vocabulary :data:`STATUSES`. ``"cvxpy"`` is a reference
-back-end for tests and timing comparisons, and :func:`reference_solution` a certified
-high-accuracy answer (interior point refined on its active set).
+solver's statuses into the toolkit's one status vocabulary
+(:class:`toolkit_common.status.Status`; :data:`STATUSES` lists the words a back-end
+reports). ``"cvxpy"`` is a reference back-end for tests and timing comparisons, and
+:func:`reference_solution` a certified high-accuracy answer (interior point refined on its
+active set).
 
 Examples
 --------

@@ -19,6 +19,7 @@ import numpy as np
 
 from rmpc.qp.problem import QP, QPResult, SolverResiduals
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
+from toolkit_common.status import Status
 
 __all__ = ["BackendSettings", "QPBackend"]
 
@@ -98,7 +99,7 @@ class QPBackend(ABC):
     #: The settings dataclass.
     settings_class: ClassVar[type[BackendSettings]] = BackendSettings
     #: Solver status -> word of :data:`rmpc.qp.problem.STATUSES`.
-    STATUS_MAP: ClassVar[dict[Any, str]] = {}
+    STATUS_MAP: ClassVar[dict[Any, Status]] = {}
 
     def __init__(self, settings: BackendSettings | Mapping[str, Any] | None = None, **kwargs: Any) -> None:
         if isinstance(settings, self.settings_class):
@@ -202,7 +203,7 @@ class QPBackend(ABC):
             raise SolverError(f"{type(self).__name__}.solve: call setup(qp) first")
         if self._setup_error is not None:
             return self._result(
-                "numerical_error", f"setup failed: {self._setup_error}", None, None, None, -1, 0.0,
+                Status.NUMERICAL_ERROR, f"setup failed: {self._setup_error}", None, None, None, -1, 0.0,
                 SolverResiduals(),
             )
         return self._solve()
@@ -217,7 +218,7 @@ class QPBackend(ABC):
 
     def _result(
         self,
-        status: str,
+        status: Status,
         raw_status: str,
         x: Any,
         y_c: Any,
@@ -230,12 +231,12 @@ class QPBackend(ABC):
         assert self._qp is not None
         n, m = self._size
         xv = None
-        if status in ("optimal", "inaccurate") and x is not None:
+        if status in (Status.OPTIMAL, Status.INACCURATE) and x is not None:
             # copies: some bindings (proxsuite) return views of the solver's own memory,
             # which the next solve would overwrite
             xv = np.array(x, dtype=float).reshape(n)
             if not np.isfinite(xv).all():
-                status, xv = "numerical_error", None
+                status, xv = Status.NUMERICAL_ERROR, None
         if xv is not None:
             objective = float(0.5 * (xv @ self._qp.H @ xv) + self._vec["g"] @ xv)
             yc = np.zeros(m) if y_c is None else np.array(y_c, dtype=float).reshape(m)
@@ -250,9 +251,9 @@ class QPBackend(ABC):
         )
 
     @classmethod
-    def map_status(cls, raw: Any) -> str:
+    def map_status(cls, raw: Any) -> Status:
         """The shared status word for a solver status (unknown ones: ``"numerical_error"``)."""
-        return cls.STATUS_MAP.get(raw, "numerical_error")
+        return cls.STATUS_MAP.get(raw, Status.NUMERICAL_ERROR)
 
     # -- what a back-end implements ---------------------------------------------------
     @abstractmethod

@@ -29,6 +29,7 @@ import scipy.sparse as sp
 
 from rmpc.qp.base import BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
+from toolkit_common.status import Status
 
 __all__ = ["ClarabelBackend", "ClarabelSettings"]
 
@@ -104,19 +105,19 @@ class ClarabelBackend(QPBackend):
 
     name = "clarabel"
     settings_class = ClarabelSettings
-    STATUS_MAP: ClassVar[dict[Any, str]] = {
-        "Solved": "optimal",
-        "AlmostSolved": "inaccurate",
-        "PrimalInfeasible": "infeasible",
-        "AlmostPrimalInfeasible": "infeasible",
-        "DualInfeasible": "unbounded",
-        "AlmostDualInfeasible": "unbounded",
-        "MaxIterations": "max_iterations",
-        "MaxTime": "time_limit",
-        "NumericalError": "numerical_error",
-        "InsufficientProgress": "numerical_error",
-        "CallbackTerminated": "interrupted",
-        "Unsolved": "not_solved",
+    STATUS_MAP: ClassVar[dict[Any, Status]] = {
+        "Solved": Status.OPTIMAL,
+        "AlmostSolved": Status.INACCURATE,
+        "PrimalInfeasible": Status.INFEASIBLE,
+        "AlmostPrimalInfeasible": Status.INFEASIBLE,
+        "DualInfeasible": Status.UNBOUNDED,
+        "AlmostDualInfeasible": Status.UNBOUNDED,
+        "MaxIterations": Status.MAX_ITERATIONS,
+        "MaxTime": Status.TIME_LIMIT,
+        "NumericalError": Status.NUMERICAL_ERROR,
+        "InsufficientProgress": Status.NUMERICAL_ERROR,
+        "CallbackTerminated": Status.INTERRUPTED,
+        "Unsolved": Status.NOT_SOLVED,
     }
 
     # -- row structure ----------------------------------------------------------------
@@ -190,7 +191,7 @@ class ClarabelBackend(QPBackend):
             sol = self._solver.solve()
         except Exception as err:  # pragma: no cover - Clarabel reports failures as statuses
             return self._result(
-                "numerical_error", f"exception: {err}", None, None, None, -1,
+                Status.NUMERICAL_ERROR, f"exception: {err}", None, None, None, -1,
                 time.perf_counter() - start, SolverResiduals(),
             )
         elapsed = time.perf_counter() - start

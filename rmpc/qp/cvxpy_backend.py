@@ -21,6 +21,7 @@ import numpy as np
 
 from rmpc.qp.base import BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
+from toolkit_common.status import Status
 
 if TYPE_CHECKING:  # cvxpy itself is imported on set-up: it costs ~0.5 s at start-up
     import cvxpy as cp
@@ -79,15 +80,15 @@ class CvxpyBackend(QPBackend):
 
     name = "cvxpy"
     settings_class = CvxpySettings
-    STATUS_MAP: ClassVar[dict[Any, str]] = {
-        "optimal": "optimal",
-        "optimal_inaccurate": "inaccurate",
-        "infeasible": "infeasible",
-        "infeasible_inaccurate": "infeasible",
-        "unbounded": "unbounded",
-        "unbounded_inaccurate": "unbounded",
-        "user_limit": "max_iterations",
-        "solver_error": "numerical_error",
+    STATUS_MAP: ClassVar[dict[Any, Status]] = {
+        "optimal": Status.OPTIMAL,
+        "optimal_inaccurate": Status.INACCURATE,
+        "infeasible": Status.INFEASIBLE,
+        "infeasible_inaccurate": Status.INFEASIBLE,
+        "unbounded": Status.UNBOUNDED,
+        "unbounded_inaccurate": Status.UNBOUNDED,
+        "user_limit": Status.MAX_ITERATIONS,
+        "solver_error": Status.NUMERICAL_ERROR,
     }
 
     def _structure(self) -> tuple[bytes, ...]:
@@ -147,7 +148,7 @@ class CvxpyBackend(QPBackend):
             )
         except cp.error.SolverError as err:
             return self._result(
-                "numerical_error", f"SolverError: {err}", None, None, None, -1,
+                Status.NUMERICAL_ERROR, f"SolverError: {err}", None, None, None, -1,
                 time.perf_counter() - start, SolverResiduals(),
             )
         elapsed = time.perf_counter() - start
@@ -155,7 +156,7 @@ class CvxpyBackend(QPBackend):
         status = self.map_status(raw)
         n, m = self._qp.n_vars, self._qp.n_cons
         y_c, y_box = np.zeros(m), np.zeros(n)
-        if status in ("optimal", "inaccurate"):
+        if status in (Status.OPTIMAL, Status.INACCURATE):
             for part, _key, idx, sign, _par, con in self._groups:
                 target = y_c if part == "C" else y_box
                 target[idx] += sign * np.asarray(con.dual_value, dtype=float).reshape(-1)

@@ -36,6 +36,7 @@ import scipy.sparse as sp
 
 from rmpc.qp.base import BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
+from toolkit_common.status import Status
 
 __all__ = ["OSQPBackend", "OSQPSettings"]
 
@@ -135,18 +136,18 @@ class OSQPBackend(QPBackend):
 
     name = "osqp"
     settings_class = OSQPSettings
-    STATUS_MAP: ClassVar[dict[Any, str]] = {
-        int(_S.OSQP_SOLVED): "optimal",
-        int(_S.OSQP_SOLVED_INACCURATE): "inaccurate",
-        int(_S.OSQP_PRIMAL_INFEASIBLE): "infeasible",
-        int(_S.OSQP_PRIMAL_INFEASIBLE_INACCURATE): "infeasible",
-        int(_S.OSQP_DUAL_INFEASIBLE): "unbounded",
-        int(_S.OSQP_DUAL_INFEASIBLE_INACCURATE): "unbounded",
-        int(_S.OSQP_MAX_ITER_REACHED): "max_iterations",
-        int(_S.OSQP_TIME_LIMIT_REACHED): "time_limit",
-        int(_S.OSQP_NON_CVX): "numerical_error",
-        int(_S.OSQP_SIGINT): "interrupted",
-        int(_S.OSQP_UNSOLVED): "not_solved",
+    STATUS_MAP: ClassVar[dict[Any, Status]] = {
+        int(_S.OSQP_SOLVED): Status.OPTIMAL,
+        int(_S.OSQP_SOLVED_INACCURATE): Status.INACCURATE,
+        int(_S.OSQP_PRIMAL_INFEASIBLE): Status.INFEASIBLE,
+        int(_S.OSQP_PRIMAL_INFEASIBLE_INACCURATE): Status.INFEASIBLE,
+        int(_S.OSQP_DUAL_INFEASIBLE): Status.UNBOUNDED,
+        int(_S.OSQP_DUAL_INFEASIBLE_INACCURATE): Status.UNBOUNDED,
+        int(_S.OSQP_MAX_ITER_REACHED): Status.MAX_ITERATIONS,
+        int(_S.OSQP_TIME_LIMIT_REACHED): Status.TIME_LIMIT,
+        int(_S.OSQP_NON_CVX): Status.NUMERICAL_ERROR,
+        int(_S.OSQP_SIGINT): Status.INTERRUPTED,
+        int(_S.OSQP_UNSOLVED): Status.NOT_SOLVED,
     }
 
     def _setup(self) -> None:
@@ -188,7 +189,7 @@ class OSQPBackend(QPBackend):
         except Exception as err:  # the binding raises on a failed setup/factorisation
             sys.stdout = saved
             return self._result(
-                "numerical_error", f"exception: {err}", None, None, None, -1,
+                Status.NUMERICAL_ERROR, f"exception: {err}", None, None, None, -1,
                 time.perf_counter() - start, SolverResiduals(),
             )
         finally:

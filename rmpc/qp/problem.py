@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.status import Status, as_status
 from toolkit_common.validation import as_matrix, as_vector, check_psd
 
 __all__ = [
@@ -44,19 +45,20 @@ __all__ = [
     "kkt_residuals",
 ]
 
-#: The shared status vocabulary. ``"optimal"`` is the only status whose ``x`` a controller
-#: should apply without further checks; ``"inaccurate"`` means the solver met only reduced
-#: tolerances (its ``x`` is returned, flagged); every other status comes with ``x`` = NaN.
-STATUSES: tuple[str, ...] = (
-    "optimal",
-    "inaccurate",
-    "infeasible",
-    "unbounded",
-    "max_iterations",
-    "time_limit",
-    "numerical_error",
-    "interrupted",
-    "not_solved",
+#: The words of the toolkit's status vocabulary (:class:`~toolkit_common.status.Status`) a QP
+#: back-end reports. ``"optimal"`` is the only status whose ``x`` a controller should apply
+#: without further checks; ``"inaccurate"`` means the solver met only reduced tolerances (its
+#: ``x`` is returned, flagged); every other status comes with ``x`` = NaN.
+STATUSES: tuple[Status, ...] = (
+    Status.OPTIMAL,
+    Status.INACCURATE,
+    Status.INFEASIBLE,
+    Status.UNBOUNDED,
+    Status.MAX_ITERATIONS,
+    Status.TIME_LIMIT,
+    Status.NUMERICAL_ERROR,
+    Status.INTERRUPTED,
+    Status.NOT_SOLVED,
 )
 
 
@@ -198,8 +200,9 @@ class QPResult:
         The primal solution; all NaN unless ``status`` is ``"optimal"`` or ``"inaccurate"``.
     objective : float
         ``1/2 x'Hx + g'x`` evaluated at ``x`` (NaN with ``x``).
-    status : str
-        One word of :data:`STATUSES`.
+    status : Status
+        One word of :data:`STATUSES` (a plain string is converted; a word outside the
+        vocabulary is an error).
     iterations : int
         Solver iterations (-1 where unknown).
     solve_time : float
@@ -220,7 +223,7 @@ class QPResult:
 
     x: np.ndarray
     objective: float
-    status: str
+    status: Status
     iterations: int
     solve_time: float
     residuals: SolverResiduals
@@ -230,10 +233,13 @@ class QPResult:
     backend: str
     info: dict[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "status", as_status(self.status, "QPResult.status"))
+
     @property
     def ok(self) -> bool:
         """``True`` when ``status == "optimal"``."""
-        return self.status == "optimal"
+        return self.status == Status.OPTIMAL
 
 
 @dataclass(frozen=True)

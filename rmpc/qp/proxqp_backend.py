@@ -43,6 +43,7 @@ from proxsuite import proxqp
 
 from rmpc.qp.base import BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
+from toolkit_common.status import Status
 
 __all__ = ["ProxQPBackend", "ProxQPSettings"]
 
@@ -133,13 +134,13 @@ class ProxQPBackend(QPBackend):
 
     name = "proxqp"
     settings_class = ProxQPSettings
-    STATUS_MAP: ClassVar[dict[Any, str]] = {
-        _O.PROXQP_SOLVED: "optimal",
-        _O.PROXQP_MAX_ITER_REACHED: "max_iterations",
-        _O.PROXQP_PRIMAL_INFEASIBLE: "infeasible",
-        _O.PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE: "infeasible",
-        _O.PROXQP_DUAL_INFEASIBLE: "unbounded",
-        _O.PROXQP_NOT_RUN: "not_solved",
+    STATUS_MAP: ClassVar[dict[Any, Status]] = {
+        _O.PROXQP_SOLVED: Status.OPTIMAL,
+        _O.PROXQP_MAX_ITER_REACHED: Status.MAX_ITERATIONS,
+        _O.PROXQP_PRIMAL_INFEASIBLE: Status.INFEASIBLE,
+        _O.PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE: Status.INFEASIBLE,
+        _O.PROXQP_DUAL_INFEASIBLE: Status.UNBOUNDED,
+        _O.PROXQP_NOT_RUN: Status.NOT_SOLVED,
     }
 
     def _setup(self) -> None:
@@ -207,18 +208,18 @@ class ProxQPBackend(QPBackend):
         self._solver.solve()
         status = self.map_status(self._solver.results.info.status)
         retried = False
-        if warm and status != "optimal" and self.settings.retry_cold:
+        if warm and status != Status.OPTIMAL and self.settings.retry_cold:
             self._build()  # a fresh solver: init + cold solve with the current data
             if self._setup_error is not None:
                 return self._result(
-                    "numerical_error", f"rebuild failed: {self._setup_error}", None, None, None, -1,
+                    Status.NUMERICAL_ERROR, f"rebuild failed: {self._setup_error}", None, None, None, -1,
                     time.perf_counter() - start, SolverResiduals(),
                 )
             status, retried = self.map_status(self._solver.results.info.status), True
         elapsed = time.perf_counter() - start
         res = self._solver.results
         info = res.info
-        self._set_guess(status == "optimal")
+        self._set_guess(status == Status.OPTIMAL)
         z = np.asarray(res.z)
         m = self._m
         return self._result(

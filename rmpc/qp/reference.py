@@ -16,6 +16,7 @@ import numpy as np
 
 from rmpc.qp.problem import QP, QPResult, SolverResiduals, kkt_residuals
 from toolkit_common.errors import SolverError
+from toolkit_common.status import Status
 
 __all__ = ["reference_solution", "refine_active_set"]
 
@@ -40,7 +41,7 @@ def refine_active_set(qp: QP, result: QPResult, max_iter: int = 50, tol: float =
         ``backend = result.backend + "+refined"``; ``None`` if no consistent active set was
         found (the caller keeps the unrefined answer).
     """
-    if not result.ok and result.status != "inaccurate":
+    if not result.ok and result.status != Status.INACCURATE:
         return None
     n = qp.n_vars
     rows = np.vstack((qp.C, np.eye(n)))
@@ -72,7 +73,7 @@ def refine_active_set(qp: QP, result: QPResult, max_iter: int = 50, tol: float =
         wrong = (at_up & ~eq & (lam < -tol * scale_y)) | (at_lo & (lam > tol * scale_y))
         if not (over.any() or under.any() or wrong.any()):
             out = QPResult(
-                x=x, objective=qp.objective(x), status="optimal", iterations=result.iterations,
+                x=x, objective=qp.objective(x), status=Status.OPTIMAL, iterations=result.iterations,
                 solve_time=result.solve_time, residuals=SolverResiduals(), y_C=lam[: qp.n_cons],
                 y_box=lam[qp.n_cons:], raw_status=result.raw_status, backend=result.backend + "+refined",
             )

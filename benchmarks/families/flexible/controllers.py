@@ -26,7 +26,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -59,28 +59,34 @@ class HandOver:
 
     Parameters
     ----------
-    slew : object
-        The large-angle law, ``step(x, pzt=v)`` returning ``[u; v]`` (:class:`rmpc.MTSMC`).
-    fine : object
-        The law near the target, ``step(x)`` returning ``[u; 0]`` (the mapped robust MPC).
+    slew : Controller
+        The large-angle law, returning ``[u; v]`` and taking the PZT command ``v`` through
+        ``StepInputs(pzt=v)`` (:class:`rmpc.MTSMC`).
+    fine : Controller
+        The law near the target, ``step(x)`` returning ``[u; 0]`` (the mapped robust MPC); its
+        PZT entries are replaced by ``v``.
     angle : float
         The hand-over rotation error (rad).
 
     Attributes
     ----------
     name : str
-        ``"<slew>><fine>"``, e.g. ``"MTSMC>OfflineRMPC"``.
+        ``"<slew>><fine>"`` from the two laws' names, e.g. ``"MTSMC>OfflineRMPC"``.
+    accepts : frozenset of str
+        ``{"pzt"}``: this sample's PZT command, passed to the slew law or into the output.
     controller : object
         The fine law's inner controller (its table or gain, for the report).
     handover_step : int or None
         The step at which the fine law took over (``None``: not yet).
     """
 
+    accepts: ClassVar[frozenset[str]] = frozenset({"pzt"})
+
     def __init__(self, slew: Any, fine: Any, angle: float) -> None:
         self.slew = slew
         self.fine = fine
         self.angle = float(angle)
-        self.name = f"{type(slew).__name__}>{getattr(fine, 'name', type(fine).__name__)}"
+        self.name = ">".join(getattr(law, "name", type(law).__name__) for law in (slew, fine))
         self.controller = getattr(fine, "controller", fine)
         self.handover_step: int | None = None
         self._count = 0
@@ -94,15 +100,17 @@ class HandOver:
         self._count = 0
         self.last = None
 
-    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+    def step(self, x: Any, inputs: Any = None) -> np.ndarray:
         """``[u; v]`` from the slew law, or from the fine law once the error was below ``angle``."""
         from models.attitude.quaternion import rotation_angle
+        from rmpc.controller import check_step_inputs
 
+        pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         if self.handover_step is None and rotation_angle(np.asarray(x, dtype=float)[:4]) < self.angle:
             self.handover_step = self._count
         self._count += 1
         if self.handover_step is None:
-            u = np.asarray(self.slew.step(x, pzt=pzt), dtype=float)
+            u = np.asarray(self.slew.step(x, inputs), dtype=float)
             self.last = self.slew.last
             return u
         u = np.array(self.fine.step(x), dtype=float)

@@ -18,12 +18,12 @@ CSMC's), ``s_b = 0.01 rad/s``, ``n0 = n1 = 10``, ``e0 = e1 = 0.1``, ``b0h(0) = 0
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import FlexibleSatellite
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms, gain_matrix
 from toolkit_common.validation import check_positive
 
@@ -35,7 +35,7 @@ class AdaptiveSMC:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model.
     dt : float
         Sample time (s).
@@ -66,9 +66,12 @@ class AdaptiveSMC:
     (-0.2995, 'ASMC')
     """
 
+    name = "ASMC"
+    accepts: ClassVar[frozenset[str]] = frozenset({"pzt"})
+
     def __init__(
         self,
-        satellite: FlexibleSatellite,
+        plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
         q_ref: Any = None,
@@ -83,7 +86,7 @@ class AdaptiveSMC:
         p1_init: float = 0.0,
         flex_feedforward: bool = True,
     ) -> None:
-        self.terms = FlexibleTerms(satellite, q_ref, flex_feedforward)
+        self.terms = FlexibleTerms(plant, q_ref, flex_feedforward)
         self.dt = check_positive(dt, "dt")
         self.lam = check_positive(lam, "lam")
         self.K_s = gain_matrix(K_s, "K_s")
@@ -94,7 +97,6 @@ class AdaptiveSMC:
         self.e1 = check_positive(e1, "e1", allow_zero=True)
         self.b0_init = check_positive(b0_init, "b0_init", allow_zero=True)
         self.p1_init = check_positive(p1_init, "p1_init", allow_zero=True)
-        self.name = "ASMC"
         self.last: StepInfo | None = None
         self.reset()
 
@@ -120,16 +122,17 @@ class AdaptiveSMC:
         u_ad = -(s / max(norm, self.s_b)) * gain
         return u_eq + u_ad, s
 
-    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
-        """Return ``[u; v]`` for the measured state (``v = pzt``, this sample's PZT command, or 0)."""
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+        """Return ``[u; v]`` for the measured state (``v = inputs.pzt``, this sample's PZT command, or 0)."""
         start = time.perf_counter()
+        pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         u, s = self.law(x, self._b0, self._p1, pzt)
         _, w, _, _ = self.terms.split(x)
         norm = float(np.linalg.norm(s))
         extra = {"sigma": s, "b0": self._b0, "p1": self._p1}
         self._b0 = max(0.0, self._b0 + self.dt * self.n0 * (norm - self.e0 * self._b0))
         self._p1 = max(0.0, self._p1 + self.dt * self.n1 * (norm * (1.0 + float(w @ w)) - self.e1 * self._p1))
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
         v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
         return np.concatenate((u, v_out))
 

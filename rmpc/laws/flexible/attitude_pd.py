@@ -19,13 +19,13 @@ axes of the published set), ``L_o = 0.5 1/s``.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import FlexibleSatellite
 from models.attitude.quaternion import cross3
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms, gain_matrix
 from toolkit_common.errors import ArgumentTypeError
 from toolkit_common.validation import check_positive
@@ -38,7 +38,7 @@ class AttitudePD:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model (``J_mb`` for the observer).
     dt : float
         Sample time (s); the observer advances by forward Euler.
@@ -65,9 +65,11 @@ class AttitudePD:
     (-0.199667, 'PD')
     """
 
+    accepts: ClassVar[frozenset[str]] = frozenset({"pzt"})
+
     def __init__(
         self,
-        satellite: FlexibleSatellite,
+        plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
         q_ref: Any = None,
@@ -77,7 +79,7 @@ class AttitudePD:
         L_o: float = 0.5,
         u_max: float | None = None,
     ) -> None:
-        self.terms = FlexibleTerms(satellite, q_ref, flex_feedforward=False)
+        self.terms = FlexibleTerms(plant, q_ref, flex_feedforward=False)
         self.dt = check_positive(dt, "dt")
         self.K_p = gain_matrix(K_p, "K_p")
         self.K_d = gain_matrix(K_d, "K_d")
@@ -86,7 +88,7 @@ class AttitudePD:
         self.disturbance_observer = disturbance_observer
         self.L_o = check_positive(L_o, "L_o")
         self.u_max = None if u_max is None else check_positive(u_max, "u_max")
-        self.name = "PD-DOB" if disturbance_observer else "PD"
+        self.name: str = "PD-DOB" if disturbance_observer else "PD"
         self.last: StepInfo | None = None
         self.reset()
 
@@ -106,13 +108,14 @@ class AttitudePD:
         u = -self.K_d @ w - self.K_p @ err.qv
         return u if d_hat is None else u - np.asarray(d_hat, dtype=float)
 
-    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
-        """Return ``[u; v]`` for the measured state (``v = pzt``, this sample's PZT command, or 0).
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+        """Return ``[u; v]`` for the measured state (``v = inputs.pzt``, this sample's PZT command, or 0).
 
         The law ignores ``v`` (PD cancels nothing); it is passed through so that
         :class:`~rmpc.FlexibleHybrid` can pair PD with vibration control.
         """
         start = time.perf_counter()
+        pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         _, w, _, _ = self.terms.split(x)
         d_hat = self.estimate(w) if self.disturbance_observer else None
         u = self.law(x, d_hat)
@@ -124,7 +127,7 @@ class AttitudePD:
             z_dot = -self.L_o * self._z - self.L_o * (-cross3(w, j_w) + u + self.L_o * j_w)
             self._z = self._z + self.dt * z_dot
             extra["d_hat"] = d_hat
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
         v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
         return np.concatenate((u, v_out))
 

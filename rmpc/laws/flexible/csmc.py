@@ -18,12 +18,12 @@ all **assumed**). The torque is not saturated here (the plant's limiter clips it
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import FlexibleSatellite
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms, SwitchKind, check_switch, gain_matrix
 from toolkit_common.validation import check_positive
 
@@ -35,7 +35,7 @@ class CSMC:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model (nominal parameters).
     dt : float
         Sample time (s).
@@ -67,9 +67,12 @@ class CSMC:
     ([0.0, 0.0, -1.4807], 0.0247)
     """
 
+    name = "CSMC"
+    accepts: ClassVar[frozenset[str]] = frozenset({"pzt"})
+
     def __init__(
         self,
-        satellite: FlexibleSatellite,
+        plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
         q_ref: Any = None,
@@ -80,7 +83,7 @@ class CSMC:
         eps: float = 0.01,
         flex_feedforward: bool = True,
     ) -> None:
-        self.terms = FlexibleTerms(satellite, q_ref, flex_feedforward)
+        self.terms = FlexibleTerms(plant, q_ref, flex_feedforward)
         self.dt = check_positive(dt, "dt")
         self.lam = check_positive(lam, "lam")
         self.K_s = gain_matrix(K_s, "K_s")
@@ -104,15 +107,17 @@ class CSMC:
         )
         return u, sigma
 
-    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[u; v]`` (``3 + n_a``) for the measured state.
 
-        ``pzt`` is this sample's PZT command ``v`` (from the vibration controller; ``None``:
-        zero); it is passed through so that the output is the plant's whole input vector.
+        ``inputs.pzt`` is this sample's PZT command ``v`` (from the vibration controller;
+        ``None``: zero); it is passed through so that the output is the plant's whole input
+        vector.
         """
         start = time.perf_counter()
+        pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         u, sigma = self.law(x, pzt)
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra={"sigma": sigma})
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra={"sigma": sigma})
         v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
         return np.concatenate((u, v_out))
 

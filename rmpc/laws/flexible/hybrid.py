@@ -8,13 +8,12 @@ cancels the reaction of ``Gamma_a v`` on the hub), and the plant gets ``[u; v]``
 
 from __future__ import annotations
 
-import inspect
 import time
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError
 
 __all__ = ["FlexibleHybrid"]
@@ -25,12 +24,15 @@ class FlexibleHybrid:
 
     Parameters
     ----------
-    attitude : object
-        The attitude law: ``step(x, pzt=v)`` returning ``[u; v]`` (:class:`~rmpc.MTSMC`,
-        :class:`~rmpc.CSMC`, :class:`~rmpc.AttitudePD`, :class:`~rmpc.AdaptiveSMC`). A law whose
-        ``step`` takes no ``pzt`` (:func:`~rmpc.flexible_lqr`) is called with ``x`` alone and
+    attitude : Controller
+        The attitude law, returning ``[u; v]``. A law whose ``accepts`` holds ``"pzt"``
+        (:class:`~rmpc.MTSMC`, :class:`~rmpc.CSMC`, :class:`~rmpc.AttitudePD`,
+        :class:`~rmpc.AdaptiveSMC`) gets this sample's PZT command through the step channel,
+        ``step(x, StepInputs(pzt=v))``, and cancels its reaction on the hub (PD passes it
+        through). Any other law
+        (:func:`~rmpc.flexible_lqr`, or one without ``accepts``) is called with ``x`` alone and
         its PZT entries are replaced by ``v``.
-    vibration : object, optional
+    vibration : Controller, optional
         The vibration law: ``step(x)`` returning ``[0; v]`` (:class:`~rmpc.RobustAVC`);
         ``None`` runs the attitude law alone with ``v = 0``.
 
@@ -39,6 +41,11 @@ class FlexibleHybrid:
     name : str
         The record name: the attitude law's ``name`` (or class name), ``"+AVC"`` appended with
         vibration control (``"MTSMC"``, ``"CSMC+AVC"``, ``"PD-DOB+AVC"``, ``"LQR+AVC"``).
+    accepts : frozenset of str
+        None: the hybrid makes the PZT command itself.
+    last : StepInfo or None
+        The first status of the two laws that is not ``"ok"`` (else ``"ok"``), ``fallback``
+        when either law fell back, and both laws' ``extra``.
 
     Examples
     --------
@@ -50,18 +57,16 @@ class FlexibleHybrid:
     ('CSMC+AVC', (7,))
     """
 
+    accepts: ClassVar[frozenset[str]] = frozenset()
+
     def __init__(self, attitude: Any, vibration: Any = None) -> None:
         if not callable(getattr(attitude, "step", None)):
-            expected = "a controller with step(x, pzt=None)"
+            expected = "a controller with step(x, inputs=None)"
             raise ArgumentTypeError("attitude", expected, type(attitude).__name__)
         if vibration is not None and not callable(getattr(vibration, "step", None)):
             expected = "None or a controller with step(x)"
             raise ArgumentTypeError("vibration", expected, type(vibration).__name__)
-        try:
-            params = inspect.signature(attitude.step).parameters
-        except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
-            params = {}
-        self._takes_pzt = "pzt" in params
+        self._takes_pzt = "pzt" in getattr(attitude, "accepts", frozenset())
         self.attitude = attitude
         self.vibration = vibration
         base = getattr(attitude, "name", None) or type(attitude).__name__
@@ -75,25 +80,26 @@ class FlexibleHybrid:
             self.vibration.reset()
         self.last = None
 
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``[u; v]``: ``v`` from the vibration law, then ``u`` given ``v``."""
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         v = None
         extra: dict[str, Any] = {}
         if self.vibration is not None:
             out = np.asarray(self.vibration.step(x), dtype=float)
             v = out[3:]
             extra.update(getattr(self.vibration.last, "extra", {}) or {})
-        if self._takes_pzt:
-            u = np.asarray(self.attitude.step(x, pzt=v), dtype=float)
+        if self._takes_pzt and v is not None:
+            u = np.asarray(self.attitude.step(x, StepInputs(pzt=v)), dtype=float)
         else:
             u = np.array(self.attitude.step(x), dtype=float)
             if v is not None:
                 u[3:] = v
         extra.update(getattr(self.attitude.last, "extra", {}) or {})
-        statuses = [getattr(c.last, "status", "ok") for c in (self.attitude, self.vibration) if c is not None]
-        status = next((s for s in statuses if s != "ok"), "ok")
         laws = [c for c in (self.attitude, self.vibration) if c is not None]
+        statuses = [getattr(c.last, "status", Status.OK) for c in laws]
+        status = next((s for s in statuses if s != Status.OK), Status.OK)
         fallback = any(bool(getattr(c.last, "fallback", False)) for c in laws)
         self.last = StepInfo(
             status=status, solve_time=time.perf_counter() - start, fallback=fallback, extra=extra

@@ -27,7 +27,7 @@ __all__ = ["flexible_lqr"]
 
 
 def flexible_lqr(
-    satellite: FlexibleSatellite,
+    plant: FlexibleSatellite,
     dt: float = 0.01,
     *,
     Q: Any = None,
@@ -38,7 +38,7 @@ def flexible_lqr(
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The design model (linearised at rest, quaternion attitude).
     dt : float
         Sample time (s) of the ZOH.
@@ -60,11 +60,11 @@ def flexible_lqr(
     >>> ctrl.name, ctrl.controller.F.shape
     ('LQR', (3, 14))
     """
-    if not isinstance(satellite, FlexibleSatellite):
-        raise ArgumentTypeError("satellite", "a models.FlexibleSatellite", type(satellite).__name__)
+    if not isinstance(plant, FlexibleSatellite):
+        raise ArgumentTypeError("plant", "a models.FlexibleSatellite", type(plant).__name__)
     dt = check_positive(dt, "dt")
-    n = satellite.n_linear_states
-    a, b = satellite.discretize(dt, attitude="quaternion")
+    n = plant.n_linear_states
+    a, b = plant.discretize(dt, attitude="quaternion")
     model = PolytopicModel([(a, b)], dt)
     if Q is None:
         Q = np.zeros((n, n))
@@ -73,10 +73,10 @@ def flexible_lqr(
         R = np.eye(3)
     lqr = LQR(model, Q, R)
     q_ref_vec = None if q_ref is None else np.asarray(q_ref, dtype=float)
-    n_pzt = satellite.n_pzt
+    n_pzt = plant.n_pzt
 
     def measure(x: np.ndarray) -> np.ndarray:
-        return satellite.linear_state(x, q_ref_vec, attitude="quaternion")
+        return plant.linear_state(x, q_ref_vec, attitude="quaternion")
 
     def output(u: np.ndarray) -> np.ndarray:
         return np.concatenate((u, np.zeros(n_pzt)))

@@ -37,12 +37,12 @@ input stage clips it (``u_max = 2 N m`` per axis in paper V's scenario).
 from __future__ import annotations
 
 import time
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from models import FlexibleSatellite
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms, gain_matrix
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_choice, check_positive
@@ -57,7 +57,7 @@ class MTSMC:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model (nominal parameters).
     dt : float
         Sample time (s) of the controller's clock (0.01 s in paper V's scenario, **assumed**).
@@ -94,9 +94,12 @@ class MTSMC:
     ([-0.2768, -0.2462, -0.1702], 'ok')
     """
 
+    name = "MTSMC"
+    accepts: ClassVar[frozenset[str]] = frozenset({"pzt"})
+
     def __init__(
         self,
-        satellite: FlexibleSatellite,
+        plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
         q_ref: Any = None,
@@ -118,7 +121,7 @@ class MTSMC:
         rho_w: float = 0.1,
         flex_feedforward: bool = True,
     ) -> None:
-        self.terms = FlexibleTerms(satellite, q_ref, flex_feedforward)
+        self.terms = FlexibleTerms(plant, q_ref, flex_feedforward)
         self.dt = check_positive(dt, "dt")
         self.alpha_law = check_choice(alpha_law, "alpha_law", ("schedule", "adaptive"))
         self.alpha_f = check_positive(alpha_f, "alpha_f")
@@ -202,13 +205,15 @@ class MTSMC:
         u = self.terms.sliding_torque(w, eta, eta_dot, v_vec, sigma, rate, self.K_s, w_s, self.eps, "tanh")
         return u, sigma
 
-    def step(self, x: Any, pzt: Any = None) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[u; v]`` (``3 + n_a``) for the measured state.
 
-        ``pzt`` is this sample's PZT command ``v`` (from the vibration controller; ``None``:
-        zero); it is passed through so that the output is the plant's whole input vector.
+        ``inputs.pzt`` is this sample's PZT command ``v`` (from the vibration controller;
+        ``None``: zero); it is passed through so that the output is the plant's whole input
+        vector.
         """
         start = time.perf_counter()
+        pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         t = self._k * self.dt
         u, sigma = self.law(t, x, pzt, z=self._z, alpha=self._alpha, w_s=self._w_s)
         q, w, _, _ = self.terms.split(x)
@@ -226,7 +231,7 @@ class MTSMC:
             w_rate = float(np.clip(w_rate, -self.rho_w * self._w_s, self.rho_w * self._w_s))
             self._w_s = self._w_s + self.dt * w_rate
         self._k += 1
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra=extra)
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
         v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
         return np.concatenate((u, v_out))
 

@@ -26,12 +26,12 @@ from __future__ import annotations
 
 import time
 import warnings
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import FlexibleSatellite
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
@@ -59,7 +59,7 @@ class RobustAVC:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model; its ``M, C, K, delta`` are the nominal ``M0, C0, K0, delta0``.
     dt : float
         Sample time (s).
@@ -85,9 +85,12 @@ class RobustAVC:
     ((7,), -0.03003, 'ok')
     """
 
+    name = "AVC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
+
     def __init__(
         self,
-        satellite: FlexibleSatellite,
+        plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
         Lam: Any = 1.0,
@@ -101,10 +104,10 @@ class RobustAVC:
         beta: float = 0.5,
         v_max: float | None = None,
     ) -> None:
-        self.terms = FlexibleTerms(satellite, None, True)
-        n = satellite.n_modes
+        self.terms = FlexibleTerms(plant, None, True)
+        n = plant.n_modes
         if n == 0:
-            raise InvalidArgumentError("satellite", "a satellite with flexible modes", "n_modes = 0")
+            raise InvalidArgumentError("plant", "a satellite with flexible modes", "n_modes = 0")
         self.dt = check_positive(dt, "dt")
         self.Lam = _modal_gain(Lam, "Lam", n)
         self.K_v = _modal_gain(K_v, "K_v", n)
@@ -116,7 +119,7 @@ class RobustAVC:
         self.e_min = check_positive(e_min, "e_min")
         self.beta = check_positive(beta, "beta", allow_zero=True)
         self.v_max = None if v_max is None else check_positive(v_max, "v_max")
-        gamma = satellite.pzt_matrix
+        gamma = plant.pzt_matrix
         if gamma.shape[0] == gamma.shape[1]:
             cond = float(np.linalg.cond(gamma)) if gamma.size else np.inf
             if not cond < PZT_COND_MAX:
@@ -132,10 +135,10 @@ class RobustAVC:
                 stacklevel=2,
             )
             self._gamma_inv = np.linalg.pinv(gamma)
-        self._mass = satellite.modal_mass
-        self._c = np.diag(satellite.damping_matrix)
-        self._k = np.diag(satellite.stiffness)
-        self._delta = satellite.coupling
+        self._mass = plant.modal_mass
+        self._c = np.diag(plant.damping_matrix)
+        self._k = np.diag(plant.stiffness)
+        self._delta = plant.coupling
         self.last: StepInfo | None = None
         self.reset()
 
@@ -174,9 +177,10 @@ class RobustAVC:
         force = psi - self.K_v * s - rho**2 * s / (rho * float(np.linalg.norm(s)) + self.smoothing(t))
         return self._gamma_inv @ force, s
 
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[0 (3 hub torques); v]`` for the measured state."""
         start = time.perf_counter()
+        check_step_inputs(inputs, self.accepts, self.name)
         t = self._step * self.dt
         _, w, eta, _ = self.terms.split(x)
         if self._eta0 is None:
@@ -187,7 +191,7 @@ class RobustAVC:
             v = np.clip(v, -self.v_max, self.v_max)
         self._w_prev = w.copy()
         self._step += 1
-        self.last = StepInfo(status="ok", solve_time=time.perf_counter() - start, extra={"s": s, "v": v})
+        self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra={"s": s, "v": v})
         return np.concatenate((np.zeros(3), v))
 
     def __repr__(self) -> str:

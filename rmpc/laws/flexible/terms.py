@@ -82,7 +82,7 @@ class FlexibleTerms:
 
     Parameters
     ----------
-    satellite : FlexibleSatellite
+    plant : FlexibleSatellite
         The controller's model (nominal parameters).
     q_ref : (4,) array_like, optional
         Reference attitude (unit quaternion, at rest); default the identity.
@@ -91,30 +91,28 @@ class FlexibleTerms:
         cancel the modal reaction; ``False`` drops every ``eta`` term.
     """
 
-    def __init__(
-        self, satellite: FlexibleSatellite, q_ref: Any = None, flex_feedforward: bool = True
-    ) -> None:
-        if not isinstance(satellite, FlexibleSatellite):
-            raise ArgumentTypeError("satellite", "a models.FlexibleSatellite", type(satellite).__name__)
+    def __init__(self, plant: FlexibleSatellite, q_ref: Any = None, flex_feedforward: bool = True) -> None:
+        if not isinstance(plant, FlexibleSatellite):
+            raise ArgumentTypeError("plant", "a models.FlexibleSatellite", type(plant).__name__)
         if not isinstance(flex_feedforward, bool):
             raise ArgumentTypeError("flex_feedforward", "a bool", type(flex_feedforward).__name__)
-        self.satellite = satellite
+        self.plant = plant
         self.q_ref = np.array([1.0, 0.0, 0.0, 0.0]) if q_ref is None else unit_quaternion(q_ref, "q_ref")
         self.flex_feedforward = flex_feedforward
-        self.n_modes = satellite.n_modes
-        self.n_pzt = satellite.n_pzt
-        self.inertia = satellite.inertia
-        self.hub_inertia = satellite.hub_inertia
-        self._delta_t = satellite.coupling.T
-        self._couple = satellite.coupling.T @ np.linalg.inv(satellite.modal_mass) if self.n_modes else (
+        self.n_modes = plant.n_modes
+        self.n_pzt = plant.n_pzt
+        self.inertia = plant.inertia
+        self.hub_inertia = plant.hub_inertia
+        self._delta_t = plant.coupling.T
+        self._couple = plant.coupling.T @ np.linalg.inv(plant.modal_mass) if self.n_modes else (
             np.zeros((3, 0)))
-        self._c = np.diag(satellite.damping_matrix)
-        self._k = np.diag(satellite.stiffness)
-        self._gamma = satellite.pzt_matrix
+        self._c = np.diag(plant.damping_matrix)
+        self._k = np.diag(plant.stiffness)
+        self._gamma = plant.pzt_matrix
 
     def split(self, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(q, w, eta, eta')`` of a measured state (checked: length ``7 + 2N``, finite)."""
-        x = as_vector(x, "x", self.satellite.n_states)
+        x = as_vector(x, "x", self.plant.n_states)
         n = self.n_modes
         return x[:4], x[4:7], x[7:7 + n], x[7 + n:]
 

@@ -55,9 +55,9 @@ class CFBackstepping(ContinuousTimeController):
 
     Parameters
     ----------
-    model : MRPSatellite
-        The controller's model: its inertia is ``J0`` and its orbit rate ``n``. The plant may
-        differ (paper M's M3 simulates ``1.3 J0``).
+    plant : MRPSatellite
+        The controller's model: its inertia is ``J0`` and its orbit rate ``n``. The simulated
+        satellite may differ (paper M's M3 simulates ``1.3 J0``).
     target : (3,) array_like, optional
         The target attitude, an MRP relative to the orbital frame, fixed there (default 0).
     c1, c2 : float
@@ -97,11 +97,11 @@ class CFBackstepping(ContinuousTimeController):
     True
     """
 
-    short_name = "BS"
+    name = "BS"
 
     def __init__(
         self,
-        model: MRPSatellite,
+        plant: MRPSatellite,
         target: Any = None,
         *,
         c1: float = 0.5,
@@ -111,12 +111,12 @@ class CFBackstepping(ContinuousTimeController):
         u_max: Any = None,
     ) -> None:
         super().__init__(dt, u_max)
-        if not isinstance(model, MRPSatellite):
-            raise ArgumentTypeError("model", "a models.MRPSatellite", type(model).__name__)
-        self.model = model
-        self._j0 = model.inertia
-        self._j0_inv = model.inertia_inv
-        self.mean_motion = model.mean_motion
+        if not isinstance(plant, MRPSatellite):
+            raise ArgumentTypeError("plant", "a models.MRPSatellite", type(plant).__name__)
+        self.plant = plant
+        self._j0 = plant.inertia
+        self._j0_inv = plant.inertia_inv
+        self.mean_motion = plant.mean_motion
         self.target = np.zeros(3) if target is None else as_vector(target, "target", 3).copy()
         self.target.setflags(write=False)
         self.c1 = check_positive(c1, "c1")

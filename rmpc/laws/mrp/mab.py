@@ -66,7 +66,7 @@ class MAB(CFBackstepping):
 
     Parameters
     ----------
-    model : MRPSatellite
+    plant : MRPSatellite
         The controller's model (``J0``, ``n``).
     target : (3,) array_like, optional
         Target MRP relative to the orbital frame (default 0).
@@ -106,11 +106,11 @@ class MAB(CFBackstepping):
     True
     """
 
-    short_name = "MAB"
+    name = "MAB"
 
     def __init__(
         self,
-        model: MRPSatellite,
+        plant: MRPSatellite,
         target: Any = None,
         *,
         c1: float = 0.5,
@@ -121,10 +121,10 @@ class MAB(CFBackstepping):
         dt: float = 0.01,
         u_max: Any = None,
     ) -> None:
-        super().__init__(model, target, c1=c1, c2=c2, command_filter=command_filter, dt=dt, u_max=u_max)
+        super().__init__(plant, target, c1=c1, c2=c2, command_filter=command_filter, dt=dt, u_max=u_max)
         self.kappa = check_positive(kappa, "kappa")
         if isinstance(estimator, str) and estimator == "neso":
-            estimator = NESO.from_bandwidth(model.inertia)
+            estimator = NESO.from_bandwidth(plant.inertia)
         if estimator is not None and not isinstance(estimator, TorqueEstimator):
             raise ArgumentTypeError(
                 "estimator", "'neso', None or an object with n_states, initial_state, derivative, "

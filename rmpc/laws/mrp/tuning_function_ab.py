@@ -36,7 +36,7 @@ class TuningFunctionAB(ContinuousTimeController):
 
     Parameters
     ----------
-    model : MRPSatellite
+    plant : MRPSatellite
         The controller's model (``J0``, ``n``).
     target : (3,) array_like, optional
         Target MRP relative to the orbital frame (default 0).
@@ -68,11 +68,11 @@ class TuningFunctionAB(ContinuousTimeController):
     1.88
     """
 
-    short_name = "TFAB"
+    name = "TFAB"
 
     def __init__(
         self,
-        model: MRPSatellite,
+        plant: MRPSatellite,
         target: Any = None,
         *,
         c1: float = 0.5,
@@ -82,12 +82,12 @@ class TuningFunctionAB(ContinuousTimeController):
         u_max: Any = None,
     ) -> None:
         super().__init__(dt, u_max)
-        if not isinstance(model, MRPSatellite):
-            raise ArgumentTypeError("model", "a models.MRPSatellite", type(model).__name__)
-        self.model = model
-        self._j0 = model.inertia
-        self._j0_inv = model.inertia_inv
-        self.mean_motion = model.mean_motion
+        if not isinstance(plant, MRPSatellite):
+            raise ArgumentTypeError("plant", "a models.MRPSatellite", type(plant).__name__)
+        self.plant = plant
+        self._j0 = plant.inertia
+        self._j0_inv = plant.inertia_inv
+        self.mean_motion = plant.mean_motion
         self.target = np.zeros(3) if target is None else as_vector(target, "target", 3).copy()
         self.target.setflags(write=False)
         self.c1 = check_positive(c1, "c1")

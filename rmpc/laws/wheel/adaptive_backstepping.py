@@ -45,25 +45,21 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from models import WheelSatellite
 from models.attitude.euler import kinematics_matrix
 from models.attitude.euler_inverse import inverse_kinematics_matrix, inverse_kinematics_rate
-from rmpc.controller import StepInfo
+from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_pd, check_positive
 
 __all__ = ["ABFTCRates", "AdaptiveBacksteppingFTC", "wrap_angle"]
 
-#: Status of a step taken at ``|theta| >= singular_pitch`` (zero command, no adaptation).
-SINGULAR = "singular"
 #: Default singularity guard: ``|theta| >= 85 deg`` (**assumed**), in rad.
 SINGULAR_PITCH: float = math.radians(85.0)
-#: Status once the adaptive states are no longer finite or exceed ``divergence_bound``.
-DIVERGED = "diverged"
 
 
 def wrap_angle(angle: float) -> float:
@@ -119,9 +115,9 @@ class AdaptiveBacksteppingFTC:
 
     Parameters
     ----------
-    satellite : WheelSatellite
+    plant : WheelSatellite
         The nominal design model: ``J``, ``D``, the gravity model and the wheel limits (for
-        ``freeze``). The plant it runs on may differ (S4's inertia error).
+        ``freeze``). The satellite it runs on may differ (S4's inertia error).
     c1, c2 : float
         Backstepping gains (defaults 0.5 and 3, paper W, **certain**).
     gamma_g : float or (3, 3) array_like
@@ -160,6 +156,8 @@ class AdaptiveBacksteppingFTC:
     ----------
     name : str
         ``"ABFTC"``, the record name in reports.
+    plant : WheelSatellite
+        The design model.
     last : StepInfo or None
         Status ``"ok"`` (or ``"singular"``, ``"diverged"``), ``solve_time`` (the step's time)
         and ``extra``: ``t``, ``nu0``, ``e1``, ``e2``, ``frozen``, ``g_hat_eig`` (min and max
@@ -178,10 +176,11 @@ class AdaptiveBacksteppingFTC:
     """
 
     name = "ABFTC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,
-        satellite: WheelSatellite,
+        plant: WheelSatellite,
         *,
         c1: float = 0.5,
         c2: float = 3.0,
@@ -197,10 +196,10 @@ class AdaptiveBacksteppingFTC:
         singular_pitch: float = SINGULAR_PITCH,
         divergence_bound: float = 1e6,
     ) -> None:
-        if not isinstance(satellite, WheelSatellite):
-            raise ArgumentTypeError("satellite", "a models.WheelSatellite", type(satellite).__name__)
-        self.satellite = satellite
-        m = satellite.n_wheels
+        if not isinstance(plant, WheelSatellite):
+            raise ArgumentTypeError("plant", "a models.WheelSatellite", type(plant).__name__)
+        self.plant = plant
+        m = plant.n_wheels
         self.c1 = check_positive(c1, "c1")
         self.c2 = check_positive(c2, "c2")
         self.gamma_g = _gain_matrix(gamma_g, "gamma_g")
@@ -214,8 +213,8 @@ class AdaptiveBacksteppingFTC:
             )
         self.dt = check_positive(dt, "dt")
         self.basis_frequencies = self._basis_spec(basis_frequencies, m)
-        self._g2 = satellite.input_matrix
-        self.g_nom = satellite.nominal_gain()
+        self._g2 = plant.input_matrix
+        self.g_nom = plant.nominal_gain()
         self.g_hat0 = self.g_nom.copy() if g_hat0 is None else as_matrix(g_hat0, "g_hat0", (3, 3))
         self.projection = self._radii(projection)
         self.leakage = check_positive(leakage, "leakage", allow_zero=True)
@@ -229,8 +228,8 @@ class AdaptiveBacksteppingFTC:
         self.divergence_bound = check_positive(divergence_bound, "divergence_bound")
         self._gamma_g_inv = np.linalg.inv(self.gamma_g)
         self._gamma_theta_inv = tuple(np.linalg.inv(g) for g in self.gamma_theta)
-        self._j_inv = satellite.inertia_inv
-        self._j = satellite.inertia
+        self._j_inv = plant.inertia_inv
+        self._j = plant.inertia
         self.last: StepInfo | None = None
         self.reset()
 
@@ -290,15 +289,15 @@ class AdaptiveBacksteppingFTC:
         k_inv = inverse_kinematics_matrix(phi, theta)
         alpha1 = k_inv @ (-self.c1 * e1)
         e2 = w - alpha1
-        torque = self.satellite.gravity_torque(x[:3]) - np.cross(w, self._j @ w)
+        torque = self.plant.gravity_torque(x[:3]) - np.cross(w, self._j @ w)
         if self.gyroscopic_compensation:
-            if x.shape[0] < 6 + self.satellite.n_wheels:
+            if x.shape[0] < 6 + self.plant.n_wheels:
                 raise InvalidArgumentError(
                     "x",
                     "the full state with wheel momenta (gyroscopic_compensation=True)",
                     f"{x.shape[0]} entries",
                 )
-            torque = torque - np.cross(w, self.satellite.wheels.D @ x[6 : 6 + self.satellite.n_wheels])
+            torque = torque - np.cross(w, self.plant.wheels.D @ x[6 : 6 + self.plant.n_wheels])
         f2 = self._j_inv @ torque
         eta_dot = k_mat @ w
         k_inv_dot = inverse_kinematics_rate(phi, theta, eta_dot[0], eta_dot[1])
@@ -367,9 +366,9 @@ class AdaptiveBacksteppingFTC:
 
         For tests and reports (the controller itself never sees these).
         """
-        m = self.satellite.n_wheels
+        m = self.plant.n_wheels
         sig = as_vector(sigma, "sigma", m)
-        g_true = self.satellite.nominal_gain(sig)
+        g_true = self.plant.nominal_gain(sig)
         thetas = []
         for j in range(m):
             q = 1 + len(self.basis_frequencies[j])
@@ -378,25 +377,26 @@ class AdaptiveBacksteppingFTC:
         return g_true, thetas
 
     # -- the sampled controller ----------------------------------------------------------------------
-    def step(self, x: Any) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the wheel commands for the measured state and advance the estimates over ``Ts``."""
         start = time.perf_counter()
-        n_full = 6 + self.satellite.n_wheels
+        check_step_inputs(inputs, self.accepts, self.name)
+        n_full = 6 + self.plant.n_wheels
         x = as_vector(x, "x")
         if x.shape[0] not in (6, n_full):
             raise InvalidArgumentError("x", f"a state of length 6 or {n_full}", f"length {x.shape[0]}")
         t = self.t
         self.k += 1
         if abs(x[1]) >= self.singular_pitch or self._diverged:
-            status = DIVERGED if self._diverged else SINGULAR
+            status = Status.DIVERGED if self._diverged else Status.SINGULAR
             self.last = StepInfo(
                 status=status, solve_time=time.perf_counter() - start, extra={"t": t, "frozen": True}
             )
-            return np.zeros(self.satellite.n_wheels)
+            return np.zeros(self.plant.n_wheels)
         rates = self.law(t, x, self.g_hat, self.theta_hat)
         frozen = False
         if self.freeze:
-            wheels = self.satellite.wheels
+            wheels = self.plant.wheels
             frozen = bool(np.any(np.abs(rates.nu) > wheels.torque_max))
             if x.shape[0] == n_full:
                 frozen = frozen or bool(np.any(np.abs(x[6:]) >= wheels.momentum_max))
@@ -416,14 +416,14 @@ class AdaptiveBacksteppingFTC:
         ):
             self._diverged = True
             self.last = StepInfo(
-                status=DIVERGED,
+                status=Status.DIVERGED,
                 solve_time=time.perf_counter() - start,
                 extra={"t": t, "frozen": True, "g_hat_norm": g_norm, "theta_norm": norms},
             )
-            return np.zeros(self.satellite.n_wheels)
+            return np.zeros(self.plant.n_wheels)
         eig = np.linalg.eigvalsh(0.5 * (self.g_hat + self.g_hat.T))
         self.last = StepInfo(
-            status="ok",
+            status=Status.OK,
             solve_time=time.perf_counter() - start,
             extra={
                 "t": t,
@@ -455,7 +455,7 @@ class AdaptiveBacksteppingFTC:
             "freeze": self.freeze,
             "gyroscopic_compensation": self.gyroscopic_compensation,
             "singular_pitch_deg": math.degrees(self.singular_pitch),
-            "gravity": self.satellite.gravity,
+            "gravity": self.plant.gravity,
         }
 
     def __repr__(self) -> str:
