@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from lmi.backends.clarabel import ClarabelKothare, RawResult
+from lmi.backends.base import KothareBackend, RawResult
+from lmi.backends.clarabel import ClarabelKothare
 from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
@@ -20,9 +21,6 @@ from lmi.infeasibility import InfeasibilityCertificate
 from lmi.status import OPTIMAL, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
-
-if TYPE_CHECKING:
-    from lmi.backends.cvxpy import CvxpyKothare
 
 __all__ = ["KothareProblem", "LMISolution"]
 
@@ -135,7 +133,7 @@ class KothareProblem:
         (a congruence; same optimum, better conditioned at small ``dt``); ``"delta_shared"``
         also lifts the common ``Q1``/``R`` part into one shared block so each vertex cone
         shrinks to ``2n``;
-        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backends.clarabel`.
+        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backends.conic`.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed relative LMI margin is ``>= -tol``.
 
@@ -184,7 +182,7 @@ class KothareProblem:
         if backend == "clarabel":
             if solver not in (None, "clarabel", "CLARABEL"):
                 raise InvalidArgumentError("solver", "None with backend='clarabel'", repr(solver))
-            self._backend: ClarabelKothare | CvxpyKothare | IPMKothare = ClarabelKothare(
+            self._backend: KothareBackend = ClarabelKothare(
                 self.data, solver_options
             )
         elif backend == "ipm":

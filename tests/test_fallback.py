@@ -86,8 +86,9 @@ def test_rmpc_and_scheduled_rmpc_decide_through_the_same_class(monkeypatch: pyte
         assert ctrl.last.fallback and ctrl.last.extra["had_gain"] is True
         np.testing.assert_array_equal(u_far, gain @ FAR)
         np.testing.assert_array_equal(u_near, gain @ NEAR)
-        ctrl.step(np.array([1e-12]))
+        u_hold = ctrl.step(np.array([1e-12]))
         assert ctrl.last.status == Status.REUSED and ctrl.last.extra["reason"] == "near origin"
+        np.testing.assert_array_equal(u_hold, gain @ np.array([1e-12]))
     assert owners == ["RMPC", "RMPC", "ScheduledRMPC", "ScheduledRMPC"]
     rmpc.step(FAR)
     assert rmpc.last.extra["inside_ellipsoid"] is False
