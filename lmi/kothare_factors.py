@@ -9,7 +9,7 @@ matrix variable ``X`` (``Q``, ``Y``, ``W`` or ``gamma I``). The columns of all t
 ``B~ = B/dt``, ``s = sqrt(dt)``), the dictionary is ``[[-A~, -B~, I, 0], [s A~, s B~, 0, I]]``
 (``3n + m`` columns) and the block has about ``5 n^2 / 2 + m n`` entries, against ``n^3`` non-zero
 coefficient entries in the block's own coordinates; the Schur complement's share of the block
-then costs the square of the first number (:func:`lmi.ipm_kernels.scaling_and_schur_direct`).
+then costs the square of the first number (:func:`lmi.ipm.kernels.scaling_and_schur_direct`).
 
 The solver checks that each factored form reproduces the block's coefficients (to 1e-9
 relative) when it is given, so a factor that does not match is an error, not a wrong answer.
