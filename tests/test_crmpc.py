@@ -4,7 +4,7 @@ Two adaptation laws are tested: paper P's MIT rule (``adaptation=MITRule()``, th
 the earlier behaviour ``torque_budget="none"``: the RMPC bound applies to ``u_rmpc`` only) and the
 default Lyapunov rule with the torque budget (the second half); then CRMPC's composition: the
 adaptation objects bound to the plant, the one interface the step loop calls, and the bound the
-inner RMPC gets through :class:`rmpc.StepInputs`.
+inner RMPC gets through :class:`rmpc.controller.StepInputs`.
 
 MIT rule, scenario E4 of SPEC 3 on the nonlinear satellite of paper P: initial attitude of paper
 P, the polytope of a +-30 % scalar inertia uncertainty linearised at it (``Ts = 0.01`` s),
@@ -537,10 +537,10 @@ class _ConstantRule(AdaptationRule):
         self.value = np.asarray(theta, dtype=float)
         self.calls: list[str] = []
 
-    def _bind(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
+    def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
         self.calls = []
 
-    def _reset_model(self) -> None:
+    def reset_model(self) -> None:
         self.calls.append("reset")
 
     def update(self, z: np.ndarray) -> AdaptationStep:

@@ -104,8 +104,10 @@ class AdaptationStep:
 class AdaptationRule(ABC):
     """An adaptation rule of CRMPC: its settings, and once bound its reference model and estimate.
 
-    Subclasses set :attr:`name` and implement :meth:`rate`, ``_bind``, :meth:`update` and
-    :meth:`advance`.
+    A rule sets :attr:`name` and implements four methods: :meth:`prepare` and
+    :meth:`reset_model`, which :meth:`bind` and :meth:`reset` call, and :meth:`update` and
+    :meth:`advance`, which CRMPC's step loop calls; the base class holds the estimate
+    (:attr:`estimate`, a :class:`~rmpc.mpc.mras.ParameterIntegrator` with the projection).
     """
 
     #: The rule's name in reports (``"lyapunov"``, ``"mit"``).
@@ -139,12 +141,13 @@ class AdaptationRule(ABC):
         dt = check_positive(dt, "dt")
         bound_rule = copy.copy(self)
         bound_rule._estimate = ParameterIntegrator(b_mat.shape[1], dt, bound=bound)
-        bound_rule._bind(a_mat, b_mat, dt)
+        bound_rule.prepare(a_mat, b_mat, dt)
         return bound_rule
 
     @abstractmethod
-    def _bind(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
-        """Set up the reference model for the checked nominal model."""
+    def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
+        """Set up the reference model for the checked nominal model (called by :meth:`bind` on the
+        copy, after :attr:`estimate` exists); check the settings that need the model here."""
 
     @property
     def estimate(self) -> ParameterIntegrator:
@@ -162,11 +165,11 @@ class AdaptationRule(ABC):
     def reset(self) -> None:
         """Return to ``theta = 0`` and forget the reference model (a bound rule only)."""
         self.estimate.reset()
-        self._reset_model()
+        self.reset_model()
 
     @abstractmethod
-    def _reset_model(self) -> None:
-        """Forget the reference model's state."""
+    def reset_model(self) -> None:
+        """Forget the reference model's state (called by :meth:`reset` and :meth:`prepare`)."""
 
     @abstractmethod
     def update(self, z: np.ndarray) -> AdaptationStep:
@@ -265,12 +268,12 @@ class LyapunovRule(AdaptationRule):
         # in the range of B'; components of theta that B maps to zero are left where they are.
         return self.gain * (np.linalg.pinv(gram, rcond=RANK_TOL, hermitian=True) @ (pb.T @ e))
 
-    def _bind(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
+    def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
         self._a, self._b = a, b
         self._b_delta = b / dt
-        self._reset_model()
+        self.reset_model()
 
-    def _reset_model(self) -> None:
+    def reset_model(self) -> None:
         self._zm: np.ndarray | None = None
         self._p: np.ndarray | None = None
 
@@ -389,7 +392,7 @@ class MITRule(AdaptationRule):
             grad = grad / (self.alpha + float(np.sum(sens * sens)))
         return -self.gain * grad
 
-    def _bind(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
+    def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
         n, m = b.shape
         self._a, self._b = a, b
         self._reset_steps = 0
@@ -415,9 +418,9 @@ class MITRule(AdaptationRule):
         self._c_e = c_e
         self._sens = SensitivityFilter(a, b, c_e, columns=m)
         self._minus_eye = -np.eye(m)
-        self._reset_model()
+        self.reset_model()
 
-    def _reset_model(self) -> None:
+    def reset_model(self) -> None:
         self._sens.reset()
         self._zm: np.ndarray | None = None
         self._since_reset = 0

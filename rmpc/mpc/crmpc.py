@@ -104,7 +104,7 @@ class CRMPC:
     name : str
         ``"CRMPC"``.
     accepts : frozenset of str
-        Empty: :meth:`step` takes no :class:`~rmpc.StepInputs`.
+        Empty: :meth:`step` takes no :class:`~rmpc.controller.StepInputs`.
     rmpc : RMPC
         The inner robust MPC (built once, with ``u_max - theta_bound`` for the ``"split"``
         budget).
@@ -270,7 +270,7 @@ class CRMPC:
     def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Adapt ``theta`` from the measured state, then return ``u = u_rmpc - theta``.
 
-        ``inputs`` must be ``None`` or an empty :class:`~rmpc.StepInputs` (:attr:`accepts`).
+        ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).
         """
         x = as_vector(x, "x", self.plant.n_states)
         check_step_inputs(inputs, self.accepts, "CRMPC")

@@ -74,7 +74,7 @@ class RMPC:
         ``"RMPC"``.
     accepts : frozenset of str
         ``{"u_max"}``: :meth:`step` takes a bound for one step through
-        :class:`~rmpc.StepInputs`.
+        :class:`~rmpc.controller.StepInputs`.
     last : StepInfo or None
         The last step: ``status``, ``solve_time``, ``gamma``, ``iterations``, ``fallback``, and
         ``extra["solution"]`` (the :class:`lmi.LMISolution`, ``None`` if no solve was made).

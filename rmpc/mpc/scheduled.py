@@ -57,7 +57,7 @@ class ScheduledRMPC:
     name : str
         ``"ScheduledRMPC"``.
     accepts : frozenset of str
-        Empty: :meth:`step` takes no :class:`~rmpc.StepInputs`.
+        Empty: :meth:`step` takes no :class:`~rmpc.controller.StepInputs`.
     last : StepInfo or None
         As for :class:`~rmpc.RMPC`; ``extra["build_time"]`` is the time spent building the
         polytope and the problem (s), which ``solve_time`` does not include.
@@ -178,7 +178,7 @@ class ScheduledRMPC:
     def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Rebuild the polytope at ``x``, solve, and return ``u = F x``.
 
-        ``inputs`` must be ``None`` or an empty :class:`~rmpc.StepInputs` (:attr:`accepts`).
+        ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).
         """
         x = as_vector(x, "x", self.n_states)
         check_step_inputs(inputs, self.accepts, "ScheduledRMPC")
