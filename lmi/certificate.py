@@ -98,7 +98,7 @@ def certify(
     )
     q1h, rh = data.Q1h, data.Rh
     # The vertex LMIs, all vertices stacked (one batched eigenvalue call per form), as printed
-    # and after the exact congruence of the delta form (see lmi.backends.clarabel): at small dt
+    # and after the exact congruence of the delta form (see lmi.backends.conic): at small dt
     # the printed form's relative margin hides violations of order dt (a "standard" 8-vertex
     # solve 4e-5 below the optimum had margin -2.4e-9 there but -1.2e-5 in the delta form), so
     # both must hold.

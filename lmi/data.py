@@ -17,11 +17,13 @@ from toolkit_common.validation import (
     check_psd,
 )
 
-__all__ = ["InputConstraint", "KothareData", "build_kothare_data", "psd_factor"]
+__all__ = ["InputConstraint", "KothareData", "build_kothare_data", "input_bound_vector", "psd_factor"]
 
 InputConstraint = Literal["ellipsoid", "peak"] | None
 Formulation = Literal["delta", "delta_shared", "standard"]
 FORMULATIONS: tuple[str, ...] = ("delta", "delta_shared", "standard")
+#: The kinds of input constraint.
+INPUT_CONSTRAINTS: tuple[str | None, ...] = ("ellipsoid", "peak", None)
 
 
 def psd_factor(mat: np.ndarray, tol: float = 1e-12) -> np.ndarray:
@@ -89,6 +91,40 @@ def _bound_vector(value: Any, name: str, size: int) -> np.ndarray:
     return vec
 
 
+def input_bound_vector(input_constraint: InputConstraint, u_max: Any, m: int) -> np.ndarray:
+    """The input bound of a problem as :class:`KothareData` holds it, checked against its kind.
+
+    ``(1,)`` for ``"ellipsoid"`` (``u_max`` a scalar), ``(m,)`` for ``"peak"`` (a scalar for
+    every input or one bound per input), empty for ``None`` (``u_max`` must be ``None``). Every
+    error names ``input_constraint`` or ``u_max``. A controller built around a Kothare problem
+    (:class:`rmpc.CRMPC`) uses it to know the bound before it builds the problem.
+
+    Examples
+    --------
+    >>> from lmi.data import input_bound_vector
+    >>> input_bound_vector("ellipsoid", 2.0, 3).tolist(), input_bound_vector("peak", 2.0, 3).tolist()
+    ([2.0], [2.0, 2.0, 2.0])
+    """
+    check_choice(input_constraint, "input_constraint", INPUT_CONSTRAINTS)
+    if input_constraint is None:
+        if u_max is not None:
+            raise InvalidArgumentError(
+                "u_max", "None when input_constraint is None", repr(u_max)
+            )
+        return np.zeros(0)
+    if u_max is None:
+        raise InvalidArgumentError(
+            "u_max", f"a bound > 0 for input_constraint={input_constraint!r}", "None"
+        )
+    if input_constraint == "ellipsoid":
+        if np.ndim(u_max) != 0:
+            raise InvalidArgumentError(
+                "u_max", "a scalar for input_constraint='ellipsoid'", repr(u_max)
+            )
+        return np.array([check_positive(u_max, "u_max")])
+    return _bound_vector(u_max, "u_max", m)
+
+
 def build_kothare_data(
     A: Any,
     B: Any,
@@ -130,27 +166,9 @@ def build_kothare_data(
     q1 = check_psd(as_matrix(Q, "Q", (n, n)), "Q")
     r = check_pd(as_matrix(R, "R", (m, m)), "R")
     dt = check_positive(dt, "dt")
-    check_choice(input_constraint, "input_constraint", ("ellipsoid", "peak", None))
+    check_choice(input_constraint, "input_constraint", INPUT_CONSTRAINTS)
     check_choice(formulation, "formulation", FORMULATIONS)
-    if input_constraint is None:
-        if u_max is not None:
-            raise InvalidArgumentError(
-                "u_max", "None when input_constraint is None", repr(u_max)
-            )
-        umax = np.zeros(0)
-    else:
-        if u_max is None:
-            raise InvalidArgumentError(
-                "u_max", f"a bound > 0 for input_constraint={input_constraint!r}", "None"
-            )
-        if input_constraint == "ellipsoid":
-            if np.ndim(u_max) != 0:
-                raise InvalidArgumentError(
-                    "u_max", "a scalar for input_constraint='ellipsoid'", repr(u_max)
-                )
-            umax = np.array([check_positive(u_max, "u_max")])
-        else:
-            umax = _bound_vector(u_max, "u_max", m)
+    umax = input_bound_vector(input_constraint, u_max, m)
     if (output_matrix is None) != (y_max is None):
         raise InvalidArgumentError(
             "output_matrix", "output_matrix and y_max given together", "only one of them"

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from lmi.backends.clarabel import ClarabelKothare, RawResult
+from lmi.backends.base import KothareBackend, RawResult
+from lmi.backends.clarabel import ClarabelKothare
 from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
@@ -20,9 +21,6 @@ from lmi.infeasibility import InfeasibilityCertificate
 from lmi.status import OPTIMAL, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
-
-if TYPE_CHECKING:
-    from lmi.backends.cvxpy import CvxpyKothare
 
 __all__ = ["KothareProblem", "LMISolution"]
 
@@ -135,7 +133,7 @@ class KothareProblem:
         (a congruence; same optimum, better conditioned at small ``dt``); ``"delta_shared"``
         also lifts the common ``Q1``/``R`` part into one shared block so each vertex cone
         shrinks to ``2n``;
-        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backends.clarabel`.
+        ``"standard"`` is eq. (14) as printed. See :mod:`lmi.backends.conic`.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed relative LMI margin is ``>= -tol``.
 
@@ -184,7 +182,7 @@ class KothareProblem:
         if backend == "clarabel":
             if solver not in (None, "clarabel", "CLARABEL"):
                 raise InvalidArgumentError("solver", "None with backend='clarabel'", repr(solver))
-            self._backend: ClarabelKothare | CvxpyKothare | IPMKothare = ClarabelKothare(
+            self._backend: KothareBackend = ClarabelKothare(
                 self.data, solver_options
             )
         elif backend == "ipm":
@@ -230,12 +228,32 @@ class KothareProblem:
             raise InvalidArgumentError(
                 "x", "a non-zero state (the problem is degenerate at the origin)", "x = 0"
             )
-        data = self.data if u_max is None else self._with_bound(u_max)
+        data = self.data if u_max is None else dataclasses.replace(self.data, u_max=self.input_bound(u_max))
         raw: RawResult = self._backend.solve(x / scale, data.u_max / scale, data.y_max / scale)
         return self._finish(raw, x, scale, data)
 
-    def _with_bound(self, u_max: Any) -> KothareData:
-        """The problem data with another input bound of the same kind (checked)."""
+    def input_bound(self, u_max: Any) -> np.ndarray:
+        """``u_max`` checked as an input bound of this problem's kind, as the problem holds it.
+
+        The form :meth:`solve` takes for a per-solve bound: a scalar (or a one-element array) for
+        the ellipsoid, a scalar or an ``(m,)`` vector for the peak bound; the result is the
+        ``(1,)`` or ``(m,)`` vector ``u_max`` of :class:`~lmi.KothareData`.
+
+        Raises
+        ------
+        InvalidArgumentError
+            Naming ``u_max``: a bound of the wrong size, not positive, or any bound for a
+            problem without an input constraint.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from lmi import KothareProblem
+        >>> prob = KothareProblem([[1.0]], [[1.0, 0.5]], Q=[[1.0]], R=np.eye(2),
+        ...                       input_constraint="peak", u_max=1.0)
+        >>> prob.input_bound(0.5).tolist(), prob.input_bound([0.2, 0.3]).tolist()
+        ([0.5, 0.5], [0.2, 0.3])
+        """
         kind = self.data.input_constraint
         if kind is None:
             raise InvalidArgumentError("u_max", "None (the problem has no input constraint)", repr(u_max))
@@ -251,7 +269,7 @@ class KothareProblem:
                 bound = as_vector(u_max, "u_max", self.data.m)
                 if np.any(bound <= 0.0):
                     raise InvalidArgumentError("u_max", "bounds > 0", repr(bound.tolist()))
-        return dataclasses.replace(self.data, u_max=bound)
+        return bound
 
     def _finish(
         self, raw: RawResult, x: np.ndarray, scale: float, data: KothareData | None = None

@@ -1,6 +1,6 @@
 """The Kothare LMIs' coefficients in factored form ``A_i = D N_i D'`` (for :mod:`lmi.ipm`).
 
-Each cost LMI of :class:`lmi.backends.clarabel.ClarabelKothare` is a sum of terms
+Each cost LMI of :class:`lmi.backends.conic.KothareConic` is a sum of terms
 ``E X F' + F X' E'`` (or ``E X E'`` for a symmetric ``X``) with constant ``E``, ``F`` and a
 matrix variable ``X`` (``Q``, ``Y``, ``W`` or ``gamma I``). The columns of all the ``E`` and
 ``F`` of a block form its dictionary ``D``; in those coordinates every variable's coefficient
@@ -9,7 +9,7 @@ matrix variable ``X`` (``Q``, ``Y``, ``W`` or ``gamma I``). The columns of all t
 ``B~ = B/dt``, ``s = sqrt(dt)``), the dictionary is ``[[-A~, -B~, I, 0], [s A~, s B~, 0, I]]``
 (``3n + m`` columns) and the block has about ``5 n^2 / 2 + m n`` entries, against ``n^3`` non-zero
 coefficient entries in the block's own coordinates; the Schur complement's share of the block
-then costs the square of the first number (:func:`lmi.ipm_kernels.scaling_and_schur_direct`).
+then costs the square of the first number (:func:`lmi.ipm.kernels.scaling_and_schur_direct`).
 
 The solver checks that each factored form reproduces the block's coefficients (to 1e-9
 relative) when it is given, so a factor that does not match is an error, not a wrong answer.
@@ -38,7 +38,7 @@ class VariableLayout:
 
     @classmethod
     def of(cls, n: int, m: int, o_q: int, o_y: int, o_w: int | None) -> VariableLayout:
-        """The layout of :class:`~lmi.backends.clarabel.ClarabelKothare` (``gamma`` first, then
+        """The layout of :class:`~lmi.backends.conic.KothareConic` (``gamma`` first, then
         ``svec(Q)`` upper triangle column by column, ``vec(Y)`` row-major, ..., ``svec(W)``)."""
         return cls(0, _symmetric_map(n, o_q), o_y + np.arange(m * n).reshape(m, n),
                    None if o_w is None else _symmetric_map(n, o_w))

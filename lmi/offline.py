@@ -69,7 +69,7 @@ def interpolation_margin(data: KothareData, q_outer: np.ndarray, f_inner: np.nda
 
     ``Q_i^-1 - M_j' Q_i^-1 M_j > 0`` with ``M_j = A_j + B_j F_{i+1}`` is, after the congruence
     with ``Q_i`` and division by ``dt``, ``[[-(H_j + H_j'), sqrt(dt) H_j'], [sqrt(dt) H_j, Q_i]] > 0``
-    with ``H_j = (M_j - I) Q_i / dt`` (the delta form of :mod:`lmi.backends.clarabel`, exact for
+    with ``H_j = (M_j - I) Q_i / dt`` (the delta form of :mod:`lmi.backends.conic`, exact for
     any ``dt`` and well conditioned when ``M_j`` is close to ``I``). Returns the smallest
     relative eigenvalue over the vertices; the condition holds when it is ``> 0``.
     """
@@ -233,7 +233,7 @@ class NestedKothareProblem:
         self._base = CvxpyKothare(self.data, solver, solver_options)
         n = self.data.n
         base = self._base
-        # gamma_s = dt gamma in the delta formulations (see lmi.backends.clarabel).
+        # gamma_s = dt gamma in the delta formulations (see lmi.backends.conic).
         self._gamma_scale = 1.0 if formulation == "standard" else self.data.dt
         self._outer = cp.Parameter((n, n), symmetric=True)
         extra = [self._outer - base.Qv >> 0]

@@ -1,7 +1,8 @@
 """Astrom & Wittenmark's example 5.2 (Adaptive Control, 2nd ed.): the textbook check of the MIT rule.
 
-A reproduction for the tests of :class:`rmpc.mpc.adaptation.MITRule` and
-:class:`~rmpc.mpc.adaptation.SensitivityFilter` (the outside reference of the MIT rule): the
+A reproduction for the tests of :class:`rmpc.mpc.adaptation.MITRule` (its rate),
+:class:`~rmpc.mpc.mras.ParameterIntegrator` and :class:`~rmpc.mpc.mras.SensitivityFilter` (the
+outside reference of the MIT rule): the
 adaptation of a feedforward and a feedback gain for a first-order plant, whose gains converge to
 4 and 2.
 """
@@ -13,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from rmpc.mpc.adaptation import MITRule, SensitivityFilter
+from rmpc.mpc.adaptation import MITRule
+from rmpc.mpc.mras import ParameterIntegrator, SensitivityFilter
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_positive, check_real
 
@@ -110,7 +112,8 @@ def example_5_2(
 
     Discretisation: the plant, the model and the two filters ``am / (p + am)`` are sampled
     exactly with a zero-order hold at ``dt``; the control is held over each sample; the
-    gains are integrated by :class:`MITRule` (``Ts / (1 - z^-1)``).
+    gains follow :meth:`MITRule.rate`, integrated by a :class:`ParameterIntegrator`
+    (``Ts / (1 - z^-1)``).
 
     Parameters
     ----------
@@ -162,7 +165,8 @@ def example_5_2(
     plant_b = b * dt if a == 0.0 else b * (1.0 - plant_a) / a
     model_a = float(np.exp(-am * dt))
     model_b = bm * (1.0 - model_a) / am
-    rule = MITRule(2, gamma, dt, normalized=normalized, alpha=alpha, theta0=theta0)
+    rule = MITRule(gamma, normalized=normalized, alpha=alpha)
+    gains = ParameterIntegrator(2, dt, theta0=theta0)
     filt_uc = SensitivityFilter.first_order(am, dt)
     filt_y = SensitivityFilter.first_order(am, dt)
 
@@ -178,8 +182,8 @@ def example_5_2(
             # The sensitivities of e(k): filtered uc and y up to k - 1, with their signs.
             sens[0, 0] = filt_uc.c[0, 0] * filt_uc._state[0]
             sens[0, 1] = -filt_y.c[0, 0] * filt_y._state[0]
-            rule._gradient_step(np.array([y[k] - ym[k]]), sens)
-        theta[k] = rule._theta
+            gains._integrate(rule._rate(np.array([y[k] - ym[k]]), sens))
+        theta[k] = gains._theta
         u[k] = theta[k, 0] * uc[k] - theta[k, 1] * y[k]
         if k == n_steps:
             break

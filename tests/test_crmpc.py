@@ -1,8 +1,10 @@
 """CRMPC (robust MPC + MRAS, paper P) against a constant input disturbance, and its MRAS layer alone.
 
-Two adaptation laws are tested: paper P's MIT rule (``rule="mit"``, the first half, with the
-earlier behaviour ``torque_budget="none"``: the RMPC bound applies to ``u_rmpc`` only) and the
-default Lyapunov rule with the torque budget (the second half).
+Two adaptation laws are tested: paper P's MIT rule (``adaptation=MITRule()``, the first half, with
+the earlier behaviour ``torque_budget="none"``: the RMPC bound applies to ``u_rmpc`` only) and the
+default Lyapunov rule with the torque budget (the second half); then CRMPC's composition: the
+adaptation objects bound to the plant, the one interface the step loop calls, and the bound the
+inner RMPC gets through :class:`rmpc.controller.StepInputs`.
 
 MIT rule, scenario E4 of SPEC 3 on the nonlinear satellite of paper P: initial attitude of paper
 P, the polytope of a +-30 % scalar inertia uncertainty linearised at it (``Ts = 0.01`` s),
@@ -24,8 +26,9 @@ import pytest
 
 from models import PolytopicModel, RigidSatellite
 from rmpc import CRMPC, RMPC, ConstantDisturbance, StepDisturbance, simulate
-from rmpc.controller import StepInfo
+from rmpc.controller import StepInfo, StepInputs
 from rmpc.errors import ArgumentTypeError, InvalidArgumentError
+from rmpc.mpc.adaptation import DEFAULT_GAIN_PLAIN, AdaptationRule, AdaptationStep, LyapunovRule, MITRule
 
 Q1 = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
 R1 = np.eye(3)
@@ -59,7 +62,8 @@ def _last_time_above(traj: Any, level: float) -> float:
 
 @pytest.fixture(scope="module")
 def e4_crmpc(sat: RigidSatellite, plant: PolytopicModel) -> Any:
-    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, rule="mit", torque_budget="none", rmpc_options=RMPC_OPTIONS)
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=MITRule(), torque_budget="none",
+                 rmpc_options=RMPC_OPTIONS)
     traj = simulate(
         ctrl, sat, sat.initial_state(), duration=30.0, dt=0.01, disturbance=StepDisturbance(D_E4, ONSET)
     )
@@ -127,7 +131,7 @@ def test_plain_rmpc_keeps_an_offset(sat: RigidSatellite, plant: PolytopicModel) 
 
 
 def test_zero_adaptation_gain_is_plain_rmpc(plant: PolytopicModel, sat: RigidSatellite) -> None:
-    crmpc = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation_gain=0.0)
+    crmpc = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=LyapunovRule(gain=0.0))
     rmpc = RMPC(plant, Q=Q1, R=R1, u_max=1.0)
     for scale in (1.0, 0.5, 0.2):
         x = sat.initial_state(scale)
@@ -145,6 +149,7 @@ class _FixedGain:
         self._gain = gain
         self.x_ref = np.zeros(gain.shape[1])
         self.last: StepInfo | None = None
+        self.inputs: list[StepInputs | None] = []
 
     @property
     def gain(self) -> np.ndarray:
@@ -153,8 +158,9 @@ class _FixedGain:
     def reset(self) -> None:
         self.last = None
 
-    def step(self, x: np.ndarray, u_max: Any = None) -> np.ndarray:
-        self.last = StepInfo(status="ok")  # a fixed gain: a law in closed form
+    def step(self, x: np.ndarray, inputs: StepInputs | None = None) -> np.ndarray:
+        self.inputs.append(inputs)
+        self.last = StepInfo(status="ok")
         return self._gain @ x
 
 
@@ -169,9 +175,11 @@ def fixed_gain(plant: PolytopicModel, sat: RigidSatellite) -> np.ndarray:
 D_LIN = np.array([0.2, -0.3, 0.1])
 
 
-def _linear_run(plant: PolytopicModel, gain: np.ndarray, duration: float, **options: Any) -> tuple[Any, Any]:
-    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, rule="mit", torque_budget="none", theta_bound=1.0, **options)
-    ctrl.rmpc = _FixedGain(gain)  # type: ignore[assignment]
+def _linear_run(plant: PolytopicModel, fixed: np.ndarray, duration: float, **options: Any) -> tuple[Any, Any]:
+    """The MIT rule with ``options`` around the fixed gain, on the nominal linear model."""
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=MITRule(**options), torque_budget="none",
+                 theta_bound=1.0)
+    ctrl.rmpc = _FixedGain(fixed)  # type: ignore[assignment]
     traj = simulate(ctrl, plant, np.zeros(6), duration=duration, disturbance=ConstantDisturbance(D_LIN))
     theta = np.array([info.extra["theta"] for info in traj.info])
     return traj, theta
@@ -210,10 +218,10 @@ def test_plain_mit_rule_fails_where_the_normalised_rule_converges(
     plant: PolytopicModel, fixed_gain: np.ndarray
 ) -> None:
     """The sensitivity grows like t^2 in each window: gamma = 1 already drives theta to its bound."""
-    _, plain = _linear_run(plant, fixed_gain, 30.0, normalized=False, adaptation_gain=1.0)
+    _, plain = _linear_run(plant, fixed_gain, 30.0, normalized=False, gain=1.0)
     assert np.max(np.abs(plain)) == pytest.approx(1.0)  # the projection bound u_max
     assert np.max(np.abs(plain[-1] - D_LIN)) > 0.1
-    _, slow = _linear_run(plant, fixed_gain, 30.0, normalized=False)  # default plain gain 0.3
+    _, slow = _linear_run(plant, fixed_gain, 30.0, normalized=False, gain=DEFAULT_GAIN_PLAIN)  # 0.3
     assert np.max(np.abs(slow)) < 0.5  # bounded ...
     assert np.max(np.abs(slow[-1] - D_LIN)) > 1e-3  # ... but not there after 30 s
 
@@ -225,7 +233,7 @@ def test_classical_reference_model_needs_resets_or_a_small_gain(
     for options, converges in (
         ({}, True),  # measured: within 1e-3 of d from 26.1 s
         ({"reset_period": None}, False),
-        ({"reset_period": None, "adaptation_gain": 0.5}, True),  # measured 22.6 s
+        ({"reset_period": None, "gain": 0.5}, True),  # measured 22.6 s
     ):
         _, theta = _linear_run(plant, fixed_gain, 30.0, reference_gain=fixed_gain, **options)
         assert bool(np.max(np.abs(theta[-1] - D_LIN)) < 1e-3) == converges, options
@@ -234,7 +242,7 @@ def test_classical_reference_model_needs_resets_or_a_small_gain(
 def test_reset_restarts_the_reference_model_at_the_measured_state(
     plant: PolytopicModel, sat: RigidSatellite
 ) -> None:
-    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, rule="mit", reset_period=0.02)
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=MITRule(reset_period=0.02))
     x0 = sat.initial_state()
     ctrl.step(x0)
     assert ctrl.last is not None and ctrl.last.extra["model_reset"]
@@ -257,28 +265,25 @@ def test_reset_restarts_the_reference_model_at_the_measured_state(
 @pytest.mark.parametrize(
     ("options", "argument"),
     [
-        ({"adaptation_gain": -1.0}, "adaptation_gain"),
-        ({"adaptation_gain": float("nan")}, "adaptation_gain"),
-        ({"rule": "mit", "alpha": 0.0}, "alpha"),
-        ({"rule": "mit", "reset_period": -2.0}, "reset_period"),
-        ({"rule": "mit", "reset_period": 0.001}, "reset_period"),
-        ({"rule": "mit", "reference_gain": np.zeros((3, 6))}, "reference_gain"),  # integrators: not Schur
-        ({"rule": "mit", "reference_gain": np.zeros((6, 3))}, "reference_gain"),
-        ({"rule": "mit", "error_output": np.zeros((3, 6))}, "error_output"),
-        ({"rule": "mit", "error_output": np.eye(3)}, "error_output"),
+        ({"adaptation": lambda: LyapunovRule(gain=-1.0)}, "gain"),
+        ({"adaptation": lambda: LyapunovRule(gain=float("nan"))}, "gain"),
+        ({"adaptation": lambda: MITRule(alpha=0.0)}, "alpha"),
+        ({"adaptation": lambda: MITRule(reset_period=-2.0)}, "reset_period"),
+        ({"adaptation": lambda: MITRule(reset_period=0.001)}, "reset_period"),  # below one sample: bind
+        ({"adaptation": lambda: MITRule(reference_gain=np.zeros((3, 6)))}, "reference_gain"),  # not Schur
+        ({"adaptation": lambda: MITRule(reference_gain=np.zeros((6, 3)))}, "reference_gain"),
+        ({"adaptation": lambda: MITRule(error_output=np.zeros((3, 6)))}, "error_output"),
+        ({"adaptation": lambda: MITRule(error_output=np.eye(3))}, "error_output"),
         ({"theta_bound": -0.5}, "theta_bound"),
         ({"theta_bound": [0.5, 0.5]}, "theta_bound"),
         ({"theta_bound": "auto-ish"}, "theta_bound"),
         ({"theta_bound": 1.0}, "theta_bound"),  # the torque budget needs theta_bound < u_max
         ({"theta_bound": [0.5, 1.2, 0.5]}, "theta_bound"),
         ({"theta_bound": None}, "theta_bound"),
-        ({"rule": "lyapunov-ish"}, "rule"),
         ({"torque_budget": "half"}, "torque_budget"),
-        ({"alpha": 1e-3}, "alpha"),  # an MIT-rule setting with the Lyapunov rule
-        ({"normalized": False}, "normalized"),
-        ({"reset_period": 2.0}, "reset_period"),
-        ({"reference_gain": np.zeros((3, 6))}, "reference_gain"),
-        ({"error_output": np.eye(6)}, "error_output"),
+        ({"input_constraint": "box"}, "input_constraint"),
+        ({"input_constraint": "peak", "u_max": [1.0, 1.0]}, "u_max"),
+        ({"u_max": -1.0}, "u_max"),
         ({"rmpc_options": {"resolve_treshold": 0.5}}, "rmpc_options"),
         ({"rmpc_options": {"Q": np.eye(6)}}, "rmpc_options"),
         ({"rmpc_options": {"resolve_threshold": 2.0}}, "resolve_threshold"),
@@ -287,8 +292,12 @@ def test_reset_restarts_the_reference_model_at_the_measured_state(
 def test_bad_options_raise_errors_that_name_the_argument(
     plant: PolytopicModel, options: dict[str, Any], argument: str
 ) -> None:
+    """Every check names its argument, whether the rule, CRMPC, the bound or the inner RMPC makes it."""
+    kwargs = {"u_max": 1.0, **options}
     with pytest.raises(InvalidArgumentError) as info:
-        CRMPC(plant, Q=Q1, R=R1, u_max=1.0, **options)
+        if callable(kwargs.get("adaptation")):
+            kwargs["adaptation"] = kwargs["adaptation"]()
+        CRMPC(plant, Q=Q1, R=R1, **kwargs)
     assert info.value.argument == argument
     assert str(info.value).startswith(f"{argument}: expected ")
 
@@ -297,8 +306,9 @@ def test_bad_options_raise_errors_that_name_the_argument(
     ("args", "options", "argument"),
     [
         (("not a plant",), {}, "plant"),
-        ((), {"rule": "mit", "normalized": "yes"}, "normalized"),
-        ((), {"adaptation_gain": "fast"}, "adaptation_gain"),
+        ((), {"adaptation": lambda: MITRule(normalized="yes")}, "normalized"),
+        ((), {"adaptation": lambda: LyapunovRule(gain="fast")}, "gain"),
+        ((), {"adaptation": lambda: "mit"}, "adaptation"),
         ((), {"rmpc_options": [("resolve_threshold", 0.5)]}, "rmpc_options"),
     ],
 )
@@ -306,6 +316,8 @@ def test_bad_types_raise_errors_that_name_the_argument(
     plant: PolytopicModel, args: tuple[Any, ...], options: dict[str, Any], argument: str
 ) -> None:
     with pytest.raises(ArgumentTypeError) as info:
+        if callable(options.get("adaptation")):
+            options = {**options, "adaptation": options["adaptation"]()}
         CRMPC(*(args or (plant,)), Q=Q1, R=R1, u_max=1.0, **options)
     assert info.value.argument == argument
 
@@ -361,7 +373,7 @@ def test_lyapunov_crmpc_rejects_the_disturbance_across_the_polytope(
     wide_plant: PolytopicModel, factor: float
 ) -> None:
     ctrl, traj = _lyapunov_run(wide_plant, factor, 0.5, 4.5)
-    assert ctrl.rule_name == "lyapunov" and ctrl.torque_budget == "current"
+    assert isinstance(ctrl.adaptation, LyapunovRule) and ctrl.torque_budget == "current"
     settled = _last_time_above(traj, 1e-3)
     assert settled <= SHORT_ONSET + 3.0  # measured 1.3-2.1 s after the onset on the 30 s runs
     # theta approaches d (measured within 0.012 of it 4 s after the onset, 1e-9 on the 30 s runs)
@@ -427,7 +439,7 @@ def _adaptive_loop(a: np.ndarray, b: np.ndarray, f: np.ndarray, p: np.ndarray, c
 
     from rmpc.mpc.adaptation import LyapunovRule
 
-    rule = LyapunovRule(3, gain=gain, dt=0.01)
+    rule = LyapunovRule(gain=gain)
     a_cl, a_t = a + b @ f, a + c * b @ f
     w_mat = a_t.T @ p + p @ a_t
     pbf = p @ b @ f
@@ -476,3 +488,114 @@ def test_lyapunov_identity_of_the_adaptation_law(sat: RigidSatellite) -> None:
     v, integral, _ = _adaptive_loop(a, b, f, p_nom, corners[0], d, z0, 100.0, 100.0)
     assert np.max(np.abs(v - v[0] - integral)) <= 1e-8 * np.max(v)  # the identity still holds ...
     assert v[-1] > 1e3 * v[0]  # ... but V grows without bound: the nominal P is not enough
+
+
+# -- the composition: adaptation objects, one interface, the typed bound channel ----------------
+
+
+def test_default_adaptation_is_the_lyapunov_rule_with_its_defaults(plant: PolytopicModel,
+                                                                    sat: RigidSatellite) -> None:
+    """adaptation=None is LyapunovRule() (g = 100): the same answers, step by step, as the rule given."""
+    default = CRMPC(plant, Q=Q1, R=R1, u_max=1.0)
+    given = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=LyapunovRule(gain=100.0))
+    assert isinstance(default.adaptation, LyapunovRule) and default.adaptation.gain == 100.0
+    for k in range(4):
+        x = sat.initial_state(1.0 - 0.1 * k) + 0.01 * k
+        np.testing.assert_array_equal(default.step(x), given.step(x))
+        np.testing.assert_array_equal(default.theta, given.theta)
+    assert np.any(default.theta != 0.0)  # the estimate moved: the comparison saw the rule at work
+
+
+def test_mit_rule_defaults_are_paper_p_settings() -> None:
+    rule = MITRule()
+    assert (rule.gain, rule.normalized, rule.alpha, rule.reset_period) == (20.0, True, 1e-3, 2.0)
+    assert rule.reference_gain is None and rule.error_output is None
+
+
+def test_crmpc_binds_a_copy_of_the_rule(plant: PolytopicModel, sat: RigidSatellite) -> None:
+    """The rule object given keeps its settings only; each controller owns its bound copy."""
+    rule = MITRule(gain=20.0, reset_period=0.02)
+    first = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=rule)
+    second = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=rule)
+    assert first.adaptation is not rule and first.adaptation is not second.adaptation
+    assert first.adaptation.reset_period == pytest.approx(0.02)  # rounded to two samples
+    with pytest.raises(InvalidArgumentError, match=r"^adaptation: expected a rule bound"):
+        _ = rule.theta
+    first.rmpc = _FixedGain(np.zeros((3, 6)))  # type: ignore[assignment]
+    x0 = sat.initial_state()
+    first.step(x0)
+    first.step(0.9 * x0)
+    assert np.any(first.theta != 0.0) and np.all(second.theta == 0.0)
+
+
+class _ConstantRule(AdaptationRule):
+    """A third rule written against the interface alone: theta fixed, the model the measured state."""
+
+    name = "constant"
+
+    def __init__(self, theta: np.ndarray) -> None:
+        self.value = np.asarray(theta, dtype=float)
+        self.calls: list[str] = []
+
+    def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
+        self.calls = []
+
+    def reset_model(self) -> None:
+        self.calls.append("reset")
+
+    def update(self, z: np.ndarray) -> AdaptationStep:
+        self.calls.append("update")
+        self.estimate._theta = self.value.copy()
+        return AdaptationStep(self.estimate.theta, np.zeros_like(z), None, z, False)
+
+    def advance(self, u_rmpc: np.ndarray, gain: np.ndarray, solution: Any) -> None:
+        self.calls.append("advance" if solution is None else "advance certified")
+
+
+def test_the_step_loop_calls_the_rule_through_update_and_advance(plant: PolytopicModel,
+                                                                 sat: RigidSatellite) -> None:
+    theta = np.array([0.1, -0.2, 0.05])
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=_ConstantRule(theta), torque_budget="none")
+    rmpc = RMPC(plant, Q=Q1, R=R1, u_max=1.0)
+    x = sat.initial_state(0.5)
+    np.testing.assert_allclose(ctrl.step(x), rmpc.step(x) - theta, rtol=1e-12, atol=1e-12)
+    assert ctrl.adaptation.calls == ["update", "advance certified"]
+    assert ctrl.last.extra["theta"].tolist() == theta.tolist()
+    ctrl.reset()
+    assert ctrl.adaptation.calls[-1] == "reset"
+
+
+def test_crmpc_gives_the_inner_rmpc_its_budget_through_step_inputs(
+    plant: PolytopicModel, sat: RigidSatellite
+) -> None:
+    theta = np.array([0.1, -0.3, 0.05])
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, adaptation=_ConstantRule(theta))
+    stub = _FixedGain(np.zeros((3, 6)))
+    ctrl.rmpc = stub  # type: ignore[assignment]
+    ctrl.step(sat.initial_state(0.5))
+    (inputs,) = stub.inputs
+    assert isinstance(inputs, StepInputs) and inputs.given() == ("u_max",)
+    assert inputs.u_max == pytest.approx(1.0 - 0.3)
+    assert CRMPC.accepts == frozenset() and ctrl.name == "CRMPC"
+    with pytest.raises(InvalidArgumentError, match=r"^inputs\.u_max"):
+        ctrl.step(sat.initial_state(0.5), StepInputs(u_max=0.5))
+
+
+@pytest.mark.parametrize("budget", ["current", "split", "none"])
+def test_crmpc_builds_one_lmi_problem(plant: PolytopicModel, monkeypatch: pytest.MonkeyPatch,
+                                      budget: str) -> None:
+    """The kind and size of the bound are known without a probe RMPC: one problem is built."""
+    import rmpc.mpc.robust_mpc as robust_mpc
+
+    built: list[Any] = []
+    original = robust_mpc.KothareProblem
+
+    def counting(*args: Any, **kwargs: Any) -> Any:
+        built.append(kwargs.get("u_max"))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(robust_mpc, "KothareProblem", counting)
+    ctrl = CRMPC(plant, Q=Q1, R=R1, u_max=1.0, theta_bound=0.6, torque_budget=budget)
+    assert len(built) == 1
+    assert built[0] == pytest.approx(0.4 if budget == "split" else 1.0)
+    assert ctrl.rmpc_kind == "ellipsoid" and ctrl.u_max.tolist() == [1.0]

@@ -53,7 +53,7 @@ def _certificate_parts():
     xs = FAR / np.linalg.norm(FAR)
     u = prob.data.u_max / np.linalg.norm(FAR)
     y_max = prob.data.y_max
-    return backend, sol, backend._a_matrix(u, y_max), backend._b_vector(xs), u, y_max
+    return backend, sol, backend.conic.a_matrix(u, y_max), backend.conic.b_vector(xs), u, y_max
 
 
 def prob_bound(x):
@@ -64,7 +64,7 @@ def _cones(backend):
     import clarabel
 
     out = []
-    for cone, rows in zip(backend._cones, backend._block_rows, strict=True):
+    for cone, rows in zip(backend.conic.cones, backend._block_rows, strict=True):
         size = rows.stop - rows.start
         if isinstance(cone, clarabel.PSDTriangleConeT):
             out.append(("psd", round((np.sqrt(8 * size + 1) - 1) / 2)))
@@ -91,11 +91,11 @@ def test_tampered_certificate_fails_the_independent_check():
     # the wrong data: a state inside the region (normalised, with its own normalised bound;
     # the problem there is feasible, so no multipliers can pass)
     assert _problem("peak").solve(NEAR).status == "optimal"
-    b_near = backend._b_vector(NEAR / np.linalg.norm(NEAR))
-    near = check_farkas(backend._a_matrix(prob_bound(NEAR), y_max), b_near, cones, y)
+    b_near = backend.conic.b_vector(NEAR / np.linalg.norm(NEAR))
+    near = check_farkas(backend.conic.a_matrix(prob_bound(NEAR), y_max), b_near, cones, y)
     assert not near.ok
     # the wrong data: the bound ten times larger
-    other = check_farkas(backend._a_matrix(10.0 * u, y_max), b, cones, y)
+    other = check_farkas(backend.conic.a_matrix(10.0 * u, y_max), b, cones, y)
     assert not other.ok
     with pytest.raises(InvalidArgumentError, match="y"):
         check_farkas(a_mat, b, cones, y[:-1])

@@ -1,4 +1,4 @@
-"""The Schur complement from factored coefficients (:func:`lmi.ipm_kernels.scaling_and_schur_direct`,
+"""The Schur complement from factored coefficients (:func:`lmi.ipm.kernels.scaling_and_schur_direct`,
 :mod:`lmi.kothare_factors`) and the IPM on the 14-state flexible satellite.
 
 * the kernel's ``H`` against ``sum_j tr(A_ij W^-1 A_kj W^-1)`` computed with plain numpy from
@@ -20,8 +20,7 @@ import pytest
 
 from benchmarks.stress import make_problem
 from lmi import KothareProblem
-from lmi import ipm_kernels as kernels
-from lmi.ipm import BlockLMISolver
+from lmi.ipm import BlockLMISolver, kernels
 from models import FlexibleSatellite
 from toolkit_common.errors import InvalidArgumentError
 
@@ -218,9 +217,9 @@ def test_rigid_hub_converges_with_the_state_scaling():
 @pytest.mark.parametrize("seed", range(3))
 def test_grouped_schur_complement_is_the_trace_formula(seed):
     """Blocks that share their entries (a group, as the Kothare vertex blocks) summed together
-    by :func:`lmi.ipm_kernels.scaling_and_schur_grouped`: ``H`` equals the plain numpy
+    by :func:`lmi.ipm.kernels.scaling_and_schur_grouped`: ``H`` equals the plain numpy
     ``sum_j tr(A_ij W^-1 A_kj W^-1)`` within ``1e-11 max |H|`` and the block-by-block kernel
-    (:func:`lmi.ipm_kernels.scaling_and_schur_direct`) within ``1e-13 max |H|`` (only the
+    (:func:`lmi.ipm.kernels.scaling_and_schur_direct`) within ``1e-13 max |H|`` (only the
     order of the sum over the group differs)."""
     rng = np.random.default_rng(100 + seed)
     n, k, d, count, members = 6, 7, 9, 30, int(rng.integers(2, 9))

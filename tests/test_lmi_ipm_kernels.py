@@ -1,7 +1,7 @@
-"""The compiled kernels of the interior-point solver (:mod:`lmi.ipm_kernels`) against numpy/LAPACK.
+"""The compiled kernels of the interior-point solver (:mod:`lmi.ipm.kernels`) against numpy/LAPACK.
 
 Each kernel is checked on its own, with the packed layout built by the solver's
-``_PackedLayout``, against references that share no code with it:
+``PackedLayout``, against references that share no code with it:
 
 * ``smallest_eigenvalue`` (Householder tridiagonalisation and Sturm bisection) against LAPACK's
   ``eigvalsh`` and against the Rayleigh quotient of LAPACK's eigenvector evaluated in exact
@@ -31,9 +31,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from lmi import ipm_kernels as kernels
 from lmi.affine import smat_matrix, svec_indices, svec_matrix
-from lmi.ipm import _PackedLayout
+from lmi.ipm import kernels
+from lmi.ipm.blocks import PackedLayout
 
 EPS = np.finfo(float).eps
 SQRT2 = np.sqrt(2.0)
@@ -60,7 +60,7 @@ def _padded(blocks: list[np.ndarray], fill: float = np.nan) -> np.ndarray:
 
 
 def _packed_block(mat: np.ndarray) -> np.ndarray:
-    """The layout of :mod:`lmi.ipm_kernels` written out: upper triangle row by row, off-diagonal
+    """The layout of :mod:`lmi.ipm.kernels` written out: upper triangle row by row, off-diagonal
     entries times sqrt(2)."""
     rows, cols = np.triu_indices(mat.shape[0])
     return mat[rows, cols] * np.where(rows == cols, 1.0, SQRT2)
@@ -118,7 +118,7 @@ KINDS = ("gaussian", "low rank minus shift", "repeated", "shifted uniform")
 
 def _sparse_coefficients(coefs: list[np.ndarray]) -> tuple:
     """``sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col`` built, by plain loops,
-    from the layout described in the module docstring of :mod:`lmi.ipm_kernels`: one entry per
+    from the layout described in the module docstring of :mod:`lmi.ipm.kernels`: one entry per
     non-zero ``A_ij[a, b]``, ``a <= b``, pointing at its position pair. The entries are in
     position order (the solver's ``_refresh`` puts them in variable order), so the kernel is
     also checked not to depend on that order."""
@@ -156,7 +156,7 @@ def _schur_rows(s_blocks: list[np.ndarray], z_blocks: list[np.ndarray], coefs: l
     """
     orders = [s.shape[0] for s in s_blocks]
     n = coefs[0].shape[0]
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     s_chol = _padded([np.linalg.cholesky(s) for s in s_blocks])  # exact zeros above the diagonal
     z = _padded(z_blocks)
     nb, kmax = len(orders), max(orders)
@@ -302,7 +302,7 @@ def test_unpack_then_pack_round_trips_any_packed_vector(orders, data):
     ``pack(unpack(v))`` exactly on the diagonal and within one ulp off it (``v / sqrt(2) *
     sqrt(2)`` rounds twice; it differs from ``v`` for ~15 % of doubles, by at most 0.71 ulp
     measured); ``unpack`` gives symmetric blocks, zero outside ``[:k, :k]``."""
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     vec = data.draw(hnp.arrays(np.float64, lay.size, elements=FINITE))
     kmax = max(orders)
     mats = kernels.unpack(vec, *lay.arrays, kmax)
@@ -325,7 +325,7 @@ def test_pack_then_unpack_round_trips_symmetric_blocks(orders, data):
     for k in orders:
         g = data.draw(hnp.arrays(np.float64, (k, k), elements=FINITE))
         blocks.append(np.triu(g) + np.triu(g, 1).T)
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     vec = kernels.pack(_padded(blocks), *lay.arrays)
     assert np.all(np.isfinite(vec))
     back = kernels.unpack(vec, *lay.arrays, max(orders))
@@ -342,10 +342,10 @@ def test_pack_is_the_svec_of_each_block_in_row_by_row_order(orders):
     order) where ``svec_matrix`` goes column by column (Clarabel's). The two orders coincide
     only for orders 1 and 2, so concatenated ``svec_matrix`` equals ``pack`` only then.
     ``unpack`` is ``smat_matrix`` after undoing the reordering, and ``pack``/``unpack`` agree
-    with the layout arrays of ``_PackedLayout``."""
+    with the layout arrays of ``PackedLayout``."""
     rng = np.random.default_rng(sum(orders))
     blocks = [_sym(rng.normal(size=(k, k))) for k in orders]
-    lay = _PackedLayout(list(orders))
+    lay = PackedLayout(list(orders))
     vec = kernels.pack(_padded(blocks), *lay.arrays)
     svecs = []
     for j, (k, b) in enumerate(zip(orders, blocks, strict=True)):
@@ -379,7 +379,7 @@ def test_packed_inner_product_is_the_trace_inner_product(seed):
     orders = [int(k) for k in rng.integers(1, 13, size=rng.integers(1, 6))]
     s_blocks = [_sym(rng.normal(size=(k, k))) for k in orders]
     z_blocks = [_sym(rng.normal(size=(k, k))) for k in orders]
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     got = kernels.pack(_padded(s_blocks), *lay.arrays) @ kernels.pack(_padded(z_blocks), *lay.arrays)
     want = sum(float(np.trace(s @ z)) for s, z in zip(s_blocks, z_blocks, strict=True))
     bound = sum(float(np.sum(np.abs(s) * np.abs(z))) for s, z in zip(s_blocks, z_blocks, strict=True))
@@ -494,7 +494,7 @@ def test_nt_scaling_and_schur_rows_match_numpy(structure, seed):
         coefs[0][:] = 0.0
     ok, ks, lams, p = _schur_rows(s_blocks, z_blocks, coefs)
     assert ok
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     for j, (s, z, kj, lam) in enumerate(zip(s_blocks, z_blocks, ks, lams, strict=True)):
         top = lam[-1]
         assert np.all(lam > 0) and np.all(np.diff(lam) >= 0)
@@ -594,7 +594,7 @@ def test_residuals_match_numpy_formulas(seed):
     rng = np.random.default_rng(seed)
     orders = [int(k) for k in rng.integers(1, 13, size=rng.integers(1, 6))]
     n = int(rng.integers(1, 10))
-    lay = _PackedLayout(orders)
+    lay = PackedLayout(orders)
     m = lay.size
     s_blocks = [_sym(rng.normal(size=(k, k))) for k in orders]
     z_blocks = [_sym(rng.normal(size=(k, k))) for k in orders]

@@ -471,7 +471,7 @@ def test_building_a_solver_loads_the_kernels_so_the_first_solve_does_not():
     the kernels' compiled signatures, before and after construction."""
     script = (
         "import numpy as np\n"
-        "import lmi.ipm_kernels as k\n"
+        "import lmi.ipm.kernels as k\n"
         "from lmi.ipm import BlockLMISolver\n"
         "kernels = (k.residuals, k.scaling_and_schur_rows, k.newton_step, k.cholesky_blocks)\n"
         "print(sum(len(f.signatures) for f in kernels))\n"

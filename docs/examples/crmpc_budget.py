@@ -18,7 +18,7 @@ traj = simulate(ctrl, heavy, np.zeros(6), duration=4.0, dt=0.01,
 err = np.max(np.abs(traj.x[:, :3]), axis=1)  # worst attitude angle (rad) at each sample
 last_above = np.nonzero(err > 1e-3)[0][-1]
 bounds = [info.extra["u_bound"] for info in traj.info]
-print(f"rule {ctrl.rule_name!r}, torque budget {ctrl.torque_budget!r}, "
+print(f"rule {ctrl.adaptation.name!r}, torque budget {ctrl.torque_budget!r}, "
       f"theta bound {ctrl.theta_bound.tolist()}")
 print(f"peak attitude error {err.max():.2e} rad; below 1e-3 rad from "
       f"{traj.t[last_above + 1] - onset:.2f} s after the onset")

@@ -1,6 +1,6 @@
 """cvxpy back-end: the Kothare LMIs written with cvxpy variables, any installed conic solver.
 
-Independent of :mod:`lmi.backends.clarabel` (a second implementation of the same problem, used
+Independent of :mod:`lmi.backends.conic` (a second implementation of the same problem, used
 to cross-check it). The problem is built once with parameters for the state and the bounds
 (DPP), so a re-solve skips cvxpy's canonicalisation.
 """
@@ -13,7 +13,8 @@ from typing import Any
 import cvxpy as cp
 import numpy as np
 
-from lmi.backends.clarabel import DEFAULT_CLARABEL_OPTIONS, RawResult, clarabel_settings
+from lmi.backends.base import KothareBackend, RawResult
+from lmi.backends.clarabel import DEFAULT_CLARABEL_OPTIONS, clarabel_settings
 from lmi.data import KothareData
 from lmi.status import CVXPY_STATUS_MAP, SOLVER_ERROR
 from toolkit_common.errors import InvalidArgumentError
@@ -53,7 +54,7 @@ def _solver_options(solver: str, options: dict[str, Any] | None) -> dict[str, An
     return {}
 
 
-class CvxpyKothare:
+class CvxpyKothare(KothareBackend):
     """The Kothare problem through cvxpy, built once and re-solved with new parameters."""
 
     def __init__(self, data: KothareData, solver: str = "CLARABEL", options: dict[str, Any] | None = None):
@@ -139,9 +140,7 @@ class CvxpyKothare:
         status = CVXPY_STATUS_MAP.get(raw, SOLVER_ERROR)
         if self.Qv.value is None:
             return RawResult(status, raw, np.nan, None, None, None, elapsed)
-        gamma = float(self.gs.value)
-        if self.data.formulation != "standard":
-            gamma /= self.data.dt
+        gamma = self.gamma(self.gs.value)
         stats = self.problem.solver_stats
         iters = None if stats is None or stats.num_iters is None else int(stats.num_iters)
         q_val, y_val = np.asarray(self.Qv.value), np.asarray(self.Yv.value)

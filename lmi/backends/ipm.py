@@ -1,10 +1,12 @@
 """The toolkit's own structure-exploiting interior-point back-end (:mod:`lmi.ipm`).
 
-The LMIs are the same affine matrices as for :class:`lmi.backends.clarabel.ClarabelKothare`
-(built once); here they are kept as matrices, ``S_j = C_j - sum_i z_i A_ij``, and handed to
-:class:`lmi.ipm.BlockLMISolver`. Per state only the state block's constant and the bound
-scalings of the input (and output) blocks change; they are written in place. Successive
-solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`).
+The LMIs are the same conic data as for :class:`lmi.backends.clarabel.ClarabelKothare`
+(:class:`~lmi.backends.conic.KothareConic`, built once); here each cone is kept as a matrix,
+``S_j = C_j - sum_i z_i A_ij``, and handed to :class:`lmi.ipm.BlockLMISolver`. Per state only
+the state block's constant and the bound scalings of the input (and output) blocks change; they
+are written in place. Successive solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`). A
+solve that fails goes to phase one and then to a :class:`~lmi.backends.clarabel.ClarabelKothare`
+the back-end owns, built on the same conic data (:meth:`IPMKothare.solve`).
 """
 
 from __future__ import annotations
@@ -17,13 +19,16 @@ import clarabel
 import numpy as np
 
 from lmi.affine import smat_matrix, svec_indices, svec_matrix
-from lmi.backends.clarabel import ClarabelKothare, RawResult
+from lmi.backends.base import KothareBackend, RawResult
+from lmi.backends.clarabel import ClarabelKothare
+from lmi.backends.conic import KothareConic
 from lmi.data import KothareData
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
 from lmi.status import INACCURATE, INFEASIBLE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
+from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
@@ -104,8 +109,21 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
-class IPMKothare(ClarabelKothare):
-    """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`."""
+class IPMKothare(KothareBackend):
+    """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`, Clarabel as its fallback.
+
+    Attributes
+    ----------
+    original_data : KothareData
+        The problem as given.
+    data : KothareData
+        The problem in the solver's coordinates ``x~ = diag(t)^-1 x`` (``original_data`` when
+        ``t = 1``).
+    conic : KothareConic
+        The conic data of ``data``.
+    fallback_solver : ClarabelKothare
+        The Clarabel back-end on the same ``conic``, which gets the solves that fail.
+    """
 
     name = "ipm"
 
@@ -118,19 +136,22 @@ class IPMKothare(ClarabelKothare):
         self._phase_one = merged.pop("phase_one")
         self._rebalance = merged.pop("rebalance")
         self._solver_options = merged
+        self._blas = SingleThreadBlas()
         self._build(t)
 
     def _build(self, t: np.ndarray) -> None:
-        """The conic data and the solver in the coordinates ``x~ = diag(t)^-1 x``."""
+        """The conic data, the solver and the fallback in the coordinates ``x~ = diag(t)^-1 x``."""
         data = self.original_data
         self._t = t
         self._scaled = bool(np.any(t != 1.0))
-        super().__init__(scale_data(data, t) if self._scaled else data, None)
-        a_dense = self._A.toarray()
-        h = self._b_static
+        self.data = scale_data(data, t) if self._scaled else data
+        conic = self.conic = KothareConic(self.data)
+        self.fallback_solver = ClarabelKothare(self.data, None, conic=conic)
+        a_dense = conic.A.toarray()
+        h = conic.b_static
         blocks: list[tuple[np.ndarray, np.ndarray]] = []
         self._block_rows: list[slice] = []
-        for cone, start, stop in zip(self._cones, self._offsets[:-1], self._offsets[1:], strict=True):
+        for cone, start, stop in zip(conic.cones, conic.offsets[:-1], conic.offsets[1:], strict=True):
             g_rows, h_rows = a_dense[start:stop], h[start:stop]
             dim = int(stop - start)
             if isinstance(cone, clarabel.PSDTriangleConeT):
@@ -143,8 +164,8 @@ class IPMKothare(ClarabelKothare):
         self._base_blocks = blocks
         # the bound-scaled blocks: entry masks (k x k) per (block, bound index, kind)
         self._scaled_blocks: list[tuple[int, list[tuple[np.ndarray, np.ndarray, str]]]] = []
-        for start, sel, bound_index, kind in self._scaled_rows:
-            j = int(np.searchsorted(self._offsets, start, side="right") - 1)
+        for start, sel, bound_index, kind in conic.scaled_rows:
+            j = int(np.searchsorted(conic.offsets, start, side="right") - 1)
             order = blocks[j][0].shape[0]
             rows, cols = svec_indices(order)
             parts = []
@@ -155,15 +176,16 @@ class IPMKothare(ClarabelKothare):
                 mask[cols[pick], rows[pick]] = True
                 parts.append((mask, idx, kind))
             self._scaled_blocks.append((j, parts))
-        self._solver = BlockLMISolver(self._q, blocks, factors=self._block_factors(len(blocks)),
+        self._solver = BlockLMISolver(conic.objective, blocks, factors=self._block_factors(len(blocks)),
                                       **self._solver_options)
 
     def _block_factors(self, count: int) -> list:
         """The cost blocks' factored coefficients (:mod:`lmi.kothare_factors`), ``None`` for the
         state, bound and diagonal blocks (their coefficients are used as they are)."""
         n, m = self.data.n, self.data.m
-        o_y = 1 + self._n_q
-        o_w = o_y + self._n_y + self._n_x + self._n_z if self._n_w else None
+        conic = self.conic
+        o_y = 1 + conic.n_q
+        o_w = o_y + conic.n_y + conic.n_x + conic.n_z if conic.n_w else None
         cost = cost_block_factors(self.data, VariableLayout.of(n, m, 1, o_y, o_w))
         return [None, *cost, *([None] * (count - 1 - len(cost)))]
 
@@ -229,7 +251,7 @@ class IPMKothare(ClarabelKothare):
                 return raw
         if not self._fallback:
             return self._unscale(raw, norm)
-        backup = super().solve(xs, u_max, y_max)
+        backup = self.fallback_solver.solve(xs, u_max, y_max)
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
         return self._unscale(dataclasses.replace(
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
@@ -297,14 +319,15 @@ class IPMKothare(ClarabelKothare):
         on the conic data Clarabel would be given at this (normalised, balanced) state and
         bounds: ``A`` with the bound rows scaled, ``b`` with the state block."""
         parts, cones = [], []
-        for cone, zj, rows in zip(self._cones, z_blocks, self._block_rows, strict=True):
+        for cone, zj, rows in zip(self.conic.cones, z_blocks, self._block_rows, strict=True):
             if isinstance(cone, clarabel.PSDTriangleConeT):
                 parts.append(svec_matrix(0.5 * (zj + zj.T)))
                 cones.append(("psd", zj.shape[0]))
             else:  # a non-negative cone: its IPM block is diagonal, only the diagonal of Z counts
                 parts.append(np.diag(zj).copy())
                 cones.append(("nonneg", rows.stop - rows.start))
-        return check_farkas(self._a_matrix(u_max, y_max), self._b_vector(xs), cones, np.concatenate(parts))
+        conic = self.conic
+        return check_farkas(conic.a_matrix(u_max, y_max), conic.b_vector(xs), cones, np.concatenate(parts))
 
     def _unscale(self, raw: RawResult, norm: float) -> RawResult:
         """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,
@@ -327,11 +350,8 @@ class IPMKothare(ClarabelKothare):
                              time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
-        z = res.x
-        gamma = float(z[0])
-        if self.data.formulation != "standard":
-            gamma /= self.data.dt
+        q_mat, y_mat = self.conic.variables(res.x)
         return RawResult(
-            _STATUS.get(res.status, NUMERICAL_ERROR), res.status, gamma, self._q_affine.value(z),
-            self._y_affine.value(z), res.iterations, elapsed,
+            _STATUS.get(res.status, NUMERICAL_ERROR), res.status, self.gamma(res.x[0]), q_mat, y_mat,
+            res.iterations, elapsed,
         )

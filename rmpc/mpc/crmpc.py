@@ -3,28 +3,32 @@
 State feedback alone leaves an offset under a persistent input disturbance. Paper P adds a
 model reference adaptive system (MRAS) around its robust MPC: a reference model, the error
 between plant and model, and a parameter ``theta`` that corrects the control so that the
-disturbance's effect is cancelled. Paper P tunes it by the MIT rule; this module offers that
-rule (``rule="mit"``) and, as the default, the Lyapunov redesign of the same MRAS
-(``rule="lyapunov"``), whose adaptation law comes with a stability argument over the whole
-inertia polytope the robust MPC is designed for. ``docs/crmpc.rst`` has the block diagrams,
-the derivations and the measurements behind the choice.
+disturbance's effect is cancelled. The adaptation rule is an object of
+:mod:`rmpc.mpc.adaptation`: paper P tunes its MRAS by the MIT rule
+(``adaptation=MITRule()``); the default is the Lyapunov redesign of the same MRAS
+(``adaptation=LyapunovRule()``), whose adaptation law comes with a stability argument over the
+whole inertia polytope the robust MPC is designed for. ``docs/crmpc.rst`` has the block
+diagrams, the derivations and the measurements behind the choice.
 
 In deviation coordinates ``z = x - x_ref`` (``x_ref`` of the inner :class:`~rmpc.RMPC`), with
 the nominal model ``(A, B)`` of the polytope and ``F(k)`` the gain the RMPC applies at step
-``k``:
+``k``, each step is::
 
-``rule="lyapunov"`` (default)::
-
-    theta(k)   = Proj[theta(k-1) + Ts g (Bd' P Bd)^-1 Bd' P e(k)]     Bd = B / Ts, P = gamma Q^-1
+    theta(k)   = rule.update(z(k))                     the rule's reference model and law
     u_rmpc(k)  = F(k) z(k),   ||u_rmpc(k)|| <= u_max - |theta(k)|      the torque budget
     u(k)       = u_rmpc(k) - theta(k)
+    rule.advance(u_rmpc(k), F(k), solution)            the reference model to k + 1
+
+:class:`~rmpc.mpc.adaptation.LyapunovRule` (default)::
+
+    theta(k)   = Proj[theta(k-1) + Ts g (Bd' P Bd)^-1 Bd' P e(k)]     Bd = B / Ts, P = gamma Q^-1
     zm(k+1)    = (A + B F(k)) zm(k),   zm(0) = z(0)                    nominal closed loop, never reset
     e(k)       = z(k) - zm(k)
 
 ``P`` is the cost matrix of the RMPC's last certified solution, a common Lyapunov matrix of the
 closed loops ``A_j + B_j F`` at every vertex of the polytope (Kothare's LMIs certify it).
 
-``rule="mit"`` (paper P's MIT rule, the toolkit's earlier default)::
+:class:`~rmpc.mpc.adaptation.MITRule` (paper P's MIT rule, the toolkit's earlier default)::
 
     zm(k+1)    = A zm(k) + B u_rmpc(k),   zm(k0) = z(k0)                reset every reset_period
     s(k+1)     = A s(k) - B,   s(k0) = 0                                 sensitivity, de/dtheta = C_e s
@@ -33,42 +37,33 @@ closed loops ``A_j + B_j F`` at every vertex of the polytope (Kothare's LMIs cer
 **The torque budget.** With an input bound, ``|theta_i|`` is projected onto
 ``theta_bound_i < u_max`` and the robust MPC gets what the correction leaves of the limit
 (``torque_budget="current"``: ``u_max - max_i |theta_i(k)|`` for the ellipsoid, ``u_max_i -
-|theta_i(k)|`` per axis for the peak bound, re-solved at every step; ``"split"``: the fixed
-``u_max - theta_bound``). Every certified step then satisfies ``|u_i(k)| <= |u_rmpc,i(k)| +
-|theta_i(k)| <= u_max`` on the nonlinear plant as on the linear one, without a limiter.
+|theta_i(k)|`` per axis for the peak bound, re-solved at every step and passed to the RMPC as
+``StepInputs(u_max=...)``; ``"split"``: the fixed ``u_max - theta_bound``). Every certified step
+then satisfies ``|u_i(k)| <= |u_rmpc,i(k)| + |theta_i(k)| <= u_max`` on the nonlinear plant as on
+the linear one, without a limiter.
 """
 
 from __future__ import annotations
 
 import inspect
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from lmi.data import input_bound_vector
 from models import PolytopicModel
-from rmpc.controller import StepInfo
-from rmpc.mpc.adaptation import LyapunovRule, MITRule, SensitivityFilter, _bound
-from rmpc.mpc.robust_mpc import RMPC
+from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.mpc.adaptation import AdaptationRule, LyapunovRule
+from rmpc.mpc.mras import projection_bound
+from rmpc.mpc.robust_mpc import RMPC, input_constraint_kind
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
+from toolkit_common.validation import as_vector, check_choice
 
 __all__ = ["CRMPC"]
 
-#: Default gain ``g`` of the Lyapunov rule (1/s^2): an estimator bandwidth of about 10 rad/s.
-DEFAULT_GAIN_LYAPUNOV = 100.0
-#: Default adaptation gain ``gamma_a`` of the normalised MIT rule (1/s), tuned on paper P's satellite.
-DEFAULT_GAIN_NORMALIZED = 20.0
-#: Default adaptation gain ``gamma_a`` of the plain rule, paper P's satellite: bounded but slow.
-DEFAULT_GAIN_PLAIN = 0.3
-#: Default regularisation ``alpha`` of the normalised rule.
-DEFAULT_ALPHA = 1e-3
-#: Default period (s) of the reference-model reset of the MIT rule.
-DEFAULT_RESET_PERIOD = 2.0
 #: Default ``theta_bound`` as a fraction of ``u_max``: the robust MPC keeps at least 20 % of the limit.
 DEFAULT_THETA_FRACTION = 0.8
-#: Adaptation laws.
-RULES = ("lyapunov", "mit")
 #: How the torque limit is shared between the robust MPC and the correction.
 TORQUE_BUDGETS = ("current", "split", "none")
 
@@ -82,30 +77,15 @@ class CRMPC:
     Parameters
     ----------
     plant : PolytopicModel
-        The polytope of discrete-time models; its ``nominal`` model is the reference model.
+        The polytope of discrete-time models; its ``nominal`` model is the reference model's.
     Q, R, u_max, input_constraint
         Passed to the inner :class:`~rmpc.RMPC` (weights, input bound and its kind).
-    rule : {"lyapunov", "mit"}
-        The adaptation law (module notes). ``"lyapunov"`` (default): the Lyapunov redesign,
-        robust over the polytope; ``"mit"``: paper P's MIT rule.
-    adaptation_gain : float, optional
-        ``g`` of the Lyapunov rule (1/s^2, default ``DEFAULT_GAIN_LYAPUNOV`` = 100) or
-        ``gamma_a`` of the MIT rule (default ``DEFAULT_GAIN_NORMALIZED`` = 20 1/s for the
-        normalised rule, ``DEFAULT_GAIN_PLAIN`` = 0.3 for the plain one). 0 turns the
-        adaptation off and leaves plain RMPC.
-    normalized, alpha : optional
-        MIT rule only: the normalised rule (default ``True``) and its regularisation (default
-        ``DEFAULT_ALPHA``). The plain rule is unstable at gains the normalised rule takes in
-        its stride (the sensitivity grows like ``t^2`` inside a reset window).
-    reset_period : float, None or "auto"
-        MIT rule only: reset the reference model to the measured state (and the sensitivity
-        to zero) every this many seconds; ``"auto"``: ``DEFAULT_RESET_PERIOD`` (2 s); ``None``:
-        only at the first step. The Lyapunov rule's reference model is never reset.
-    reference_gain : (m, n) array_like, optional
-        MIT rule only: a fixed gain ``Fm`` for the classical reference model
-        ``zm(k+1) = (A + B Fm) zm(k)`` (Schur stable on the nominal model).
-    error_output : (p, n) array_like, optional
-        MIT rule only: ``C_e`` of the error ``e = C_e (z - zm)`` (default the identity).
+    adaptation : LyapunovRule, MITRule or None
+        The adaptation rule (:mod:`rmpc.mpc.adaptation`) with its settings; CRMPC binds a copy of
+        it to the nominal model, the sample time and ``theta_bound``
+        (:meth:`~rmpc.mpc.adaptation.AdaptationRule.bind`). ``None`` (default):
+        ``LyapunovRule()``, robust over the polytope; ``MITRule()`` is paper P's rule.
+        ``LyapunovRule(gain=0)`` turns the adaptation off and leaves plain RMPC.
     theta_bound : "auto", float, array_like or None
         Projection ``|theta_i| <= theta_bound_i``. ``"auto"``: ``DEFAULT_THETA_FRACTION``
         (0.8) times ``u_max`` when there is an input bound, else none. With a torque budget it
@@ -121,10 +101,15 @@ class CRMPC:
 
     Attributes
     ----------
+    name : str
+        ``"CRMPC"``.
+    accepts : frozenset of str
+        Empty: :meth:`step` takes no :class:`~rmpc.controller.StepInputs`.
     rmpc : RMPC
-        The inner robust MPC.
-    rule : LyapunovRule or MITRule
-        The adaptation law; ``rule.theta`` is the current disturbance estimate.
+        The inner robust MPC (built once, with ``u_max - theta_bound`` for the ``"split"``
+        budget).
+    adaptation : LyapunovRule or MITRule
+        The bound adaptation rule; ``adaptation.theta`` is the current disturbance estimate.
     last : StepInfo or None
         ``status``, ``solve_time``, ``gamma``, ``iterations`` and ``fallback`` of the inner
         RMPC step; ``extra`` holds the adaptation state: ``theta`` (applied at this step),
@@ -169,9 +154,22 @@ class CRMPC:
     >>> plant = sat.polytope(x0, dt=0.01, spread=0.3, mode="scalar")
     >>> ctrl = CRMPC(plant, Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]), R=np.eye(3), u_max=1.0)
     >>> u = ctrl.step(x0)
-    >>> ctrl.last.status, ctrl.last.extra["theta"].tolist(), ctrl.last.extra["u_bound"]
-    ('optimal', [0.0, 0.0, 0.0], 1.0)
+    >>> print(ctrl.last.status, ctrl.last.extra["theta"].tolist(), ctrl.last.extra["u_bound"])
+    optimal [0.0, 0.0, 0.0] 1.0
+    >>> ctrl.adaptation
+    LyapunovRule(gain=100)
+
+    Paper P's MIT rule, normalised, its gain and reset period set:
+
+    >>> from rmpc.mpc.adaptation import MITRule
+    >>> mit = CRMPC(plant, Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]), R=np.eye(3), u_max=1.0,
+    ...             adaptation=MITRule(gain=20.0, reset_period=1.0))
+    >>> mit.adaptation.name, mit.torque_budget, mit.theta_bound.tolist()
+    ('mit', 'current', [0.8, 0.8, 0.8])
     """
+
+    name: ClassVar[str] = "CRMPC"
+    accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,
@@ -181,13 +179,7 @@ class CRMPC:
         u_max: Any = None,
         input_constraint: str | None = "auto",
         *,
-        rule: str = "lyapunov",
-        adaptation_gain: float | None = None,
-        normalized: bool | None = None,
-        alpha: float | None = None,
-        reset_period: float | str | None = "auto",
-        reference_gain: Any = None,
-        error_output: Any = None,
+        adaptation: AdaptationRule | None = None,
         theta_bound: Any = "auto",
         torque_budget: str = "auto",
         rmpc_options: Mapping[str, Any] | None = None,
@@ -195,75 +187,19 @@ class CRMPC:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
         options = _rmpc_options(rmpc_options)
+        if adaptation is None:
+            adaptation = LyapunovRule()
+        elif not isinstance(adaptation, AdaptationRule):
+            expected = "None or an adaptation rule (rmpc.mpc.adaptation.LyapunovRule or MITRule)"
+            raise ArgumentTypeError("adaptation", expected, type(adaptation).__name__)
         self.plant = plant
         self.dt = plant.dt
-        n, m = plant.n_states, plant.n_inputs
-        self._a, self._b = (np.array(mat, dtype=float) for mat in plant.nominal)
-        self.rule_name = str(check_choice(rule, "rule", RULES))
-        lyapunov = self.rule_name == "lyapunov"
-        if lyapunov:
-            for name, value in (("normalized", normalized), ("alpha", alpha),
-                                ("reference_gain", reference_gain), ("error_output", error_output)):
-                if value is not None:
-                    raise InvalidArgumentError(
-                        name, "None with rule='lyapunov' (an MIT-rule setting)", repr(value)
-                    )
-            if reset_period not in ("auto", None):
-                raise InvalidArgumentError(
-                    "reset_period",
-                    "'auto' or None with rule='lyapunov' (its reference model is never reset)",
-                    repr(reset_period),
-                )
-        if normalized is None:
-            normalized = True
-        if not isinstance(normalized, bool | np.bool_):
-            found = f"{type(normalized).__name__} {normalized!r}"
-            raise ArgumentTypeError("normalized", "True or False", found)
-        self.normalized = bool(normalized)
-        self.alpha = check_positive(DEFAULT_ALPHA if alpha is None else alpha, "alpha")
-        if adaptation_gain is None:
-            if lyapunov:
-                adaptation_gain = DEFAULT_GAIN_LYAPUNOV
-            else:
-                adaptation_gain = DEFAULT_GAIN_NORMALIZED if self.normalized else DEFAULT_GAIN_PLAIN
-        self.adaptation_gain = check_positive(adaptation_gain, "adaptation_gain", allow_zero=True)
-
-        if reset_period == "auto":
-            reset_period = None if lyapunov else DEFAULT_RESET_PERIOD
-        if reset_period is None:
-            self.reset_period: float | None = None
-            self._reset_steps = 0
-        else:
-            period = check_positive(reset_period, "reset_period")
-            steps = round(period / self.dt)
-            if steps < 1:
-                raise InvalidArgumentError(
-                    "reset_period", f"None or at least one sample (dt = {self.dt:g} s)", repr(reset_period)
-                )
-            self.reset_period = steps * self.dt
-            self._reset_steps = steps
-
-        if reference_gain is None:
-            self.reference_gain: np.ndarray | None = None
-        else:
-            fm = as_matrix(reference_gain, "reference_gain", (m, n))
-            radius = float(np.max(np.abs(np.linalg.eigvals(self._a + self._b @ fm))))
-            if radius >= 1.0 - 1e-9:
-                raise InvalidArgumentError(
-                    "reference_gain",
-                    "a gain Fm with A + B Fm Schur stable on the nominal model (spectral radius < 1)",
-                    f"spectral radius {radius:.6g}",
-                )
-            self.reference_gain = fm
-        c_e = np.eye(n) if error_output is None else as_matrix(error_output, "error_output", (None, n))
-        if not np.any(c_e):
-            raise InvalidArgumentError("error_output", "a non-zero output matrix C_e", "all zeros")
-        self.error_output = c_e
-
-        # the inner RMPC's own constraint (validated there) decides the kind of bound
-        probe = RMPC(plant, Q, R, u_max=u_max, input_constraint=input_constraint, **options)
-        kind = probe.input_constraint
-        self.u_max = None if kind is None else np.array(probe.problem.data.u_max, dtype=float)
+        m = plant.n_inputs
+        # the kind and size of the bound, checked as the inner RMPC's problem will hold it
+        kind = input_constraint_kind(input_constraint, u_max)
+        bound = input_bound_vector(kind, u_max, m)
+        self._kind = kind
+        self.u_max = None if kind is None else np.array(bound, dtype=float)
         budget = check_choice(torque_budget, "torque_budget", ("auto", *TORQUE_BUDGETS))
         if budget == "auto":
             budget = "none" if kind is None else "current"
@@ -272,29 +208,14 @@ class CRMPC:
                 "torque_budget", "'none' or 'auto' without an input bound (u_max)", repr(torque_budget)
             )
         self.torque_budget = str(budget)
-        theta_bound = self._theta_bound(theta_bound, m)
-        self.theta_bound = theta_bound
+        self.theta_bound = self._theta_bound(theta_bound, m)
+        rmpc_bound = u_max
         if self.torque_budget == "split":
-            assert self.u_max is not None and theta_bound is not None
-            split = self._budget(theta_bound)
-            self.rmpc = RMPC(plant, Q, R, u_max=split, input_constraint=kind, **options)
-        else:
-            self.rmpc = probe
-        if lyapunov:
-            self.rule: LyapunovRule | MITRule = LyapunovRule(
-                m, self.adaptation_gain, self.dt, bound=theta_bound
-            )
-        else:
-            self.rule = MITRule(
-                m, self.adaptation_gain, self.dt, normalized=self.normalized, alpha=self.alpha,
-                bound=theta_bound,
-            )
-        self._b_delta = self._b / self.dt
-        self._sens = SensitivityFilter(self._a, self._b, c_e, columns=m)
-        self._minus_eye = -np.eye(m)
-        self._zm: np.ndarray | None = None
-        self._p: np.ndarray | None = None
-        self._since_reset = 0
+            assert self.theta_bound is not None
+            rmpc_bound = self._budget(self.theta_bound)
+        self.rmpc = RMPC(plant, Q, R, u_max=rmpc_bound, input_constraint=kind, **options)
+        a_nom, b_nom = (np.array(mat, dtype=float) for mat in plant.nominal)
+        self.adaptation = adaptation.bind(a_nom, b_nom, self.dt, self.theta_bound)
         self.last: StepInfo | None = None
 
     def _theta_bound(self, value: Any, m: int) -> np.ndarray | None:
@@ -306,7 +227,7 @@ class CRMPC:
             if self.u_max is None:
                 return None
             return DEFAULT_THETA_FRACTION * np.broadcast_to(self.u_max, (m,)).copy()
-        bound = _bound(value, "theta_bound", m)
+        bound = projection_bound(value, "theta_bound", m)
         if self.torque_budget != "none":
             if bound is None:
                 raise InvalidArgumentError(
@@ -332,45 +253,30 @@ class CRMPC:
     @property
     def rmpc_kind(self) -> str | None:
         """The inner RMPC's input constraint (``"ellipsoid"``, ``"peak"`` or ``None``)."""
-        return None if self.u_max is None else ("ellipsoid" if self.u_max.shape == (1,) else "peak")
+        return self._kind
 
     # -- the step(x) protocol -----------------------------------------------------------
     @property
     def theta(self) -> np.ndarray:
         """The current disturbance estimate ``theta`` (one value per input), a copy."""
-        return self.rule.theta
+        return self.adaptation.theta
 
     def reset(self) -> None:
         """Forget the adaptation, the reference model and the inner RMPC's gain."""
         self.rmpc.reset()
-        self.rule.reset()
-        self._sens.reset()
-        self._zm = None
-        self._p = None
-        self._since_reset = 0
+        self.adaptation.reset()
         self.last = None
 
-    def step(self, x: Any) -> np.ndarray:
-        """Adapt ``theta`` from the measured state, then return ``u = u_rmpc - theta``."""
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+        """Adapt ``theta`` from the measured state, then return ``u = u_rmpc - theta``.
+
+        ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).
+        """
         x = as_vector(x, "x", self.plant.n_states)
+        check_step_inputs(inputs, self.accepts, "CRMPC")
         z = x - self.rmpc.x_ref
-        lyapunov = isinstance(self.rule, LyapunovRule)
-        model_reset = self._zm is None or (not lyapunov and 0 < self._reset_steps <= self._since_reset)
-        if model_reset:
-            self._zm = z.copy()
-            self._sens.reset()
-            self._since_reset = 0
-        assert self._zm is not None
-        sens = None
-        if lyapunov:
-            error = z - self._zm
-            if self._p is not None:
-                self.rule.update(error, self._b_delta, self._p)
-            theta = self.rule.theta
-        else:
-            sens = self._sens.output()
-            error = self.error_output @ (z - self._zm)
-            theta = self.rule.update(error, sens)
+        adapted = self.adaptation.update(z)
+        theta = adapted.theta
 
         bound: float | np.ndarray | None = None
         step_bound: float | np.ndarray | None = None
@@ -379,27 +285,17 @@ class CRMPC:
         elif self.torque_budget == "split":
             step_bound = self.rmpc.problem.data.u_max[0] if self.rmpc_kind == "ellipsoid" else (
                 self.rmpc.problem.data.u_max.copy())
-        u_rmpc = np.asarray(self.rmpc.step(x, u_max=bound), dtype=float)
+        step_inputs = None if bound is None else StepInputs(u_max=bound)
+        u_rmpc = np.asarray(self.rmpc.step(x, step_inputs), dtype=float)
         inner = self.rmpc.last
         scaled = False
         if step_bound is not None:
             u_rmpc, scaled = _into_bound(u_rmpc, step_bound, self.rmpc_kind)
-        zm = self._zm
         gain = self.rmpc.gain
         if gain is None:
             gain = np.zeros((self.plant.n_inputs, self.plant.n_states))
-        if lyapunov:
-            self._zm = (self._a + self._b @ gain) @ zm
-            solution = None if inner is None else inner.extra.get("solution")
-            if solution is not None and inner is not None and not inner.fallback and solution.Q is not None:
-                self._p = solution.P
-        elif self.reference_gain is None:
-            self._zm = self._a @ zm + self._b @ u_rmpc
-            self._sens.advance(self._minus_eye)
-        else:
-            self._zm = (self._a + self._b @ self.reference_gain) @ zm
-            self._sens.advance(self._minus_eye, a=self._a + self._b @ gain)
-        self._since_reset += 1
+        certified = None if inner is None or inner.fallback else inner.extra.get("solution")
+        self.adaptation.advance(u_rmpc, gain, certified)
 
         self.last = StepInfo(
             status=inner.status if inner is not None else "unknown",
@@ -408,13 +304,17 @@ class CRMPC:
             iterations=inner.iterations if inner is not None else None,
             fallback=inner.fallback if inner is not None else False,
             extra={
-                "theta": theta, "error": error, "sensitivity": sens, "x_model": zm + self.rmpc.x_ref,
-                "u_rmpc": u_rmpc, "model_reset": model_reset, "rmpc": inner,
+                "theta": theta, "error": adapted.error, "sensitivity": adapted.sensitivity,
+                "x_model": adapted.model + self.rmpc.x_ref, "u_rmpc": u_rmpc,
+                "model_reset": adapted.model_reset, "rmpc": inner,
                 "u_bound": step_bound if not isinstance(step_bound, np.ndarray) else step_bound.copy(),
                 "budget_scaled": scaled,
             },
         )
         return u_rmpc - theta
+
+    def __repr__(self) -> str:
+        return f"CRMPC(adaptation={self.adaptation!r}, torque_budget={self.torque_budget!r})"
 
 
 def _into_bound(u: np.ndarray, bound: float | np.ndarray, kind: str | None) -> tuple[np.ndarray, bool]:

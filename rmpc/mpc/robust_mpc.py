@@ -11,16 +11,23 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from lmi import KothareProblem, LMISolution
-from lmi.status import INACCURATE, OPTIMAL
 from models import PolytopicModel
-from rmpc.controller import StepInfo
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
-from toolkit_common.validation import as_vector, check_choice, check_positive
+from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.mpc.fallback import CertifiedGain
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["RMPC"]
+__all__ = ["RMPC", "input_constraint_kind"]
 
-#: Statuses whose gain may be applied: converged (or nearly) *and* certified.
-_USABLE = (OPTIMAL, INACCURATE)
+
+def input_constraint_kind(input_constraint: str | None, u_max: Any) -> str | None:
+    """The input constraint ``"auto"`` stands for: ``"ellipsoid"`` with a bound ``u_max``, else none.
+
+    Any other value is returned as it is (the LMI problem checks it).
+    """
+    if input_constraint == "auto":
+        return None if u_max is None else "ellipsoid"
+    return input_constraint
 
 
 class RMPC:
@@ -48,7 +55,8 @@ class RMPC:
         Passed to :class:`lmi.KothareProblem`.
     on_failure : {"fallback", "raise"}
         What to do when a solve gives no usable (certified) answer: keep the last certified
-        gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`.
+        gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`
+        (:class:`~rmpc.mpc.fallback.CertifiedGain`).
     hold_radius : float
         Below this norm of ``x - x_ref`` the problem degenerates (``gamma -> 0``); the last
         certified gain is kept without re-solving (its invariant ellipsoid contains the state).
@@ -63,10 +71,15 @@ class RMPC:
     Attributes
     ----------
     name : str
-        ``"RMPC"``, the short name in reports.
+        ``"RMPC"``.
+    accepts : frozenset of str
+        ``{"u_max"}``: :meth:`step` takes a bound for one step through
+        :class:`~rmpc.controller.StepInputs`.
     last : StepInfo or None
         The last step: ``status``, ``solve_time``, ``gamma``, ``iterations``, ``fallback``, and
         ``extra["solution"]`` (the :class:`lmi.LMISolution`, ``None`` if no solve was made).
+    certified : CertifiedGain
+        The last certified gain, its ellipsoid and bound (:mod:`rmpc.mpc.fallback`).
 
     Examples
     --------
@@ -82,8 +95,8 @@ class RMPC:
     ('optimal', True)
     """
 
-    name = "RMPC"
-    accepts: ClassVar[frozenset[str]] = frozenset()
+    name: ClassVar[str] = "RMPC"
+    accepts: ClassVar[frozenset[str]] = frozenset({"u_max"})
 
     def __init__(
         self,
@@ -107,16 +120,14 @@ class RMPC:
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
-        if input_constraint == "auto":
-            input_constraint = None if u_max is None else "ellipsoid"
+        input_constraint = input_constraint_kind(input_constraint, u_max)
         self.plant = plant
         self.problem = KothareProblem(
             plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
             output_matrix=output_matrix, y_max=y_max, backend=backend, solver=solver,
             solver_options=solver_options, formulation=formulation, certificate_tol=certificate_tol,
         )
-        self.on_failure = check_choice(on_failure, "on_failure", ("fallback", "raise"))
-        self.hold_radius = check_positive(hold_radius, "hold_radius", allow_zero=True)
+        self.certified = CertifiedGain("RMPC", on_failure, hold_radius)
         self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
         if self.resolve_threshold > 1.0:
             raise InvalidArgumentError("resolve_threshold", "a level in (0, 1]", repr(resolve_threshold))
@@ -130,30 +141,31 @@ class RMPC:
             )
         self.dt = plant.dt
         self.last: StepInfo | None = None
-        self._gain: np.ndarray | None = None
-        self._q_inv: np.ndarray | None = None
-        self._gain_bound: np.ndarray | None = None
 
     @property
     def input_constraint(self) -> str | None:
+        """The kind of input bound, ``"ellipsoid"``, ``"peak"`` or ``None``."""
         return self.problem.data.input_constraint
+
+    @property
+    def on_failure(self) -> str:
+        """``"fallback"`` or ``"raise"``."""
+        return self.certified.on_failure
+
+    @property
+    def hold_radius(self) -> float:
+        """Below this norm of ``x - x_ref`` the last gain is kept without a solve."""
+        return self.certified.hold_radius
 
     @property
     def gain(self) -> np.ndarray | None:
         """The gain currently applied (the last certified ``F``), or ``None``."""
-        return None if self._gain is None else self._gain.copy()
-
-    def _current_gain(self) -> np.ndarray:
-        if self._gain is None:
-            return np.zeros((self.plant.n_inputs, self.plant.n_states))
-        return self._gain
+        return self.certified.gain
 
     def reset(self) -> None:
         """Forget the last gain and step."""
         self.last = None
-        self._gain = None
-        self._q_inv = None
-        self._gain_bound = None
+        self.certified.reset()
 
     def solve(self, x: Any, u_max: Any = None) -> LMISolution:
         """Solve the LMI problem at ``x`` (the deviation ``x - x_ref`` is used); no side effects.
@@ -163,72 +175,48 @@ class RMPC:
         x = as_vector(x, "x", self.plant.n_states)
         return self.problem.solve(x - self.x_ref, u_max=u_max)
 
-    def _bound_vector(self, u_max: Any) -> np.ndarray | None:
-        """The input bound of a step as a vector (``None``: the constructed bound)."""
-        if u_max is None:
-            return None
-        return self.problem._with_bound(u_max).u_max
-
     def in_ellipsoid(self, x: Any) -> bool:
         """Whether ``x - x_ref`` lies in the invariant ellipsoid of the current gain."""
-        if self._q_inv is None:
+        if self.certified.solution is None:
             return False
-        z = as_vector(x, "x", self.plant.n_states) - self.x_ref
-        return bool(z @ self._q_inv @ z <= 1.0 + 1e-9)
+        return self.certified.contains(as_vector(x, "x", self.plant.n_states) - self.x_ref)
 
-    def step(self, x: Any, u_max: Any = None) -> np.ndarray:
+    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
         """Solve at ``x`` and return ``u = F (x - x_ref)``; see the class notes on failures.
 
         Parameters
         ----------
         x : (n,) array_like
             The measured state.
-        u_max : float or array_like, optional
-            The input bound for this step instead of the constructed one (same kind). With
+        inputs : StepInputs, optional
+            ``inputs.u_max``: the input bound for this step instead of the constructed one
+            (same kind, checked by :meth:`lmi.KothareProblem.input_bound`). With
             ``resolve_threshold < 1`` a kept gain is re-solved when the requested bound is
             tighter than the one it was certified for. :class:`rmpc.CRMPC` passes what its
-            disturbance correction leaves of the torque limit.
+            disturbance correction leaves of the torque limit. Other fields are errors.
         """
         x = as_vector(x, "x", self.plant.n_states)
-        bound = self._bound_vector(u_max)
+        u_max = check_step_inputs(inputs, self.accepts, "RMPC").u_max
+        bound = None if u_max is None else self.problem.input_bound(u_max)
         z = x - self.x_ref
-        if float(np.linalg.norm(z)) <= self.hold_radius:
-            gain = self._current_gain()
-            self.last = StepInfo(status="reused", extra={"solution": None, "reason": "near origin"})
-            return gain @ z
+        shape = (self.plant.n_inputs, self.plant.n_states)
+        kept = self.certified
+        if kept.near_origin(z):
+            u, self.last = kept.reuse(z, shape, "near origin")
+            return u
         tighter = (
-            bound is not None and self._gain_bound is not None
-            and bool(np.any(bound < self._gain_bound * (1.0 - 1e-12)))
+            bound is not None and kept.bound is not None
+            and bool(np.any(bound < kept.bound * (1.0 - 1e-12)))
         )
-        if self.resolve_threshold < 1.0 and self._q_inv is not None and not tighter:
-            level = float(z @ self._q_inv @ z)
+        q_inv = kept.q_inv if self.resolve_threshold < 1.0 else None
+        if q_inv is not None and not tighter:
+            level = float(z @ q_inv @ z)
             if self.resolve_threshold < level <= 1.0:
-                self.last = StepInfo(
-                    status="reused", extra={"solution": None, "reason": "inside ellipsoid", "level": level}
-                )
-                return self._current_gain() @ z
+                u, self.last = kept.reuse(z, shape, "inside ellipsoid", level=level)
+                return u
         sol = self.problem.solve(z, u_max=bound)
-        usable = sol.status in _USABLE and sol.certificate is not None and sol.certificate.ok
-        if usable:
-            assert sol.F is not None and sol.Q is not None
-            self._gain = sol.F
-            self._q_inv = np.linalg.inv(sol.Q)
-            self._gain_bound = self.problem.data.u_max if bound is None else bound
-            self.last = StepInfo(
-                status=sol.status, solve_time=sol.solve_time, gamma=sol.gamma,
-                iterations=sol.iterations, extra={"solution": sol},
-            )
-            return self._gain @ z
-        if self.on_failure == "raise":
-            raise SolverError(
-                f"RMPC.step: the LMI solve at x = {x.tolist()} returned status {sol.status!r} "
-                f"(solver: {sol.solver_status!r}) and on_failure='raise'"
-            )
-        inside = self.in_ellipsoid(x)
-        gain = self._current_gain()
-        self.last = StepInfo(
-            status=sol.status, solve_time=sol.solve_time, gamma=None, iterations=sol.iterations,
-            fallback=True,
-            extra={"solution": sol, "inside_ellipsoid": inside, "had_gain": self._gain is not None},
+        u, self.last = kept.take(
+            sol, z, shape, x=x, bound=self.problem.data.u_max if bound is None else bound,
+            failure_extra={"inside_ellipsoid": kept.contains(z)},
         )
-        return gain @ z
+        return u

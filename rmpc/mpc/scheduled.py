@@ -24,15 +24,14 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from lmi import KothareProblem, LMISolution
-from lmi.status import INACCURATE, OPTIMAL
 from models import PolytopicModel, RigidSatellite
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
-from toolkit_common.validation import as_vector, check_choice, check_positive
+from rmpc.mpc.fallback import CertifiedGain
+from rmpc.mpc.robust_mpc import input_constraint_kind
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_positive
 
 __all__ = ["ScheduledRMPC"]
-
-_USABLE = (OPTIMAL, INACCURATE)
 
 
 class ScheduledRMPC:
@@ -56,10 +55,14 @@ class ScheduledRMPC:
     Attributes
     ----------
     name : str
-        ``"ScheduledRMPC"``, the short name in reports.
+        ``"ScheduledRMPC"``.
+    accepts : frozenset of str
+        Empty: :meth:`step` takes no :class:`~rmpc.controller.StepInputs`.
     last : StepInfo or None
         As for :class:`~rmpc.RMPC`; ``extra["build_time"]`` is the time spent building the
         polytope and the problem (s), which ``solve_time`` does not include.
+    certified : CertifiedGain
+        The last certified gain (:mod:`rmpc.mpc.fallback`, as for :class:`~rmpc.RMPC`).
 
     Examples
     --------
@@ -70,11 +73,11 @@ class ScheduledRMPC:
     >>> ctrl = ScheduledRMPC.for_satellite(sat, dt=0.01, spread=0.3, Q=np.diag([1, 1, 1, 0.1, 0.1, 0.1]),
     ...                                    R=np.eye(3), u_max=1.0)
     >>> u = ctrl.step(sat.initial_state())
-    >>> ctrl.last.status, bool(np.linalg.norm(u) <= 1.0 + 1e-6)
-    ('optimal', True)
+    >>> print(ctrl.last.status, bool(np.linalg.norm(u) <= 1.0 + 1e-6))
+    optimal True
     """
 
-    name = "ScheduledRMPC"
+    name: ClassVar[str] = "ScheduledRMPC"
     accepts: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
@@ -94,20 +97,17 @@ class ScheduledRMPC:
         if not callable(polytope_at):
             expected = "a callable x -> PolytopicModel"
             raise ArgumentTypeError("polytope_at", expected, type(polytope_at).__name__)
-        if input_constraint == "auto":
-            input_constraint = None if u_max is None else "ellipsoid"
+        input_constraint = input_constraint_kind(input_constraint, u_max)
         self.polytope_at = polytope_at
         self.options = {
             "Q": Q, "R": R, "input_constraint": input_constraint, "u_max": u_max, "backend": backend,
             "formulation": formulation, "certificate_tol": certificate_tol,
         }
-        self.on_failure = check_choice(on_failure, "on_failure", ("fallback", "raise"))
-        self.hold_radius = check_positive(hold_radius, "hold_radius", allow_zero=True)
+        self.certified = CertifiedGain("ScheduledRMPC", on_failure, hold_radius)
         self.n_states: int | None = None
         self.n_inputs: int | None = None
         self.dt: float | None = None
         self.last: StepInfo | None = None
-        self._gain: np.ndarray | None = None
 
     @classmethod
     def for_satellite(
@@ -136,14 +136,24 @@ class ScheduledRMPC:
         return cls(polytope_at, Q, R, u_max, input_constraint, **options)
 
     @property
+    def on_failure(self) -> str:
+        """``"fallback"`` or ``"raise"``."""
+        return self.certified.on_failure
+
+    @property
+    def hold_radius(self) -> float:
+        """Below this state norm the last gain is kept without a solve."""
+        return self.certified.hold_radius
+
+    @property
     def gain(self) -> np.ndarray | None:
         """The gain currently applied (the last certified ``F``), or ``None``."""
-        return None if self._gain is None else self._gain.copy()
+        return self.certified.gain
 
     def reset(self) -> None:
         """Forget the last gain and step."""
         self.last = None
-        self._gain = None
+        self.certified.reset()
 
     def problem_at(self, x: Any) -> KothareProblem:
         """The Kothare problem on the polytope at ``x``."""
@@ -166,40 +176,26 @@ class ScheduledRMPC:
         return self.problem_at(x).solve(x)
 
     def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
-        """Rebuild the polytope at ``x``, solve, and return ``u = F x``."""
-        check_step_inputs(inputs, self.accepts, self.name)
+        """Rebuild the polytope at ``x``, solve, and return ``u = F x``.
+
+        ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).
+        """
         x = as_vector(x, "x", self.n_states)
-        if float(np.linalg.norm(x)) <= self.hold_radius:
-            gain = self._current_gain(x)
-            self.last = StepInfo(status="reused", extra={"solution": None, "reason": "near origin"})
-            return gain @ x
+        check_step_inputs(inputs, self.accepts, "ScheduledRMPC")
+        kept = self.certified
+        if kept.near_origin(x):
+            u, self.last = kept.reuse(x, self._gain_shape(x), "near origin")
+            return u
         start = time.perf_counter()
         problem = self.problem_at(x)
         build = time.perf_counter() - start
         sol = problem.solve(x)
-        usable = sol.status in _USABLE and sol.certificate is not None and sol.certificate.ok
-        if usable:
-            assert sol.F is not None
-            self._gain = sol.F
-            self.last = StepInfo(
-                status=sol.status, solve_time=sol.solve_time, gamma=sol.gamma, iterations=sol.iterations,
-                extra={"solution": sol, "build_time": build},
-            )
-            return self._gain @ x
-        if self.on_failure == "raise":
-            raise SolverError(
-                f"ScheduledRMPC.step: the LMI solve at x = {x.tolist()} returned status {sol.status!r} "
-                f"(solver: {sol.solver_status!r}) and on_failure='raise'"
-            )
-        gain = self._current_gain(x)
-        self.last = StepInfo(
-            status=sol.status, solve_time=sol.solve_time, iterations=sol.iterations, fallback=True,
-            extra={"solution": sol, "build_time": build, "had_gain": self._gain is not None},
+        u, self.last = kept.take(
+            sol, x, self._gain_shape(x), extra={"build_time": build}, failure_extra={"build_time": build}
         )
-        return gain @ x
+        return u
 
-    def _current_gain(self, x: np.ndarray) -> np.ndarray:
-        if self._gain is not None:
-            return self._gain
+    def _gain_shape(self, x: np.ndarray) -> tuple[int, int]:
+        """``(m, n)`` of the gain (the zero gain applied before the first certified one)."""
         m = self.n_inputs if self.n_inputs is not None else self.problem_at(x).n_inputs
-        return np.zeros((m, x.shape[0]))
+        return (m, x.shape[0])

@@ -92,6 +92,7 @@ def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
 def _crmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CRMPC
+    from rmpc.mpc.adaptation import LyapunovRule
 
     constrained = scenario.saturation == "constraint"
     ctrl = CRMPC(
@@ -100,7 +101,7 @@ def _crmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
         np.diag(s["R_diag"]),
         u_max=scenario.u_max if constrained else None,
         input_constraint=s["input_constraint"] if constrained else None,
-        adaptation_gain=s["adaptation_gain"],
+        adaptation=LyapunovRule(gain=s["adaptation_gain"]),
         theta_bound=s["theta_fraction"] * scenario.u_max,
         torque_budget=s["torque_budget"] if constrained else "none",
         rmpc_options={"backend": s["backend"]},

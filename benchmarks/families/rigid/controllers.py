@@ -63,7 +63,7 @@ def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -> BuiltController:
+def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], adaptation: Any) -> BuiltController:
     from rmpc.mpc.crmpc import CRMPC
 
     q, r = _weights(s)
@@ -78,7 +78,7 @@ def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -
         theta_bound=s["theta_fraction"] * scenario.u_max,  # the projection is anti-windup in every mode
         torque_budget=budget,
         rmpc_options={"resolve_threshold": s["resolve_threshold"]},
-        **rule,
+        adaptation=adaptation,
     )
     limiter = scenario.saturation == "limiter" or (
         constrained and (bool(s["limiter"]) or budget == "none")
@@ -87,14 +87,20 @@ def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], **rule: Any) -
 
 
 def _crmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    return _crmpc_common(poly, scenario, s, rule="lyapunov", adaptation_gain=s["adaptation_gain"])
+    from rmpc.mpc.adaptation import LyapunovRule
+
+    # the setting adaptation_gain is the Lyapunov rule's gain g
+    return _crmpc_common(poly, scenario, s, LyapunovRule(gain=s["adaptation_gain"]))
 
 
 def _crmpc_mit(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    return _crmpc_common(
-        poly, scenario, s, rule="mit", adaptation_gain=s["mit_gain"], normalized=s["normalized"],
-        alpha=s["alpha"], reset_period=s["reset_period"],
+    from rmpc.mpc.adaptation import MITRule
+
+    # the settings mit_gain, normalized, alpha and reset_period are the MIT rule's
+    rule = MITRule(
+        gain=s["mit_gain"], normalized=s["normalized"], alpha=s["alpha"], reset_period=s["reset_period"]
     )
+    return _crmpc_common(poly, scenario, s, rule)
 
 
 def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:

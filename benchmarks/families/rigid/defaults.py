@@ -20,12 +20,12 @@ Why these values
   diverges: its ``u(k-1)`` is its own command, not the clipped torque. With ``R_du = 10`` it never
   exceeds 0.4 N m and E2 is void.) With the bounds of E2
   (``|u| <= 1``, ``|du| <= 0.01``) it settles within about 10 s.
-- CRMPC: the Lyapunov-based MRAS (rule "lyapunov", gain 100 1/s^2, an estimator bandwidth of
+- CRMPC: the Lyapunov-based MRAS (``LyapunovRule``, gain 100 1/s^2, an estimator bandwidth of
   about 10 rad/s) with the torque budget "current": the robust MPC is solved at every sample
   with what the disturbance estimate leaves of the limit, ``u_max - max |theta_i|``, and
   ``|theta_i| <= 0.8 u_max``, so the applied torque ``u_rmpc - theta`` stays inside the limit
   without a limiter. At E5 (true inertia 1.7 x) it rejects the disturbance in about 1.4 s
-  without a limit cycle. CRMPC-MIT is paper P's own MIT rule (normalised, gain 20 1/s,
+  without a limit cycle. CRMPC-MIT is paper P's own MIT rule (``MITRule``: normalised, gain 20 1/s,
   ``alpha = 1e-3``, open-loop reference model reset every 2 s, full-state error) with the
   same budget; it settles at the nominal inertia but not across the whole +-70 % polytope
   (docs/crmpc.rst).
@@ -215,7 +215,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
             "nominal closed loop under the RMPC's gain, never reset; |theta_i| <= theta_fraction u_max",
             "toolkit",
         ),
-        ("CRMPC-MIT error output", "full state (rmpc.CRMPC defaults for rule='mit')", "toolkit"),
+        ("CRMPC-MIT error output", "full state (MITRule's default error_output)", "toolkit"),
         ("GIPC outputs, memory", "the attitude; at rest with u(-1) = 0 (rmpc.GIPC defaults)", "toolkit"),
         (
             "OfflineRMPC design states",

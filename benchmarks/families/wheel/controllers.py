@@ -79,6 +79,7 @@ def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContro
 
 def _crmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CRMPC
+    from rmpc.mpc.adaptation import LyapunovRule
 
     q, r = _weights(s)
     constrained = scenario.saturation == "constraint"
@@ -89,7 +90,7 @@ def _crmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContr
         r,
         u_max=u_max,
         input_constraint=s["input_constraint"] if constrained else None,
-        adaptation_gain=s["adaptation_gain"],
+        adaptation=LyapunovRule(gain=s["adaptation_gain"]),
         theta_bound=s["theta_fraction"] * scenario.u_max if constrained else None,
         torque_budget=s["torque_budget"] if constrained else "none",
         rmpc_options={"backend": s["backend"]},

@@ -1,0 +1,336 @@
+"""The data of a block LMI problem, held the way the interior-point kernels read it.
+
+:class:`BlockData` is the data half of :class:`lmi.ipm.BlockLMISolver`: the blocks
+``S_j = C_j - sum_i x_i A_ij`` checked (:func:`check_block`, :func:`check_factor`), each block's
+upper triangle packed into one vector (:class:`PackedLayout`, the layout of
+:mod:`lmi.ipm.kernels`), the variables equilibrated once, and the coefficients kept in the three
+forms the kernels take: packed (``G``), as their non-zero entries (the ``sp_*`` arrays) and in
+factored form ``A_ij = D_j N_ij D_j'`` (the ``dict_*`` and ``fe_*`` arrays, grouped by
+:func:`factor_groups`). :meth:`BlockData.set_block` replaces a block in place; the scaled forms
+are refreshed before the next iteration (``_refresh``), and :data:`DIRECT_MIN_VARIABLES` decides
+whether the Schur complement is formed from the factored coefficients.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from toolkit_common.errors import InvalidArgumentError
+
+__all__ = [
+    "DIRECT_MIN_VARIABLES", "BlockData", "BlockFactor", "PackedLayout", "check_block", "check_factor",
+    "concatenate_factors", "concatenate_sparse", "entry_weight", "factor_groups",
+]
+
+#: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
+#: dictionary ``D`` (``k x d``) and the entries ``N_ij[p, q] = N_ij[q, p] = value`` (``i = var``,
+#: ``p <= q``; entries that repeat a position add up).
+BlockFactor = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+#: ``H`` is formed from the factored coefficients (:func:`lmi.ipm.kernels.scaling_and_schur_direct`)
+#: only for more variables than this, and when the operation count says it is cheaper. Below,
+#: the Schur complement is a small part of an iteration: on paper P (61 variables with its
+#: ellipsoid input bound) both ways measured the same median per solve (3.2-3.3 ms at 2
+#: vertices, 7.3-7.7 ms at 8), and the rows path keeps paper P's records bit-identical (the
+#: direct sum rounds differently; with a peak bound paper P has 67 variables and takes the
+#: direct path). On the 14-state flexible satellite (259 variables, 2 vertices) the direct form
+#: took the warm median from 876 ms to 21 ms (load ~7).
+DIRECT_MIN_VARIABLES = 64
+
+
+class PackedLayout:
+    """Where each block's upper triangle sits in a packed vector (see :mod:`lmi.ipm.kernels`)."""
+
+    def __init__(self, orders: list[int]) -> None:
+        self.orders = np.asarray(orders, dtype=np.int64)
+        sizes = [k * (k + 1) // 2 for k in orders]
+        self.offsets = np.cumsum([0, *sizes]).astype(np.int64)
+        self.size = int(self.offsets[-1])
+        self._triangles = []
+        for k in orders:
+            iu0, iu1 = np.triu_indices(k)
+            self._triangles.append((iu0, iu1, np.where(iu0 == iu1, 1.0, np.sqrt(2.0))))
+        self.ent_row = np.concatenate([t[0] for t in self._triangles]).astype(np.int64)
+        self.ent_col = np.concatenate([t[1] for t in self._triangles]).astype(np.int64)
+        self.ent_w = np.concatenate([t[2] for t in self._triangles])
+        #: the arguments every kernel takes, in order
+        self.arrays = (self.orders, self.offsets, self.ent_row, self.ent_col, self.ent_w)
+
+    def rows(self, j: int) -> slice:
+        return slice(int(self.offsets[j]), int(self.offsets[j + 1]))
+
+    def triangle(self, j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Row and column indices of block ``j``'s upper triangle, and the packing weights."""
+        return self._triangles[j]
+
+class BlockData:
+    """The blocks of ``min c'x, C_j - sum_i x_i A_ij >= 0`` as the kernels read them.
+
+    Parameters
+    ----------
+    n : int
+        Number of variables.
+    blocks : sequence of (C_j, A_j)
+        ``C_j`` is ``(k_j, k_j)`` symmetric, ``A_j`` is ``(n, k_j, k_j)`` with symmetric slices.
+    factors : sequence of BlockFactor or None, optional
+        Per block, its coefficients in factored form (:data:`BlockFactor`), or ``None``.
+
+    Attributes
+    ----------
+    n : int
+    block_orders : list of int
+        ``k_j``.
+    degree : int
+        ``sum_j k_j``.
+    """
+
+    def __init__(
+        self, n: int, blocks: Sequence[tuple[np.ndarray, np.ndarray]],
+        factors: Sequence[BlockFactor | None] | None = None,
+    ) -> None:
+        self.n = n
+        self._dscale: np.ndarray | None = None
+        checked = [check_block(j, const, coef, n) for j, (const, coef) in enumerate(blocks)]
+        orders = [const.shape[0] for const, _ in checked]
+        self.block_orders = orders
+        self.degree = sum(orders)
+        self._layout = PackedLayout(orders)
+        lay = self._layout
+        self._kmax = max(orders)
+        self._coef: list[np.ndarray] = [np.zeros((n, k, k)) for k in orders]
+        self._dirty: set[int] = set()
+        self._h_vec = np.zeros(lay.size)
+        self._g_mat = np.zeros((lay.size, n))  # packed scaled coefficients
+        self._sparse: tuple[np.ndarray, ...] = ()  # non-zero scaled coefficients (kernels' sp_*)
+        self._sparse_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
+        # factored coefficients A_ij = D_j N_ij D_j' (kernels' dict_*, fe_*; see
+        # scaling_and_schur_direct); None: D_j = I and N_ij = A_ij
+        if factors is not None and len(factors) != len(checked):
+            raise InvalidArgumentError("factors", f"one entry (or None) per block, {len(checked)}",
+                                       f"{len(factors)} entries")
+        self._factor_raw: list[BlockFactor | None] = [None] * len(checked)
+        self._fact_parts: list[tuple[np.ndarray, ...]] = [() for _ in orders]
+        self._fact: tuple[np.ndarray, ...] = ()
+        self._groups: tuple[np.ndarray, np.ndarray] = (np.zeros(1, dtype=np.int64),
+                                                       np.zeros(0, dtype=np.int64))
+        self._direct = False
+        self._const: list[np.ndarray] = [const for const, _ in checked]
+        for j, (const, coef) in enumerate(checked):
+            self._set_checked(j, const, coef)
+            if factors is not None and factors[j] is not None:
+                self._factor_raw[j] = check_factor(j, factors[j], coef, n)
+
+    def set_block(self, j: int, const: np.ndarray, coef: np.ndarray | None = None,
+                  factor: BlockFactor | None = None) -> None:
+        """Replace block ``j``'s constant (and coefficients, if given, with their factored form
+        ``factor`` or none)."""
+        if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < len(self.block_orders)):
+            raise InvalidArgumentError("j", f"a block index in [0, {len(self.block_orders)})", repr(j))
+        if factor is not None and coef is None:
+            raise InvalidArgumentError("factor", "None unless coef is given", "a factor without coef")
+        const_c, coef_c = check_block(int(j), const, coef, self.n, self.block_orders[j])
+        checked_factor = None if factor is None else check_factor(int(j), factor, coef_c, self.n)
+        self._set_checked(int(j), const_c, coef_c)
+        if coef_c is not None:
+            if (checked_factor is None) != (self._factor_raw[int(j)] is None) or checked_factor is not None:
+                self._dirty.add(int(j))
+                self._fact_parts[int(j)] = ()
+            self._factor_raw[int(j)] = checked_factor
+
+    def _set_checked(self, j: int, const: np.ndarray, coef: np.ndarray | None) -> None:
+        rows = self._layout.rows(j)
+        iu0, iu1, w = self._layout.triangle(j)
+        self._h_vec[rows] = const[iu0, iu1] * w
+        self._const[j] = const.copy()
+        if coef is not None and not np.array_equal(coef, self._coef[j]):
+            self._coef[j] = coef.copy()
+            self._dirty.add(j)
+
+    def _refresh(self) -> None:
+        """Variable scaling (once) and the scaled coefficients of the changed blocks."""
+        if self._dscale is None:
+            # equilibrate the variables once, x = D x~ with unit-norm scaled coefficients
+            # (later coefficient updates, e.g. a bound scaling, keep D)
+            norms = np.sqrt(sum(np.einsum("ikl,ikl->i", a, a) for a in self._coef))
+            self._dscale = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
+            self._dirty = set(range(len(self.block_orders)))
+        if not self._dirty:
+            return
+        rebuild = not self._sparse
+        for j in sorted(self._dirty):
+            scaled = self._coef[j] * self._dscale[:, None, None]  # (n, k, k)
+            iu0, iu1, w = self._layout.triangle(j)
+            upper = scaled[:, iu0, iu1]  # (n, entries), entries in packed order
+            self._g_mat[self._layout.rows(j)] = (upper * w).T
+            pattern = upper != 0.0
+            old = self._sparse_parts[j]
+            if (old and np.array_equal(pattern, old[0]) and self._fact_parts[j]
+                    and self._factor_raw[j] is None):  # same non-zeros (e.g. a bound scaling)
+                lo, hi = self._sparse[0][j], self._sparse[0][j + 1]
+                self._sparse[3][lo:hi] = upper[pattern]
+                flo, fhi = self._fact[2][j], self._fact[2][j + 1]
+                self._fact[6][flo:fhi] = upper[pattern] * entry_weight(old[4][old[2]], old[5][old[2]])
+                continue
+            var, entry = np.nonzero(pattern)  # ordered (variable, entry), as upper[pattern]
+            pair_entries, pair_of = np.unique(entry, return_inverse=True)
+            self._sparse_parts[j] = (pattern, var, pair_of, upper[pattern], iu0[pair_entries],
+                                     iu1[pair_entries])
+            self._fact_parts[j] = self._factored_part(j)
+            rebuild = True
+        self._dirty.clear()
+        if rebuild:
+            self._sparse = concatenate_sparse(self._sparse_parts)
+            self._fact = concatenate_factors(self._fact_parts, self._kmax)
+            self._groups = factor_groups(self._fact_parts, self._factor_raw)
+            self._direct = self._direct_is_cheaper()
+
+    def _factored_part(self, j: int) -> tuple[np.ndarray, ...]:
+        """``(D, var, p, q, value)`` of block ``j`` with the variable scaling and the weights of
+        :func:`lmi.ipm.kernels.scaling_and_schur_direct`, sorted by variable."""
+        raw = self._factor_raw[j]
+        if raw is None:  # D = I: the sparse upper-triangle entries
+            _, var, pair_of, val, prow, pcol = self._sparse_parts[j]
+            p, q = prow[pair_of], pcol[pair_of]
+            dmat = np.eye(self.block_orders[j])
+        else:
+            dmat, var, p, q, val = raw
+            val = val * self._dscale[var]
+            order = np.argsort(var, kind="stable")
+            var, p, q, val = var[order], p[order], q[order], val[order]
+        return dmat, var, p, q, val * entry_weight(p, q)
+
+    def _direct_is_cheaper(self) -> bool:
+        """Whether forming ``H`` from the factored coefficients costs fewer operations than
+        forming ``P`` and ``P'P``."""
+        n = self.n
+        direct, rows = 0.0, 0.0
+        for j, k in enumerate(self.block_orders):
+            dmat, var = self._fact_parts[j][0], self._fact_parts[j][1]
+            d = dmat.shape[1]
+            size = k * (k + 1) // 2
+            direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
+            rows += self._sparse_parts[j][1].shape[0] * size + size * n * n
+        return n > DIRECT_MIN_VARIABLES and direct < rows
+
+
+def entry_weight(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``sqrt(2) h`` with ``h = 1`` off the diagonal (``p != q``) and ``1/2`` on it."""
+    return np.where(p == q, 0.5, 1.0) * np.sqrt(2.0)
+
+
+def concatenate_factors(parts: list[tuple[np.ndarray, ...]], kmax: int) -> tuple[np.ndarray, ...]:
+    """The kernels' ``dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q, fe_val``."""
+    dims = np.array([part[0].shape[1] for part in parts], dtype=np.int64)
+    dict_mat = np.zeros((len(parts), kmax, int(dims.max())))
+    for j, part in enumerate(parts):
+        dict_mat[j, : part[0].shape[0], : dims[j]] = part[0]
+    offsets = np.cumsum([0, *(part[1].shape[0] for part in parts)]).astype(np.int64)
+    return (
+        dict_mat, dims, offsets,
+        np.concatenate([part[1] for part in parts]).astype(np.int64),
+        np.concatenate([part[2] for part in parts]).astype(np.int64),
+        np.concatenate([part[3] for part in parts]).astype(np.int64),
+        np.concatenate([part[4] for part in parts]).astype(float),
+    )
+
+
+def factor_groups(parts: list[tuple[np.ndarray, ...]],
+                   raw: list[BlockFactor | None]) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's ``grp_off, grp_blk`` (:func:`lmi.ipm.kernels.scaling_and_schur_grouped`):
+    blocks given in factored form whose order, dictionary width and entries are equal form one
+    group (a Kothare problem's vertex blocks); every other block is a group of its own. Groups
+    are ordered by their first block. Blocks without a given factor are never grouped: their
+    entry values change in place with the bound scalings (see ``_refresh``)."""
+    groups: list[list[int]] = []
+    for j, part in enumerate(parts):
+        for grp in groups:
+            head = parts[grp[0]]
+            if (raw[j] is not None and raw[grp[0]] is not None and part[0].shape == head[0].shape
+                    and all(np.array_equal(a, b) for a, b in zip(part[1:], head[1:], strict=True))):
+                grp.append(j)
+                break
+        else:
+            groups.append([j])
+    offsets = np.cumsum([0, *(len(g) for g in groups)]).astype(np.int64)
+    return offsets, np.array([j for g in groups for j in g], dtype=np.int64)
+
+
+def check_factor(j: int, factor: Any, coef: np.ndarray | None, n: int) -> BlockFactor:
+    """Validate a factored form ``(D, var, p, q, value)`` of block ``j``'s coefficients: it must
+    reproduce them (``A_ij = D N_ij D'``) to 1e-9 relative."""
+    name = f"factors[{j}]"
+    if coef is None:
+        raise InvalidArgumentError(name, "a factor only for a block given with coefficients", "no A")
+    try:
+        dmat, var, p, q, val = factor
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(name, "a tuple (D, var, p, q, value)", repr(type(factor))) from None
+    dmat = np.asarray(dmat, dtype=float)
+    k = coef.shape[1]
+    if dmat.ndim != 2 or dmat.shape[0] != k or dmat.shape[1] == 0 or not np.all(np.isfinite(dmat)):
+        raise InvalidArgumentError(f"{name} D", f"a finite ({k}, d) matrix", f"shape {dmat.shape}")
+    d = dmat.shape[1]
+    var, p, q = (np.asarray(a, dtype=np.int64).ravel() for a in (var, p, q))
+    val = np.asarray(val, dtype=float).ravel()
+    if not (var.shape == p.shape == q.shape == val.shape):
+        raise InvalidArgumentError(f"{name} entries", "var, p, q and value of equal length",
+                                   f"lengths {var.size}, {p.size}, {q.size}, {val.size}")
+    if np.any((var < 0) | (var >= n)) or np.any((p < 0) | (p > q) | (q >= d)) or not np.all(np.isfinite(val)):
+        raise InvalidArgumentError(f"{name} entries", f"0 <= var < {n}, 0 <= p <= q < {d}, finite values",
+                                   "an entry out of range")
+    nmat = np.zeros((n, d, d))
+    np.add.at(nmat, (var, p, q), val)
+    off = p != q
+    np.add.at(nmat, (var[off], q[off], p[off]), val[off])
+    rebuilt = dmat @ (nmat @ dmat.T)  # matmul: an unoptimised einsum took 5.3 s of a 7.3 s build
+    err = float(np.max(np.abs(rebuilt - coef), initial=0.0))
+    if err > 1e-9 * max(1.0, float(np.max(np.abs(coef), initial=0.0))):
+        raise InvalidArgumentError(name, "D N_i D' equal to the block's coefficients A_i",
+                                   f"a largest difference of {err:.1e}")
+    return dmat, var, p, q, val
+
+
+def concatenate_sparse(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
+    """The kernels' ``sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col`` from the
+    per-block ``(pattern, var, pair, value, pair_row, pair_col)``."""
+    entry_base = np.cumsum([0, *(part[1].shape[0] for part in parts)]).astype(np.int64)
+    pair_base = np.cumsum([0, *(part[4].shape[0] for part in parts)]).astype(np.int64)
+    return (
+        entry_base,
+        np.concatenate([part[1] for part in parts]).astype(np.int64),
+        np.concatenate([part[2] + pair_base[j] for j, part in enumerate(parts)]).astype(np.int64),
+        np.concatenate([part[3] for part in parts]).astype(float),
+        pair_base,
+        np.concatenate([part[4] for part in parts]).astype(np.int64),
+        np.concatenate([part[5] for part in parts]).astype(np.int64),
+    )
+
+
+def check_block(
+    j: int, const: Any, coef: Any, n: int, order: int | None = None
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Validate block ``j``: ``C_j`` ``(k, k)`` and ``A_j`` ``(n, k, k)``, finite and symmetric."""
+    name = f"blocks[{j}]"
+    c_mat = np.asarray(const, dtype=float)
+    if c_mat.ndim != 2 or c_mat.shape[0] != c_mat.shape[1] or c_mat.shape[0] == 0:
+        raise InvalidArgumentError(f"{name} C", "a square (k, k) matrix", f"shape {c_mat.shape}")
+    k = c_mat.shape[0]
+    if order is not None and k != order:
+        raise InvalidArgumentError(f"{name} C", f"order {order} (the block's order)", f"order {k}")
+    arrays = [("C", c_mat)]
+    a_mat = None
+    if coef is not None:
+        a_mat = np.asarray(coef, dtype=float)
+        if a_mat.shape != (n, k, k):
+            raise InvalidArgumentError(f"{name} A", f"shape ({n}, {k}, {k})", f"shape {a_mat.shape}")
+        arrays.append(("A", a_mat))
+    for label, arr in arrays:
+        if not np.all(np.isfinite(arr)):
+            raise InvalidArgumentError(f"{name} {label}", "finite values", "NaN or inf")
+        asym = float(np.max(np.abs(arr - np.swapaxes(arr, -1, -2)), initial=0.0))
+        if asym > 1e-12 * max(1.0, float(np.max(np.abs(arr), initial=0.0))):
+            raise InvalidArgumentError(f"{name} {label}", "symmetric matrices", f"asymmetry {asym:.1e}")
+    return c_mat, a_mat

@@ -1,0 +1,44 @@
+"""Compiled kernels of the interior-point iterations of :mod:`lmi.ipm` (numba, ``nopython``).
+
+The blocks of the Kothare problems are small (orders 7-15) and few (5-11), so a numpy
+implementation of an iteration is dominated by the fixed cost of its ~250 array calls, not by
+arithmetic (measured on paper P at 2 vertices: 0.55 of 0.8 ms per iteration). These kernels do
+one iteration's work in three calls: :func:`residuals`, :func:`scaling_and_schur_rows` and
+:func:`newton_step`; the Schur complement itself is factored by LAPACK from Python (in
+:mod:`lmi.ipm`). Matrix products and eigen-decompositions are BLAS/LAPACK calls made from
+compiled code; the Cholesky factorisations of the blocks and the smallest eigenvalues of the
+step-length test are plain loops.
+
+Layout shared by every kernel. ``nb`` blocks of orders ``orders[j]``; block matrices are held
+in ``(nb, kmax, kmax)`` arrays, only ``[:k, :k]`` used. A packed vector holds, block after
+block (``offsets[j]:offsets[j + 1]``), the upper triangle of each block row by row (the order
+of ``numpy.triu_indices``) scaled by ``w`` (1 on the diagonal, sqrt(2) off it), entry ``t`` at
+row ``ent_row[t]`` and column ``ent_col[t]``.
+The coefficients, with the variable scaling applied, are held as their non-zero upper-triangle
+entries: entry ``e`` (block ``j``'s entries are ``sp_off[j]:sp_off[j + 1]``) is
+``A_ij[a, b] = sp_val[e]`` with ``i = sp_var[e]`` and ``(a, b)`` the position pair
+``sp_pair[e]``; the distinct pairs of block ``j`` are ``pair_off[j]:pair_off[j + 1]``, pair
+``q`` being ``(pair_row[q], pair_col[q])`` with ``a <= b``. The
+Schur complement is ``H = P'P``; its factor is held transposed, ``pt`` ``(n, size)``, so that
+the rows the kernels write are contiguous.
+
+The kernels are grouped by stage: the packed layout, the block Cholesky factors and the
+residuals (:mod:`lmi.ipm.kernels.packed`), the NT scaling and the Schur complement in its three
+forms (:mod:`lmi.ipm.kernels.schur`), and the Newton step with its refinement and step lengths
+(:mod:`lmi.ipm.kernels.step`); this package re-exports the public ones. Compiled on first use and
+cached next to their files (``cache=True``): the first process after an install pays the
+compilation (about 10-20 s here), later ones load it (well under 1 s).
+"""
+
+from lmi.ipm.kernels.packed import cholesky_blocks, pack, residuals, unpack
+from lmi.ipm.kernels.schur import (
+    scaling_and_schur_direct,
+    scaling_and_schur_grouped,
+    scaling_and_schur_rows,
+)
+from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
+
+__all__ = [
+    "REFINE_STEPS", "cholesky_blocks", "newton_step", "pack", "residuals", "scaling_and_schur_direct",
+    "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
+]

@@ -1,0 +1,107 @@
+"""Kernels of the packed layout (:mod:`lmi.ipm.kernels`): packing, block Cholesky, residuals."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    "JIT", "cholesky_blocks", "cholesky_into", "diagonal_entry", "pack", "pack_block", "residuals", "unpack",
+    "unpack_block",
+]
+
+#: numba's options for every kernel: compiled once and cached on disk, released from the GIL.
+JIT = {"cache": True, "nogil": True}
+
+
+@njit(**JIT)
+def unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w):
+    """Block ``j`` (order ``k``) of a packed vector as a full symmetric ``(k, k)`` matrix."""
+    out = np.empty((k, k))
+    for t in range(offsets[j], offsets[j + 1]):
+        v = vec[t] / ent_w[t]
+        out[ent_row[t], ent_col[t]] = v
+        out[ent_col[t], ent_row[t]] = v
+    return out
+
+
+@njit(**JIT)
+def pack_block(mat, j, offsets, ent_row, ent_col, ent_w, out):
+    for t in range(offsets[j], offsets[j + 1]):
+        out[t] = mat[ent_row[t], ent_col[t]] * ent_w[t]
+
+
+@njit(**JIT)
+def pack(mats, orders, offsets, ent_row, ent_col, ent_w):
+    """Packed vector of the blocks ``mats`` ``(nb, kmax, kmax)``."""
+    out = np.empty(offsets[-1])
+    for j in range(orders.shape[0]):
+        pack_block(mats[j], j, offsets, ent_row, ent_col, ent_w, out)
+    return out
+
+
+@njit(**JIT)
+def unpack(vec, orders, offsets, ent_row, ent_col, ent_w, kmax):
+    """Blocks ``(nb, kmax, kmax)`` (zero outside ``[:k, :k]``) of a packed vector."""
+    out = np.zeros((orders.shape[0], kmax, kmax))
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        out[j, :k, :k] = unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w)
+    return out
+
+
+@njit(**JIT)
+def cholesky_into(a, k, out):
+    """Lower Cholesky factor of ``a[:k, :k]`` into ``out[:k, :k]``; ``False`` if not positive
+    definite (a non-positive or non-finite pivot)."""
+    for j in range(k):
+        for i in range(j):
+            out[i, j] = 0.0
+        s = a[j, j]
+        for p in range(j):
+            s -= out[j, p] * out[j, p]
+        if not 0.0 < s < np.inf:
+            return False
+        d = np.sqrt(s)
+        out[j, j] = d
+        for i in range(j + 1, k):
+            s = a[i, j]
+            for p in range(j):
+                s -= out[i, p] * out[j, p]
+            out[i, j] = s / d
+    return True
+
+
+@njit(**JIT)
+def cholesky_blocks(mats, orders, out):
+    """Cholesky factors of every block into ``out``; ``False`` if one is not positive definite."""
+    for j in range(orders.shape[0]):
+        if not cholesky_into(mats[j], orders[j], out[j]):
+            return False
+    return True
+
+
+@njit(**JIT)
+def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, ent_w):
+    """Residuals and norms at ``(x, S, Z)``.
+
+    Returns ``rd = G'z + c``, ``rp = G x + s - h``, ``gap = s'z``, the primal and dual costs,
+    and the norms of ``rp, G x, s, rd, G'z``.
+    """
+    sp = pack(s, orders, offsets, ent_row, ent_col, ent_w)
+    zp = pack(z, orders, offsets, ent_row, ent_col, ent_w)
+    gx = g_mat @ x
+    gtz = g_mat.T @ zp
+    rd = gtz + cvec
+    rp = gx + sp - h_vec
+    gap = float(sp @ zp)
+    pcost = float(cvec @ x)
+    dcost = -float(h_vec @ zp)
+    return (rd, rp, gap, pcost, dcost, np.linalg.norm(rp), np.linalg.norm(gx), np.linalg.norm(sp),
+            np.linalg.norm(rd), np.linalg.norm(gtz))
+
+
+@njit(**JIT)
+def diagonal_entry(offsets, j, k, a):
+    """Packed position of entry ``(a, a)`` of block ``j`` (upper triangle, row by row)."""
+    return offsets[j] + a * k - (a * (a - 1)) // 2

@@ -1,0 +1,207 @@
+"""Kernels of the NT scaling and the Schur complement ``H = P'P`` (:mod:`lmi.ipm.kernels`).
+
+:func:`scaling_and_schur_rows` forms ``P`` from the sparse coefficients and leaves ``H`` to
+LAPACK; :func:`scaling_and_schur_direct` and :func:`scaling_and_schur_grouped` form ``H`` from
+the factored coefficients, the vertex blocks of a group summed together.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from lmi.ipm.kernels.packed import JIT
+
+__all__ = ["scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows"]
+
+
+@njit(**JIT)
+def _nt_block(s_chol, z, j, k, kk_out, lam_out):
+    """NT scaling of block ``j`` (see :func:`scaling_and_schur_rows`) into ``kk_out[j]`` and
+    ``lam_out[j]``; ``False`` if the block lost positive definiteness."""
+    ell = np.ascontiguousarray(s_chol[j, :k, :k])
+    zj = np.ascontiguousarray(z[j, :k, :k])
+    m = ell.T @ (zj @ ell)
+    m = 0.5 * (m + m.T)
+    if not np.all(np.isfinite(m)):
+        return False
+    d, qv = np.linalg.eigh(m)
+    if not d[0] > 0.0:
+        return False
+    lam = np.sqrt(d)
+    rr = (ell @ qv) / np.sqrt(lam)  # columns scaled
+    kk_out[j, :k, :k] = (rr.T @ zj) / lam.reshape(k, 1)  # rows scaled
+    lam_out[j, :k] = lam
+    return True
+
+
+@njit(**JIT)
+def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
+                           sp_pair, sp_val, pair_off, pair_row, pair_col, kk_out, lam_out, pt_out):
+    """Nesterov-Todd scaling of every block and the Schur complement factor ``P'`` (``pt_out``).
+
+    For block ``j``, with ``S = L L'`` (``s_chol``) and ``L' Z L = Q diag(d) Q'`` (as in
+    SDPT3): ``lambda = sqrt(d)``, ``R = L Q diag(lambda)^-1/2``, ``K = diag(lambda)^-1 R' Z``,
+    so that ``K S K' = R' Z R = diag(lambda)``. Near the central path ``L' Z L`` is close to
+    ``mu I``, so the eigen-decomposition is well conditioned even when ``S`` and ``Z`` are
+    not.
+
+    Then ``pt_out[i, t]`` is entry ``t`` of the packed ``K A_ij K'``. By linearity it is a sum,
+    over the non-zero entries ``A_ij[a, b]`` (``a <= b``), of ``A_ij[a, b]`` times the packed
+    ``K (e_a e_b' + e_b e_a') K'`` (halved for ``a = b``); those packed matrices are formed once
+    per pair ``(a, b)`` that occurs (``pair_*``) and each entry is one contiguous multiply-add.
+    The Kothare blocks have 1-5 % non-zero coefficient entries, so this is several times less
+    arithmetic than two dense products per block. Returns ``False`` if a block lost positive
+    definiteness.
+    """
+    n = pt_out.shape[0]
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
+            return False
+        kk = np.ascontiguousarray(kk_out[j, :k, :k])  # contiguous, as computed: same rounding
+        kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
+        lo, hi = offsets[j], offsets[j + 1]
+        size = hi - lo
+        first = pair_off[j]
+        basis = np.empty((pair_off[j + 1] - first, size))
+        for q in range(first, pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            out = basis[q - first]
+            for t in range(size):
+                p, r = ent_row[lo + t], ent_col[lo + t]
+                if a == b:
+                    out[t] = ent_w[lo + t] * kt[a, p] * kt[a, r]
+                else:
+                    out[t] = ent_w[lo + t] * (kt[a, p] * kt[b, r] + kt[b, p] * kt[a, r])
+        for i in range(n):
+            for t in range(lo, hi):
+                pt_out[i, t] = 0.0
+        for e in range(sp_off[j], sp_off[j + 1]):
+            v = sp_val[e]
+            row = pt_out[sp_var[e]]
+            src = basis[sp_pair[e] - first]
+            for t in range(size):
+                row[lo + t] += v * src[t]
+    return True
+
+
+@njit(**JIT)
+def scaling_and_schur_direct(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q,
+                             fe_val, kk_out, lam_out, h_out):
+    """NT scaling of every block (as :func:`scaling_and_schur_rows`) and the Schur complement
+    ``H = P'P`` itself (``h_out``, ``n x n``), formed without ``P``.
+
+    Block ``j``'s coefficients are given in factored form ``A_ij = D_j N_ij D_j'`` with a
+    dictionary ``D_j`` (``dict_mat[j, :k, :d]``, ``d = dict_dims[j]``) shared by every variable
+    and sparse symmetric ``N_ij``: entry ``e`` (``fe_off[j]:fe_off[j + 1]``, sorted by variable)
+    adds ``N_ij[p, q] = N_ij[q, p] = v`` (``p = fe_p[e] <= q = fe_q[e]``, ``i = fe_var[e]``),
+    stored as ``fe_val[e] = v sqrt(2) h`` with ``h = 1`` (``p < q``) or ``1/2`` (``p = q``).
+    With ``G = (K D)'(K D)``, ``H_ik = sum_j tr(A_ij W^-1 A_kj W^-1)`` (``W^-1 = K'K``) is a sum
+    over pairs of entries of ``fe_val fe_val' (G_pr G_qs + G_ps G_qr)``: the cost is the square
+    of the number of entries, not ``rows x n^2``. With ``D = I`` this is the sparse formula of
+    SDPA (Fujisawa, Kojima, Nakata 1997); with the Kothare blocks' dictionaries
+    (:mod:`lmi.kothare_factors`) a vertex block of order ``2n`` has about ``5 n^2 / 2`` entries.
+    Returns ``False`` if a block lost positive definiteness. Every block is its own group of
+    :func:`scaling_and_schur_grouped` (the same arithmetic, in the same order).
+    """
+    nb = orders.shape[0]
+    return scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p,
+                                     fe_q, fe_val, np.arange(nb + 1), np.arange(nb), kk_out,
+                                     lam_out, h_out)
+
+
+@njit(**JIT)
+def scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p, fe_q,
+                              fe_val, grp_off, grp_blk, kk_out, lam_out, h_out):
+    """:func:`scaling_and_schur_direct` with blocks that share their entries summed together.
+
+    The blocks ``grp_blk[grp_off[g]:grp_off[g + 1]]`` of group ``g`` have the same order,
+    dictionary width and entries (``fe_var``, ``fe_p``, ``fe_q``, ``fe_val``; those of the
+    group's first block are used); only their dictionaries ``D_j`` and NT points differ, as for
+    the vertex blocks of a Kothare problem (only ``A_j``, ``B_j`` change from vertex to vertex).
+    Their ``G_j`` are stacked ``(d, d, members)``, so a pair of entries reads its indices once
+    and the group's ``G`` values from contiguous memory: ``c = v v' sum_j (G_j,pr G_j,qs +
+    G_j,ps G_j,qr)``, the sum over ``j`` compiled with re-association allowed (vectorised; its
+    rounding differs from the block-by-block sum). A group of one block does the arithmetic of
+    :func:`scaling_and_schur_direct` bit for bit. Groups are summed into ``H`` in their order.
+    """
+    n = h_out.shape[0]
+    for a in range(n):
+        for b in range(n):
+            h_out[a, b] = 0.0
+    for g in range(grp_off.shape[0] - 1):
+        first = grp_blk[grp_off[g]]
+        members = grp_off[g + 1] - grp_off[g]
+        k = orders[first]
+        d = dict_dims[first]
+        gs = np.empty((d, d, members))
+        for jj in range(members):
+            j = grp_blk[grp_off[g] + jj]
+            if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
+                return False
+            kd = np.ascontiguousarray(kk_out[j, :k, :k]) @ np.ascontiguousarray(dict_mat[j, :k, :d])
+            gj = kd.T @ kd
+            if members == 1:
+                _pair_sum(gj, fe_off[first], fe_off[first + 1], fe_var, fe_p, fe_q, fe_val, h_out)
+            else:
+                for a in range(d):
+                    for b in range(d):
+                        gs[a, b, jj] = gj[a, b]
+        if members > 1:
+            _pair_sum_group(gs, fe_off[first], fe_off[first + 1], fe_var, fe_p, fe_q, fe_val, h_out)
+    for a in range(n):
+        for b in range(a + 1, n):
+            h_out[b, a] = h_out[a, b]
+    return True
+
+
+@njit(**JIT)
+def _pair_sum(g, lo, hi, fe_var, fe_p, fe_q, fe_val, h_out):
+    """One block's pairs of entries ``lo:hi`` into the upper triangle of ``h_out`` (see
+    :func:`scaling_and_schur_direct`)."""
+    for e1 in range(lo, hi):
+        i1 = fe_var[e1]
+        p, q = fe_p[e1], fe_q[e1]
+        v1 = fe_val[e1]
+        gp = g[p]
+        gq = g[q]
+        hrow = h_out[i1]
+        # the pair (e1, e1) once, pairs (e1, e2 > e1) of the same variable twice (for
+        # (e2, e1)), pairs with a later variable once (H is mirrored by the caller)
+        hrow[i1] += v1 * v1 * (gp[p] * gq[q] + gp[q] * gq[p])
+        for e2 in range(e1 + 1, hi):
+            r, t = fe_p[e2], fe_q[e2]
+            c = v1 * fe_val[e2] * (gp[r] * gq[t] + gp[t] * gq[r])
+            i2 = fe_var[e2]
+            if i2 == i1:
+                c *= 2.0
+            hrow[i2] += c
+
+
+@njit(cache=True, nogil=True, fastmath={"reassoc", "contract", "nsz"})
+def _pair_sum_group(gs, lo, hi, fe_var, fe_p, fe_q, fe_val, h_out):
+    """:func:`_pair_sum` for a group of blocks with the same entries, ``gs`` ``(d, d, members)``;
+    the sum over the members may be re-associated (vectorised)."""
+    members = gs.shape[2]
+    for e1 in range(lo, hi):
+        i1 = fe_var[e1]
+        p, q = fe_p[e1], fe_q[e1]
+        v1 = fe_val[e1]
+        gp = gs[p]
+        gq = gs[q]
+        hrow = h_out[i1]
+        s = 0.0
+        for jj in range(members):
+            s += gp[p, jj] * gq[q, jj] + gp[q, jj] * gq[p, jj]
+        hrow[i1] += v1 * v1 * s
+        for e2 in range(e1 + 1, hi):
+            r, t = fe_p[e2], fe_q[e2]
+            s = 0.0
+            for jj in range(members):
+                s += gp[r, jj] * gq[t, jj] + gp[t, jj] * gq[r, jj]
+            c = v1 * fe_val[e2] * s
+            i2 = fe_var[e2]
+            if i2 == i1:
+                c *= 2.0
+            hrow[i2] += c

@@ -1,0 +1,312 @@
+"""Kernels of the Newton step (:mod:`lmi.ipm.kernels`): the refined Newton solve, the smallest
+eigenvalue of the step-length test and the predictor-corrector step itself."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, pack_block, unpack_block
+
+__all__ = ["REFINE_STEPS", "newton_step", "smallest_eigenvalue"]
+
+#: At most this many steps of iterative refinement per Newton solve (each stops early once
+#: the residual of ``P' dz = -r_d`` stops shrinking).
+REFINE_STEPS = 3
+
+
+@njit(**JIT)
+def _pt_times(pt, v, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+              pair_off, pair_row, pair_col, n):
+    """``P' v`` for a packed ``v``: ``pt @ v`` if ``P`` is formed (``pt`` has columns), else
+    ``sum_j <A_ij, K_j' V_j K_j>`` from the sparse coefficients: ``M = K_j' V_j K_j``, then
+    ``M_ab + M_ba`` (``M_aa`` on the diagonal) once per position pair, then one multiply-add
+    per coefficient entry."""
+    if pt.shape[1] > 0:
+        return pt @ v
+    out = np.zeros(n)
+    mp = np.empty(pair_row.shape[0])
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        kj = np.ascontiguousarray(kk[j, :k, :k])
+        m = kj.T @ unpack_block(v, j, k, offsets, ent_row, ent_col, ent_w) @ kj
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            mp[q] = m[a, a] if a == b else m[a, b] + m[b, a]
+        for e in range(sp_off[j], sp_off[j + 1]):
+            out[sp_var[e]] += sp_val[e] * mp[sp_pair[e]]
+    return out
+
+
+@njit(**JIT)
+def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+             pair_off, pair_row, pair_col):
+    """``P dx`` (packed): ``pt.T @ dx`` if ``P`` is formed, else the packed
+    ``K_j (sum_i dx_i A_ij) K_j'`` from the sparse coefficients (summed per position pair, in
+    entry order)."""
+    if pt.shape[1] > 0:
+        return pt.T @ dx
+    out = np.empty(offsets[-1])
+    acc_pair = np.zeros(pair_row.shape[0])
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        for e in range(sp_off[j], sp_off[j + 1]):
+            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
+        acc = np.zeros((k, k))
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            acc[a, b] = acc_pair[q]
+            acc[b, a] = acc_pair[q]
+        kj = np.ascontiguousarray(kk[j, :k, :k])
+        pack_block(kj @ acc @ kj.T, j, offsets, ent_row, ent_col, ent_w, out)
+    return out
+
+
+@njit(**JIT)
+def _triangular_solve(r_fac, b):
+    """``x`` with ``R'R x = b`` for upper triangular ``R``."""
+    n = b.shape[0]
+    y = b.copy()
+    for i in range(n):  # R' y = b (forward), by rows of R: the subtractions of a row-by-column
+        y[i] = y[i] / r_fac[i, i]  # loop in the same order (p ascending), contiguous reads
+        for p in range(i + 1, n):
+            y[p] -= r_fac[i, p] * y[i]
+    x = np.empty(n)
+    for i in range(n - 1, -1, -1):  # R x = y (backward)
+        s = y[i]
+        for p in range(i + 1, n):
+            s -= r_fac[i, p] * x[p]
+        x[i] = s / r_fac[i, i]
+    return x
+
+
+@njit(**JIT)
+def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col, ent_w, sp):
+    """Scaled Newton step ``(dx, ds~, dz~)`` for the complementarity right-hand side ``u``.
+
+    Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
+    refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks. ``sp`` holds the
+    sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)`` used for the
+    products with ``P`` when ``P`` is not formed (see :func:`_pt_times`).
+    """
+    n = rd.shape[0]
+    lay = (orders, offsets, ent_row, ent_col, ent_w)
+    v = u + rpt
+    dx = _triangular_solve(r_fac, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
+    dzt = _p_times(pt, dx, kk, *lay, *sp) + v
+    err = _pt_times(pt, dzt, kk, *lay, *sp, n) + rd
+    err_norm = np.linalg.norm(err)
+    for _ in range(REFINE_STEPS):
+        if err_norm <= 1e-14 * ref_scale:
+            break
+        ddx = _triangular_solve(r_fac, -err)
+        dzt_new = dzt + _p_times(pt, ddx, kk, *lay, *sp)
+        err_new = _pt_times(pt, dzt_new, kk, *lay, *sp, n) + rd
+        new_norm = np.linalg.norm(err_new)
+        if new_norm >= err_norm:
+            break
+        dx, dzt, err, err_norm = dx + ddx, dzt_new, err_new, new_norm
+    return dx, u - dzt, dzt
+
+
+@njit(**JIT)
+def _sturm_count(d, e, k, sigma):
+    """Number of eigenvalues below ``sigma`` of the tridiagonal matrix ``(d, e)`` (LDL' inertia)."""
+    count = 0
+    q = d[0] - sigma
+    for i in range(k):
+        if i > 0:
+            if q == 0.0:
+                q = 1e-300
+            q = d[i] - sigma - e[i - 1] * e[i - 1] / q
+        if q < 0.0:
+            count += 1
+    return count
+
+
+@njit(**JIT)
+def _tridiagonalize(a, k):
+    """Diagonal ``d`` and sub-diagonal ``e`` of a tridiagonal matrix similar to symmetric
+    ``a[:k, :k]`` (Householder reflections; overwrites ``a``)."""
+    d = np.empty(k)
+    e = np.zeros(k)
+    v = np.zeros(k)
+    w = np.zeros(k)
+    for c in range(k - 2):
+        s = 0.0
+        for i in range(c + 1, k):
+            s += a[i, c] * a[i, c]
+        if s == 0.0:
+            e[c] = 0.0
+            continue
+        alpha = -np.sqrt(s) if a[c + 1, c] > 0.0 else np.sqrt(s)
+        for i in range(c + 1, k):
+            v[i] = a[i, c]
+        v[c + 1] -= alpha
+        vv = s - a[c + 1, c] * a[c + 1, c] + v[c + 1] * v[c + 1]
+        beta = 2.0 / vv
+        for i in range(c + 1, k):  # w = beta A v - (beta^2 v'Av / 2) v
+            t = 0.0
+            for j in range(c + 1, k):
+                t += a[i, j] * v[j]
+            w[i] = beta * t
+        half = 0.0
+        for i in range(c + 1, k):
+            half += v[i] * w[i]
+        half *= 0.5 * beta
+        for i in range(c + 1, k):
+            w[i] -= half * v[i]
+        for i in range(c + 1, k):  # H A H = A - v w' - w v'
+            for j in range(c + 1, k):
+                a[i, j] -= v[i] * w[j] + w[i] * v[j]
+        e[c] = alpha
+    for i in range(k):
+        d[i] = a[i, i]
+    if k >= 2:
+        e[k - 2] = a[k - 1, k - 2]
+    return d, e
+
+
+@njit(**JIT)
+def smallest_eigenvalue(a, k, upper=np.inf, rtol=4.0 * 2.220446049250313e-16):
+    """A lower bound on the smallest eigenvalue of symmetric ``a[:k, :k]`` (overwrites ``a``).
+
+    Householder reduction to tridiagonal form, then bisection on Sturm counts from the
+    Gershgorin interval until the bracket is narrower than ``rtol`` times its largest end. The
+    lower end of the bracket is returned, so a step length ``-1 / lambda`` computed from it is
+    never too long. If the smallest eigenvalue is not below ``upper``, ``upper`` is returned
+    after one Sturm count (the step-length search only needs eigenvalues below ``-1 / cap``).
+    For the small blocks here this is several times faster than a LAPACK eigenvalue call from
+    compiled code, whose fixed cost (copies, workspace queries) dominates.
+    """
+    d, e = _tridiagonalize(a, k)
+    lo, hi = np.inf, -np.inf
+    for i in range(k):
+        radius = (abs(e[i - 1]) if i > 0 else 0.0) + (abs(e[i]) if i < k - 1 else 0.0)
+        lo = min(lo, d[i] - radius)
+        hi = max(hi, d[i] + radius)
+    if upper < hi:
+        if _sturm_count(d, e, k, upper) == 0:
+            return upper
+        hi = upper
+    if not lo < hi:
+        return lo
+    width = rtol * max(abs(lo), abs(hi)) + 1e-300
+    for _ in range(200):
+        if hi - lo <= width:
+            break
+        mid = 0.5 * (lo + hi)
+        if _sturm_count(d, e, k, mid) >= 1:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
+#: Step lengths are computed up to this cap (the callers use ``min(1, a)`` and
+#: ``min(1, 0.99 a)``), to this relative accuracy (a lower bound, never too long).
+_STEP_CAP = 1.0 / 0.99
+_STEP_RTOL = 1e-9
+
+
+@njit(**JIT)
+def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
+    """Largest ``a`` (up to ``_STEP_CAP``) with ``diag(lambda) + a d >= 0`` for ``d`` = ``ds``
+    and ``dz``, every block."""
+    alpha = _STEP_CAP
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        isq = 1.0 / np.sqrt(lam[j, :k])
+        for vec in (ds, dz):
+            dd = unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w)
+            for a in range(k):
+                for b in range(k):
+                    dd[a, b] *= isq[a] * isq[b]
+            t = smallest_eigenvalue(dd, k, -1.0 / alpha, _STEP_RTOL)
+            if t < -1.0 / alpha:
+                alpha = -1.0 / t
+    return alpha
+
+
+@njit(**JIT)
+def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
+                orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+                pair_row, pair_col, s_out, z_out, chol_out):
+    """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
+
+    The new ``S`` is recomputed from ``x`` as ``h - G x + theta r0`` (``theta`` decays by
+    ``1 - alpha``), so the primal residual decays exactly; its Cholesky factors go to
+    ``chol_out`` (reused by the next scaling). If rounding leaves that ``S`` not positive
+    definite, the step is shortened (at most five times by 0.8).
+
+    ``pt`` is ``P'`` (``n x size``) when it was formed (QR phase), or ``n x 0`` when only ``H``
+    was (:func:`scaling_and_schur_direct`); then the products with ``P`` come from the sparse
+    coefficients ``sp_*``, ``pair_*`` (layout of :func:`scaling_and_schur_rows`).
+
+    Returns ``(code, x_new, theta_new, alpha_aff, sigma, alpha)``; ``code`` 0 on success, 1 if
+    the step length is not finite or <= 1e-12, 2 if no shortened step kept ``S`` positive
+    definite.
+    """
+    nb = orders.shape[0]
+    m = offsets[-1]
+    # scaled primal residual K rp K'
+    rpt = np.empty(m)
+    for j in range(nb):
+        k = orders[j]
+        kj = np.ascontiguousarray(kk[j, :k, :k])
+        rj = unpack_block(rp, j, k, offsets, ent_row, ent_col, ent_w)
+        pack_block(kj @ rj @ kj.T, j, offsets, ent_row, ent_col, ent_w, rpt)
+    # predictor: u = lambda^{o-1}(-lambda o lambda) = -diag(lambda)
+    u = np.zeros(m)
+    for j in range(nb):
+        k = orders[j]
+        for a in range(k):
+            u[diagonal_entry(offsets, j, k, a)] = -lam[j, a]
+    sp = (sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)
+    _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col,
+                            ent_w, sp)
+    alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
+    sigma = (1.0 - alpha_aff) ** 3
+    # corrector: u = lambda^{o-1}(sigma mu e - lambda o lambda - ds_a o dz_a)
+    u_cor = np.empty(m)
+    for j in range(nb):
+        k = orders[j]
+        da = unpack_block(dsa, j, k, offsets, ent_row, ent_col, ent_w)
+        db = unpack_block(dza, j, k, offsets, ent_row, ent_col, ent_w)
+        prod = da @ db
+        rc = -0.5 * (prod + prod.T)
+        for a in range(k):
+            rc[a, a] += sigma * mu - lam[j, a] * lam[j, a]
+        for a in range(k):
+            for b in range(k):
+                rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
+        pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
+    dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
+                           ent_col, ent_w, sp)
+    alpha = min(1.0, 0.99 * _max_step(lam, dst, dzt, orders, offsets, ent_row, ent_col, ent_w))
+    if not (np.isfinite(alpha) and alpha > 1e-12):
+        return 1, x, theta, alpha_aff, sigma, alpha
+    for _ in range(6):
+        x_new = x + alpha * dx
+        theta_new = theta * (1.0 - alpha)
+        s_vec = h_vec - g_mat @ x_new + theta_new * r0
+        ok = True
+        for j in range(nb):
+            k = orders[j]
+            s_out[j, :k, :k] = unpack_block(s_vec, j, k, offsets, ent_row, ent_col, ent_w)
+            if not cholesky_into(s_out[j], k, chol_out[j]):
+                ok = False
+                break
+        if not ok:
+            alpha *= 0.8
+            continue
+        for j in range(nb):
+            k = orders[j]
+            kj = np.ascontiguousarray(kk[j, :k, :k])
+            lz = alpha * unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w)
+            for a in range(k):
+                lz[a, a] += lam[j, a]
+            zn = kj.T @ lz @ kj
+            z_out[j, :k, :k] = 0.5 * (zn + zn.T)
+        return 0, x_new, theta_new, alpha_aff, sigma, alpha
+    return 2, x, theta, alpha_aff, sigma, alpha

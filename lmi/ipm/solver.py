@@ -1,0 +1,422 @@
+"""A structure-exploiting primal-dual interior-point solver for small block LMI problems.
+
+Solves ::
+
+    minimise c'x   subject to   S_j = C_j - sum_i x_i A_ij  >= 0   (every block j)
+
+with ``x`` in R^n and a few symmetric blocks of small order (the Kothare problems of this
+toolkit: tens of variables, blocks of order <= 25). General conic solvers handle this badly:
+Clarabel factors a sparse KKT system in the half-vectorised space, in which every order-``k``
+block becomes a dense ``k(k+1)/2`` square. Here each Newton step is reduced to the ``n x n``
+Schur complement ``H = P' P``, where the columns of ``P`` are the half-vectorised scaled
+coefficients ``K A_i K'``. The blocks are small and few, so an iteration written as numpy
+calls costs more in the calls' fixed overhead than in arithmetic; the work of an iteration is
+therefore done by three compiled kernels (:mod:`lmi.ipm.kernels`, numba) and one LAPACK
+factorisation, and this module keeps the data, the starting points and the stopping rules.
+
+Algorithm: infeasible-start path following with Nesterov-Todd scaling and Mehrotra's
+predictor-corrector, as in Vandenberghe's CVXOPT ``coneqp`` (L. Vandenberghe, "The CVXOPT
+linear and quadratic cone program solvers", 2010), without the homogeneous self-dual embedding:
+an infeasible or unbounded problem ends as ``"insufficient_progress"``, ``"max_iterations"`` or
+``"numerical_error"``, never as a wrong ``"optimal"``. The NT scaling of each block comes from
+one Cholesky factor and one small symmetric eigen-decomposition (as in SDPT3).
+Variables are equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is factored by Cholesky until it
+becomes ill-conditioned near the optimum, then through a QR factorisation of ``P`` (which does
+not square the condition number); each Newton solve is iteratively refined on the exact
+equations. Successive solves can be warm-started from an interior iterate of the previous one.
+
+Larger problems (``factors``): forming ``P`` costs ``size x n`` per block and ``P'P``
+``size x n^2``, which grows as ``n_states^6`` for the Kothare blocks. When a block's
+coefficients are given in factored form ``A_ij = D_j N_ij D_j'`` (a dictionary ``D_j`` shared by
+all variables, sparse ``N_ij``; :mod:`lmi.kothare_factors`), ``H`` is formed directly as a sum
+over pairs of entries (:func:`lmi.ipm.kernels.scaling_and_schur_direct`) and ``P`` is never
+formed; the Newton products with ``P`` use the sparse coefficients. The QR phase still forms
+``P``. See :data:`DIRECT_MIN_VARIABLES` for when this is used.
+
+The solver is split along its seams: the data as the kernels read it (:mod:`lmi.ipm.blocks`,
+the base class :class:`~lmi.ipm.blocks.BlockData`), phase one and its certificate
+(:mod:`lmi.ipm.phase_one`), the compiled kernels (:mod:`lmi.ipm.kernels`) and, here, the method:
+the starting points, the iterations, their stopping rules and the warm starts.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+from scipy.linalg.lapack import dpotrf
+
+from lmi.ipm import kernels as _kernels
+from lmi.ipm.blocks import BlockData, BlockFactor
+from lmi.ipm.phase_one import PhaseOneResult, run_phase_one
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_vector, check_positive
+
+__all__ = ["QR_SWITCH", "REDUCED_TOL", "STALL_WINDOW", "BlockLMISolver", "IPMResult"]
+
+_LOG = logging.getLogger(__name__)
+
+#: A run that stalls but has reached relative residuals and gap below this ends as
+#: ``"inaccurate"`` (Clarabel's ``AlmostSolved``).
+REDUCED_TOL = 1e-6
+
+#: The Newton system is solved by Cholesky of the Schur complement ``H`` until a pivot falls
+#: below this fraction of ``sqrt(H_jj)`` (a scale-invariant measure of the accuracy lost), then,
+#: for the rest of the solve, by a QR factorisation of the scaled coefficients ``P`` (about twice
+#: the cost; it does not square ``P``'s condition number). Measured on paper P: 1e-6 gave the
+#: fewest iterations; 1e-7 and below cost 2 more iterations per solve at 2 vertices.
+QR_SWITCH = 1e-6
+
+#: A run stops as ``"insufficient_progress"`` when its worst measure (relative residuals and
+#: gap) has not halved over this many iterations. Infeasible problems stall like this. On 60
+#: random Kothare problems (n 2-10, 1-5 vertices, 42 of them infeasible or failing) a window of
+#: 15 stopped the failing runs after a median of 18 iterations (max 33) instead of 60 and lost
+#: none of the 18 optimal ones; a window of 10 lost one (it converged at iteration 28).
+STALL_WINDOW = 15
+STALL_FACTOR = 0.5
+
+
+@dataclass
+class IPMResult:
+    """Outcome of :meth:`BlockLMISolver.solve`.
+
+    ``x`` is the variable vector; ``S`` and ``Z`` are the slack and dual blocks (in the order
+    the blocks were given, without padding).
+    """
+
+    status: str
+    x: np.ndarray
+    S: list[np.ndarray]
+    Z: list[np.ndarray]
+    iterations: int
+    primal_objective: float
+    dual_objective: float
+    primal_residual: float
+    dual_residual: float
+    gap: float
+    solve_time: float
+
+
+
+class BlockLMISolver(BlockData):
+    """Interior-point solver for ``min c'x, C_j - sum_i x_i A_ij >= 0``, data updatable in place.
+
+    Parameters
+    ----------
+    c : (n,) ndarray
+        Objective.
+    blocks : sequence of (C_j, A_j)
+        ``C_j`` is ``(k_j, k_j)`` symmetric, ``A_j`` is ``(n, k_j, k_j)`` with symmetric slices.
+    tol_feas, tol_gap_abs, tol_gap_rel : float
+        Relative primal/dual residual and absolute/relative duality gap at termination.
+    max_iter : int
+        Iteration limit of a cold start.
+    warm_max_iter : int
+        Iteration limit of a warm start (then it is retried cold).
+    warm_gap, warm_feas : float
+        The iterate kept for the next warm start is the last one of a successful solve with a
+        relative gap in ``[warm_gap / 10, warm_gap]`` and relative residuals below
+        ``warm_feas``. Measured on paper P's closed loop (2 and 8 vertices), ``1e-2``/``1e-3``
+        took 8-10 iterations per solve against 16-20 cold; ``1e-1`` took 10-11, ``1e-3`` 13.
+
+    Raises
+    ------
+    InvalidArgumentError
+        For data of the wrong shape, non-finite or non-symmetric data, or bad settings; the
+        message names the argument.
+
+    Notes
+    -----
+    An instance keeps work buffers and the warm-start point between solves: use one instance
+    per thread (each :class:`lmi.KothareProblem` has its own). The iterations run in compiled
+    kernels (:mod:`lmi.ipm.kernels`). The first solver built in a process loads them (about
+    0.3 s; after a fresh install it compiles them, 10-20 s), so that this cost falls on the
+    construction and not on the first solve of a real-time loop.
+
+    Examples
+    --------
+    The largest eigenvalue of ``M`` is ``min t`` subject to ``t I - M >= 0``:
+
+    >>> import numpy as np
+    >>> m = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> res = BlockLMISolver([1.0], [(-m, -np.eye(2)[None])]).solve()
+    >>> res.status, round(float(res.x[0]), 6)
+    ('optimal', 3.0)
+    """
+
+    def __init__(
+        self,
+        c: np.ndarray,
+        blocks: Sequence[tuple[np.ndarray, np.ndarray]],
+        *,
+        tol_feas: float = 1e-8,
+        tol_gap_abs: float = 1e-8,
+        tol_gap_rel: float = 1e-8,
+        max_iter: int = 60,
+        warm_max_iter: int = 25,
+        warm_gap: float = 1e-2,
+        warm_feas: float = 1e-3,
+        factors: Sequence[BlockFactor | None] | None = None,
+    ) -> None:
+        self.c = as_vector(c, "c")
+        n = self.n = self.c.shape[0]
+        if len(blocks) == 0:
+            raise InvalidArgumentError("blocks", "at least one (C_j, A_j) pair", "none")
+        for name, value in (("tol_feas", tol_feas), ("tol_gap_abs", tol_gap_abs),
+                            ("tol_gap_rel", tol_gap_rel), ("warm_gap", warm_gap),
+                            ("warm_feas", warm_feas)):
+            check_positive(value, name)
+        for name, value in (("max_iter", max_iter), ("warm_max_iter", warm_max_iter)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise InvalidArgumentError(name, "an integer >= 1", repr(value))
+        self.tol_feas, self.tol_gap_abs, self.tol_gap_rel = tol_feas, tol_gap_abs, tol_gap_rel
+        self.max_iter = max_iter
+        self.warm_max_iter = warm_max_iter
+        self.warm_gap, self.warm_feas = warm_gap, warm_feas
+        self._warm: tuple | None = None
+        super().__init__(n, blocks, factors)
+        self._phase_one_solver: BlockLMISolver | None = None
+        _load_kernels()
+
+    def reset_warm_start(self) -> None:
+        """Forget the stored warm-start point (the next warm solve starts cold)."""
+        self._warm = None
+
+    # -- the solve -----------------------------------------------------------------------
+    def solve(self, warm_start: bool = False) -> IPMResult:
+        """Solve with the current data.
+
+        With ``warm_start``, start from the iterate the previous solve passed through at a
+        relative gap of ``warm_gap`` (an interior, roughly centred point) instead of the
+        default initial point; the residuals the new data cause are handled like any
+        infeasible start. A warm start that fails is retried cold.
+        """
+        start = time.perf_counter()
+        self._refresh()
+        res = None
+        spent = 0
+        if warm_start and self._warm is not None:
+            res = self._run(self._warm, self.warm_max_iter)
+            if res.status != "optimal":
+                spent, res = res.iterations, None
+        if res is None:
+            res = self._run(None, self.max_iter)
+        res.iterations += spent
+        res.solve_time = time.perf_counter() - start
+        return res
+
+    def phase_one(self) -> PhaseOneResult:
+        """Decide feasibility of the current data: ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0``.
+
+        The phase-one problem is strictly feasible by construction and started at a feasible
+        point (``x = 0``, ``t = 1 + max(0, -lambda_min(C))``), so its primal iterates stay
+        feasible and its dual iterates ``Z`` stay positive definite. It stops as soon as
+
+        * an iterate has ``t < 0``: its ``x`` is strictly feasible for the original problem
+          (``"feasible"``; checked by Cholesky of every ``C_j - sum_i x_i A_ij``), or
+        * the dual iterate, moved onto ``sum_j <A_ij, Z_j> = 0`` (for every original ``i``) by
+          the least-norm correction, is still positive semidefinite with
+          ``sum_j <C_j, Z_j> <= -PHASE_ONE_MARGIN ||C|| ||Z||``: a Farkas certificate of
+          infeasibility (``"infeasible"``, see :class:`PhaseOneResult`).
+
+        Otherwise (its optimum ``t* = 0``, i.e. the data on the boundary of feasibility, or a
+        failed run) the answer is ``"inconclusive"``. An interior ``Z`` is well conditioned, so
+        the correction, of the size of the dual residual, leaves it positive definite once
+        that residual is small; the limit of a failed run of the problem itself is a nearly
+        singular ray that such a correction makes indefinite. The phase-one solver is built on
+        the first call (the same blocks with one more variable of coefficient ``-I``; factored
+        blocks keep their factored form when their dictionary holds the identity columns) and
+        reused.
+        """
+        return run_phase_one(self)
+
+    def _initial_point(self, cvec: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """CVXOPT's initial point: least squares, shifted into the interiors."""
+        g_mat, h_vec = self._g_mat, self._h_vec
+        gtg_f = cho_factor(g_mat.T @ g_mat + 1e-12 * np.eye(self.n))
+        x = cho_solve(gtg_f, g_mat.T @ h_vec)
+        s = self._shift_interior(self._unpack(h_vec - g_mat @ x))
+        z = self._shift_interior(self._unpack(-g_mat @ cho_solve(gtg_f, cvec)))
+        return x, s, z
+
+    def _run(self, warm: tuple | None, max_iter: int, monitor: Any = None) -> IPMResult:
+        """The iterations. ``monitor(x, s, z)`` (optional, phase one) is called at every iterate
+        with the equilibrated ``x``; a word it returns ends the run with that status."""
+        n = self.n
+        lay = self._layout
+        packing = lay.arrays
+        orders = lay.orders
+        dscale = self._dscale
+        g_mat, h_vec = self._g_mat, self._h_vec
+        cvec = self.c * dscale
+        c_norm = max(1.0, float(np.linalg.norm(cvec)))
+        h_norm = max(1.0, float(np.linalg.norm(h_vec)))
+        if warm is None:
+            x, s, z = self._initial_point(cvec)
+        else:
+            x, s, z = warm[0] / dscale, warm[1], warm[2]
+        # S is kept as h - G x + theta r0 (theta = prod(1 - alpha)): the primal residual then
+        # decays exactly, where updating S through the scaling lets it drift up near the optimum
+        # (measured: 1e-10 -> 3e-6 relative over the last iterations of some paper-P solves)
+        r0 = _kernels.pack(s, *packing) + g_mat @ x - h_vec
+        theta = 1.0
+        kmax = self._kmax
+        kk = np.zeros((len(orders), kmax, kmax))
+        lam = np.zeros((len(orders), kmax))
+        pt_mat = np.zeros((n, lay.size))  # P', P = the scaled coefficients, packed
+        no_pt = np.zeros((n, 0))  # P not formed: the kernels use the sparse coefficients
+        h_mat = np.zeros((n, n))
+        sp = self._sparse
+        s_chol = np.zeros_like(s)
+        status = "max_iterations"
+        pres = dres = gap = np.inf
+        it = 0
+        use_qr = False
+        best: tuple | None = None
+        warm_next: tuple | None = None
+        merits: list[float] = []
+        if not _kernels.cholesky_blocks(s, orders, s_chol):
+            max_iter, status = -1, "numerical_error"
+        debug = _LOG.isEnabledFor(logging.DEBUG)
+        for it in range(max_iter + 1):
+            rd, rp, gap, pcost, dcost, n_rp, n_gx, n_sp, n_rd, n_gtz = _kernels.residuals(
+                s, z, x, g_mat, h_vec, cvec, *packing)
+            pres = n_rp / max(h_norm, n_gx, n_sp)
+            dres = n_rd / max(c_norm, n_gtz)
+            rel_gap = gap / max(abs(pcost), abs(dcost), 1e-300)
+            if debug:
+                _LOG.debug("%3d %+.9e %+.9e pres %.1e dres %.1e gap %.1e", it, pcost, dcost, pres,
+                           dres, gap)
+            if pres <= self.tol_feas and dres <= self.tol_feas and (
+                gap <= self.tol_gap_abs or rel_gap <= self.tol_gap_rel
+            ):
+                status = "optimal"
+                break
+            if max(pres, dres) <= REDUCED_TOL and min(gap, rel_gap) <= REDUCED_TOL:
+                best = (x, s, z, pres, dres, gap)
+            if monitor is not None and (word := monitor(x, s, z)) is not None:
+                status, best = word, None
+                break
+            merits.append(max(pres, dres, min(gap, rel_gap)))
+            if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW]:
+                status = "insufficient_progress"
+                break
+            if (0.1 * self.warm_gap <= rel_gap <= self.warm_gap
+                    and max(pres, dres) <= self.warm_feas):
+                warm_next = (x * dscale, s, z)
+            if it == max_iter:
+                break
+            pt_use = pt_mat
+            if self._direct and not use_qr:  # H from the factored coefficients, P not formed
+                if not _kernels.scaling_and_schur_grouped(s_chol, z, orders, *self._fact,
+                                                          *self._groups, kk, lam, h_mat):
+                    status = "numerical_error"
+                    break
+                r_fac, use_qr = _cholesky(h_mat)
+                pt_use = no_pt
+            if not self._direct or use_qr:
+                if not _kernels.scaling_and_schur_rows(s_chol, z, *packing, *self._sparse, kk, lam,
+                                                       pt_mat):
+                    status = "numerical_error"
+                    break
+                try:
+                    r_fac, use_qr = _factor(pt_mat, use_qr)
+                except (np.linalg.LinAlgError, ValueError):
+                    status = "numerical_error"
+                    break
+                pt_use = pt_mat
+            s_new, z_new, chol_new = np.zeros_like(s), np.zeros_like(z), np.zeros_like(s)
+            code, x_new, theta, a_aff, sigma, alpha = _kernels.newton_step(
+                pt_use, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, gap / self.degree,
+                max(c_norm, n_gtz), *packing, *sp, s_new, z_new, chol_new)
+            if debug:
+                _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
+            if code != 0:
+                status = "numerical_error"
+                break
+            x, s, z, s_chol = x_new, s_new, z_new, chol_new
+        if status == "optimal" and warm_next is not None:
+            self._warm = warm_next
+        if status != "optimal" and best is not None:
+            status = "inaccurate"
+            x, s, z, pres, dres, gap = best
+        s_out = [s[j, :k, :k].copy() for j, k in enumerate(self.block_orders)]
+        z_out = [z[j, :k, :k].copy() for j, k in enumerate(self.block_orders)]
+        zp = _kernels.pack(z, *packing)
+        return IPMResult(
+            status, x * dscale, s_out, z_out, it, float(cvec @ x), -float(h_vec @ zp), pres, dres,
+            gap, 0.0,
+        )
+
+    def _unpack(self, vec: np.ndarray) -> np.ndarray:
+        return _kernels.unpack(vec, *self._layout.arrays, self._kmax)
+
+    def _shift_interior(self, mats: np.ndarray) -> np.ndarray:
+        """``mats + t I`` (every block), ``t = 1 + max(0, -lambda_min)``."""
+        low = min(float(np.linalg.eigvalsh(mats[j, :k, :k])[0]) for j, k in enumerate(self.block_orders))
+        shift = 1.0 + max(0.0, -low)
+        for j, k in enumerate(self.block_orders):
+            mats[j, :k, :k] += shift * np.eye(k)
+        return mats
+
+
+# -- helpers -------------------------------------------------------------------------------
+#: Set once a solver in this process has run the kernels (see :func:`_load_kernels`).
+_KERNELS_LOADED = threading.Event()
+
+
+def _load_kernels() -> None:
+    """Load (or, after an install, compile) the kernels once per process, at construction.
+
+    numba loads a cached kernel on its first call with given argument types: measured, the
+    first solve of a process took 294 ms instead of 3 ms. A one-variable problem solved here
+    makes every kernel run once with the argument types of real solves. The flag is set first,
+    so the solver built here does not recurse.
+    """
+    if _KERNELS_LOADED.is_set():
+        return
+    _KERNELS_LOADED.set()
+    BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
+
+
+def _cholesky(hmat: np.ndarray) -> tuple[np.ndarray | None, bool]:
+    """Upper Cholesky factor of ``H`` and ``False``, or ``(None, True)`` when a pivot relative to
+    ``sqrt(H_jj)`` falls below :data:`QR_SWITCH` or Cholesky fails (then ``P`` is formed and
+    factored by QR, see :func:`_factor`)."""
+    r_fac, info = dpotrf(hmat, lower=0, clean=1)
+    rel = np.abs(np.diag(r_fac)) / np.sqrt(np.maximum(np.diag(hmat), 1e-300))
+    if info != 0 or not np.all(np.isfinite(r_fac)) or float(np.min(rel)) < QR_SWITCH:
+        return None, True
+    return np.ascontiguousarray(r_fac), False
+
+
+def _factor(pt_mat: np.ndarray, use_qr: bool) -> tuple[np.ndarray, bool]:
+    """Upper factor ``R`` with ``R'R = P'P``; switches to QR for good once Cholesky degrades.
+
+    ``H = P'P`` squares ``P``'s condition number, which grows like ``1/mu`` near the optimum;
+    once a relative pivot of the Cholesky factor falls below :data:`QR_SWITCH` (or Cholesky
+    fails), ``P`` itself is factored.
+    """
+    r_fac = None
+    if not use_qr:
+        hmat = pt_mat @ pt_mat.T
+        r_fac, info = dpotrf(hmat, lower=0, clean=1)
+        # the pivots relative to sqrt(H_jj) (invariant to the scaling of the variables): how
+        # much of each column is new, i.e. the loss of accuracy of the Cholesky factor
+        rel = np.abs(np.diag(r_fac)) / np.sqrt(np.maximum(np.diag(hmat), 1e-300))
+        if info != 0 or float(np.min(rel)) < QR_SWITCH:
+            use_qr, r_fac = True, None
+    if r_fac is None:
+        r_fac = np.linalg.qr(pt_mat.T, mode="r")
+    diag = np.abs(np.diag(r_fac))
+    if not np.all(np.isfinite(r_fac)) or float(np.min(diag)) == 0.0:
+        raise np.linalg.LinAlgError("singular Schur complement")
+    return np.ascontiguousarray(r_fac), use_qr
+
+
