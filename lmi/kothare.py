@@ -209,6 +209,11 @@ class KothareProblem:
     def n_inputs(self) -> int:
         return self.data.m
 
+    def reset(self) -> None:
+        """Forget what earlier solves left behind (the IPM's warm-start point and rebalanced
+        coordinates): the next solve gives what a freshly built problem gives."""
+        self._backend.reset()
+
     def solve(self, x: Any, u_max: Any = None) -> LMISolution:
         """Solve at the state ``x`` (non-zero); failures come back as a status, never raised.
 

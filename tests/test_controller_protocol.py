@@ -123,21 +123,7 @@ CONTROLLERS: dict[str, tuple[Callable[[], tuple[Any, np.ndarray]], str]] = {
 #: The robust-MPC controllers whose step signature is not this protocol's yet (their step
 #: channel, ``u_max`` through ``StepInputs``, is being moved in their own modules). Strict: a
 #: controller listed here that follows the protocol fails the test, so the mark is removed then.
-_NOT_YET = {
-    "CRMPC": "CRMPC lacks name, accepts and step(x, inputs=None) (crmpc.py is rebuilt separately)",
-    "RMPC": "RMPC.step still takes u_max=None instead of inputs (moved to StepInputs separately)",
-}
-
-
-def _cases(skip_protocol: tuple[str, ...]) -> list[Any]:
-    return [
-        pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=_NOT_YET[key]))
-        if key in skip_protocol else key
-        for key in CONTROLLERS
-    ]
-
-
-@pytest.mark.parametrize("key", _cases(("CRMPC",)))
+@pytest.mark.parametrize("key", list(CONTROLLERS))
 def test_every_controller_has_the_protocol_members(key: str) -> None:
     build, record_name = CONTROLLERS[key]
     ctrl, x = build()
@@ -152,7 +138,7 @@ def test_every_controller_has_the_protocol_members(key: str) -> None:
     assert ctrl.last is None
 
 
-@pytest.mark.parametrize("key", _cases(("CRMPC", "RMPC")))
+@pytest.mark.parametrize("key", list(CONTROLLERS))
 def test_every_controller_takes_the_step_channel_and_names_an_unknown_field(key: str) -> None:
     build, _ = CONTROLLERS[key]
     ctrl, x = build()

@@ -56,6 +56,10 @@ class KothareBackend(ABC):
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         """Solve at the normalised state ``x`` with the normalised bounds; never raises on a failure."""
 
+    def reset(self) -> None:
+        """Forget what earlier solves left behind (warm starts, adapted coordinates); default: nothing."""
+        return None
+
     def gamma(self, objective: float) -> float:
         """``gamma`` from the solver's objective ``gamma_s`` (``dt gamma`` in the delta formulations)."""
         gamma = float(objective)

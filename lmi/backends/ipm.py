@@ -137,7 +137,20 @@ class IPMKothare(KothareBackend):
         self._rebalance = merged.pop("rebalance")
         self._solver_options = merged
         self._blas = SingleThreadBlas()
+        self._initial_scaling = t
         self._build(t)
+
+    def reset(self) -> None:
+        """Back to the state of a fresh back-end: no warm-start point, the initial state coordinates.
+
+        A rebalanced retry keeps its coordinates for the next solves (see :meth:`solve`); a
+        reset returns to those of the construction, so the next solve gives what a new
+        back-end on the same data gives.
+        """
+        if np.array_equal(self._t, self._initial_scaling):
+            self._solver.reset_warm_start()
+        else:
+            self._build(self._initial_scaling)
 
     def _build(self, t: np.ndarray) -> None:
         """The conic data, the solver and the fallback in the coordinates ``x~ = diag(t)^-1 x``."""

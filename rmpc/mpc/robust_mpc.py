@@ -163,9 +163,11 @@ class RMPC:
         return self.certified.gain
 
     def reset(self) -> None:
-        """Forget the last gain and step."""
+        """Forget the last gain and step, and the solver's warm start (:meth:`lmi.KothareProblem.reset`):
+        a run after a reset repeats a run of a new controller."""
         self.last = None
         self.certified.reset()
+        self.problem.reset()
 
     def solve(self, x: Any, u_max: Any = None) -> LMISolution:
         """Solve the LMI problem at ``x`` (the deviation ``x - x_ref`` is used); no side effects.
