@@ -373,13 +373,13 @@ smallest eigenvalue -1
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
         raise ArgumentTypeError(name, forms, type(value).__name__) from None
-    bound = ">= 0" if allow_zero else "> 0"
     if arr.ndim == 0 and scalar:
         return check_positive(float(arr), name, allow_zero=allow_zero) * np.eye(size)
     if arr.ndim == 1:
         diag = as_vector(arr, name, size)
         if np.any(diag < 0.0) or (not allow_zero and np.any(diag == 0.0)):
-            raise InvalidArgumentError(name, f"{entries} {bound}", repr(diag.tolist()))
+            sign = "non-negative" if allow_zero else "positive"
+            raise InvalidArgumentError(name, f"{sign} {entries}", repr(diag.tolist()))
         return np.diag(diag)
     if arr.ndim != 2:
         raise InvalidArgumentError(name, forms, f"shape {arr.shape}")
@@ -404,7 +404,7 @@ def as_inertia(value: Any, name: str = "inertia") -> np.ndarray:
     >>> as_inertia([1.0, -2.0, 3.0])
     Traceback (most recent call last):
     ...
-    toolkit_common.errors.InvalidArgumentError: inertia: expected principal inertias (kg m^2) > 0, but \
+    toolkit_common.errors.InvalidArgumentError: inertia: expected positive principal inertias (kg m^2), but \
 found [1.0, -2.0, 3.0]
     """
     return as_square_matrix(value, name, 3, scalar=False, entries="principal inertias (kg m^2)")
