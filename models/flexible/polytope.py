@@ -33,7 +33,7 @@ discretised vertices only up to a residual of order ``dt^2`` (measured in
 from __future__ import annotations
 
 import itertools
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
@@ -41,9 +41,6 @@ from models.flexible.linear import POLYTOPIC_ATTITUDE, AttitudeForm, ParameterPo
 from models.linear import PolytopicModel, sample_time, zoh
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_choice, check_positive
-
-if TYPE_CHECKING:
-    from models.flexible.satellite import FlexibleSatellite
 
 __all__ = [
     "DEFAULT_DAMPING_RANGE",
@@ -75,6 +72,33 @@ RENAMED_RANGES: dict[str, str] = {
 }
 
 
+class FlexibleLinearisation(Protocol):
+    """What the polytope reads of its satellite (the members of :class:`models.FlexibleSatellite`).
+
+    A structural type, so that this module does not import the satellite's (which imports it).
+    """
+
+    @property
+    def n_modes(self) -> int: ...  # pragma: no cover
+    @property
+    def n_pzt(self) -> int: ...  # pragma: no cover
+    @property
+    def stiffness(self) -> np.ndarray: ...  # pragma: no cover
+    @property
+    def damping_matrix(self) -> np.ndarray: ...  # pragma: no cover
+    @property
+    def input_names(self) -> tuple[str, ...]: ...  # pragma: no cover
+
+    def linear_state_names(
+        self, attitude: AttitudeForm = "euler"
+    ) -> tuple[str, ...]: ...  # pragma: no cover
+
+    def linearize(
+        self, x_op: Any = None, *, pzt: bool = False, attitude: AttitudeForm = "euler",
+        parameters: ParameterPoint | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]: ...  # pragma: no cover
+
+
 def _interval(value: Any, name: str) -> tuple[float, float]:
     arr = as_vector(value, name, 2)
     lo, hi = float(arr[0]), float(arr[1])
@@ -85,7 +109,7 @@ def _interval(value: Any, name: str) -> tuple[float, float]:
 
 
 def vertex_parameters(
-    sat: FlexibleSatellite,
+    sat: FlexibleLinearisation,
     mode: PolytopeMode = "groups",
     inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
     frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
@@ -124,7 +148,7 @@ def vertex_parameters(
 
 
 def flexible_polytope(
-    sat: FlexibleSatellite,
+    sat: FlexibleLinearisation,
     x_op: Any = None,
     dt: float | None = None,
     *,

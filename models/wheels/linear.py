@@ -8,7 +8,8 @@ The attitude and the rates about the level attitude at rest (the wheel momenta d
 with ``K_g`` the gravity stiffness (:meth:`models.WheelSatellite.gravity_stiffness`),
 ``Lambda = diag(lambda)`` the wheel effectiveness (1 healthy, 0 an outage) and ``J`` possibly
 scaled. :class:`models.WheelSatellite` delegates its ``linearize``, ``discretize``,
-``linear_model``, ``effectiveness_vertices`` and ``polytope`` here.
+``linear_model``, ``effectiveness_vertices`` and ``polytope`` here; the functions take the
+pieces they need (the array, ``J^-1``, ``K_g``), not the satellite.
 
 ``B`` is linear in ``Lambda`` and the zero-order hold at a fixed ``A`` is linear in ``B``, so
 the effectiveness vertices of the polytope are exact. ``A`` and ``B`` are also affine in
@@ -18,17 +19,14 @@ cover the continuous-time set, and their discretisations approximate the discret
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from models.linear import PolytopicModel, operating_point, relative_spread, sample_time, zoh
-from models.wheels.array import _rank
+from models.wheels.array import WheelArray, _rank
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_choice, check_positive
-
-if TYPE_CHECKING:
-    from models.wheels.satellite import WheelSatellite
 
 __all__ = [
     "LINEAR_STATE_NAMES",
@@ -60,28 +58,36 @@ def level_operating_point(x_op: Any) -> np.ndarray:
 
 
 def linearize(
-    sat: WheelSatellite, x_op: Any = None, effectiveness: Any = None, inertia_scale: float = 1.0
+    wheels: WheelArray,
+    inertia_inv: np.ndarray,
+    gravity_stiffness: np.ndarray,
+    x_op: Any = None,
+    effectiveness: Any = None,
+    inertia_scale: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous ``(A, B)``; see :meth:`models.WheelSatellite.linearize`."""
+    """Continuous ``(A, B)`` with ``J^-1 = inertia_inv``, ``K_g = gravity_stiffness``.
+
+    See :meth:`models.WheelSatellite.linearize`.
+    """
     level_operating_point(x_op)
     s = check_positive(inertia_scale, "inertia_scale")
-    m = sat.n_wheels
+    m = wheels.n_wheels
     lam = np.ones(m) if effectiveness is None else as_vector(effectiveness, "effectiveness", m)
-    d_lam = sat.wheels.effective_matrix(lam)
-    j_inv = sat.inertia_inv / s
+    d_lam = wheels.effective_matrix(lam)
+    j_inv = inertia_inv / s
     a = np.zeros((6, 6))
     a[:3, 3:] = np.eye(3)
-    a[3:, :3] = -j_inv @ sat.gravity_stiffness()
+    a[3:, :3] = -j_inv @ gravity_stiffness
     b = np.zeros((6, m))
     b[3:, :] = j_inv @ d_lam
     return a, b
 
 
 def effectiveness_vertices(
-    sat: WheelSatellite, effectiveness: Any = "single_outage", lambda_min: float = 0.2
+    n_wheels: int, effectiveness: Any = "single_outage", lambda_min: float = 0.2
 ) -> np.ndarray:
     """The wheel-effectiveness vertices; see :meth:`models.WheelSatellite.effectiveness_vertices`."""
-    m = sat.n_wheels
+    m = n_wheels
     if isinstance(effectiveness, str):
         check_choice(effectiveness, "effectiveness", ("single_outage", "box"))
         if effectiveness == "single_outage":
@@ -105,7 +111,9 @@ def effectiveness_vertices(
 
 
 def wheel_polytope(
-    sat: WheelSatellite,
+    wheels: WheelArray,
+    inertia_inv: np.ndarray,
+    gravity_stiffness: np.ndarray,
     x_op: Any = None,
     dt: float | None = None,
     effectiveness: Any = "single_outage",
@@ -115,9 +123,9 @@ def wheel_polytope(
     """The effectiveness (and inertia) polytope; see :meth:`models.WheelSatellite.polytope`."""
     x_op = level_operating_point(x_op)
     dt = sample_time(dt)
-    lam = effectiveness_vertices(sat, effectiveness, lambda_min)
+    lam = effectiveness_vertices(wheels.n_wheels, effectiveness, lambda_min)
     for i, row in enumerate(lam):
-        rank = _rank(sat.wheels.D * row)
+        rank = _rank(wheels.D * row)
         if rank < 3:
             raise InvalidArgumentError(
                 "effectiveness",
@@ -128,9 +136,10 @@ def wheel_polytope(
     if spread is not None:
         s = relative_spread(spread)
         scales = [1.0 + s, 1.0 - s]
-    verts = [zoh(*linearize(sat, x_op, row, scale), dt) for scale in scales for row in lam]
-    nominal = zoh(*linearize(sat, x_op), dt)
-    names = tuple(f"u{j + 1}" for j in range(sat.n_wheels))
+    platform = (wheels, inertia_inv, gravity_stiffness)
+    verts = [zoh(*linearize(*platform, x_op, row, scale), dt) for scale in scales for row in lam]
+    nominal = zoh(*linearize(*platform, x_op), dt)
+    names = tuple(f"u{j + 1}" for j in range(wheels.n_wheels))
     return PolytopicModel(
         verts, dt, nominal=nominal, state_names=LINEAR_STATE_NAMES, input_names=names, attitude="euler321"
     )

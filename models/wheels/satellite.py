@@ -350,7 +350,9 @@ class WheelSatellite:
         ``x_op`` = ``[phi, theta, psi, p, q, r]`` is the level attitude at rest (default zero; any
         yaw); any other point is an error naming ``x_op``.
         """
-        return linear.linearize(self, x_op, effectiveness, inertia_scale)
+        return linear.linearize(
+            self._wheels, self._inertia_inv, self.gravity_stiffness(), x_op, effectiveness, inertia_scale
+        )
 
     def discretize(
         self, x_op: Any = None, dt: float | None = None, effectiveness: Any = None, inertia_scale: float = 1.0
@@ -384,7 +386,7 @@ class WheelSatellite:
         lambda_min : float
             Lower corner of the box, in ``[0, 1)`` (default 0.2, **assumed**).
         """
-        return linear.effectiveness_vertices(self, effectiveness, lambda_min)
+        return linear.effectiveness_vertices(self.n_wheels, effectiveness, lambda_min)
 
     @renamed_arguments(inertia_spread="spread")
     def polytope(
@@ -432,4 +434,5 @@ class WheelSatellite:
         The effectiveness vertices are exact; with ``spread`` they approximate the discrete set
         (see :mod:`models.wheels.linear`).
         """
-        return linear.wheel_polytope(self, x_op, dt, effectiveness, lambda_min, spread)
+        platform = (self._wheels, self._inertia_inv, self.gravity_stiffness())
+        return linear.wheel_polytope(*platform, x_op, dt, effectiveness, lambda_min, spread)
