@@ -5,7 +5,7 @@ and one message:
 
 - numbers and choices: :func:`check_real`, :func:`check_positive`, :func:`check_bool`,
   :func:`check_choice`;
-- arrays: :func:`as_vector`, :func:`as_matrix`, :func:`check_symmetric`, :func:`check_psd`,
+- arrays: :func:`as_array`, :func:`as_vector`, :func:`as_matrix`, :func:`check_symmetric`, :func:`check_psd`,
   :func:`check_pd`;
 - per-component values given as a scalar or one per component (gains, limits):
   :func:`as_positive_values`, :func:`as_optional_limits`;
@@ -26,6 +26,7 @@ import numpy as np
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 __all__ = [
+    "as_array",
     "as_inertia",
     "as_matrix",
     "as_optional_limits",
@@ -49,16 +50,17 @@ def _describe_shape(arr: np.ndarray) -> str:
     return f"shape {arr.shape}"
 
 
-def _to_float_array(value: Any, name: str) -> np.ndarray:
-    if isinstance(value, str | bytes):
-        raise ArgumentTypeError(name, "a numeric array", f"{type(value).__name__} {value!r}")
+def _to_float_array(
+    value: Any, name: str, expected: str = "a numeric array", *, copy: bool = False, allow_bool: bool = True
+) -> np.ndarray:
+    """``value`` as a float array (a new one with ``copy``); a string or a non-numeric value is an error."""
+    rejected = str | bytes if allow_bool else str | bytes | bool | np.bool_
+    if isinstance(value, rejected):
+        raise ArgumentTypeError(name, expected, f"{type(value).__name__} {value!r}")
     try:
-        arr = np.asarray(value, dtype=float)
+        return np.array(value, dtype=float) if copy else np.asarray(value, dtype=float)
     except (TypeError, ValueError) as err:
-        raise ArgumentTypeError(
-            name, "a numeric array", f"{type(value).__name__} ({err})"
-        ) from None
-    return arr
+        raise ArgumentTypeError(name, expected, f"{type(value).__name__} ({err})") from None
 
 
 def _check_finite(arr: np.ndarray, name: str) -> None:
@@ -68,6 +70,24 @@ def _check_finite(arr: np.ndarray, name: str) -> None:
         raise InvalidArgumentError(
             name, "finite values", f"{arr[tuple(bad)]} at index {where}"
         )
+
+
+def as_array(value: Any, name: str) -> np.ndarray:
+    """``value`` as a new finite float array of any shape.
+
+    Examples
+    --------
+    >>> from toolkit_common.validation import as_array
+    >>> as_array([[1, 2], [3, 4]], "M").shape
+    (2, 2)
+    >>> as_array([1.0, float("nan")], "M")
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.InvalidArgumentError: M: expected finite values, but found nan at index (1,)
+    """
+    arr = _to_float_array(value, name, copy=True)
+    _check_finite(arr, name)
+    return arr
 
 
 def as_vector(value: Any, name: str, size: int | None = None) -> np.ndarray:
@@ -213,12 +233,7 @@ def _positive_values(
     """The body of :func:`as_positive_values` and :func:`as_optional_limits` (one wording)."""
     none = "None, " if optional else ""
     expected = f"{none}a number or one number per {per}"
-    if isinstance(value, str | bytes | bool | np.bool_):
-        raise ArgumentTypeError(name, expected, f"{type(value).__name__} {value!r}")
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ArgumentTypeError(name, expected, type(value).__name__) from None
+    arr = _to_float_array(value, name, expected, copy=True, allow_bool=False)
     if arr.ndim == 0:
         arr = np.full(1 if size is None else size, float(arr))
     if arr.ndim != 1 or (size is not None and arr.shape != (size,)):
@@ -367,12 +382,7 @@ def as_square_matrix(
 smallest eigenvalue -1
     """
     forms = f"{'a scalar, ' if scalar else ''}{size} {entries} or a {size} x {size} matrix"
-    if isinstance(value, str | bytes | bool | np.bool_):
-        raise ArgumentTypeError(name, forms, f"{type(value).__name__} {value!r}")
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ArgumentTypeError(name, forms, type(value).__name__) from None
+    arr = _to_float_array(value, name, forms, copy=True, allow_bool=False)
     if arr.ndim == 0 and scalar:
         return check_positive(float(arr), name, allow_zero=allow_zero) * np.eye(size)
     if arr.ndim == 1:

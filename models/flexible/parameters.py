@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, check_pd
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_array, as_matrix, check_pd
 
 __all__ = [
     "DI_GENNARO_COUPLING",
@@ -97,21 +97,9 @@ class HybridParameters:
         return int(self.pzt_matrix.shape[1])
 
 
-def _real_array(value: Any, name: str) -> np.ndarray:
-    if isinstance(value, str | bytes):
-        raise ArgumentTypeError(name, "a numeric array", f"{type(value).__name__} {value!r}")
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise ArgumentTypeError(name, "a numeric array", f"{type(value).__name__} ({err})") from None
-    if not np.all(np.isfinite(arr)):
-        raise InvalidArgumentError(name, "finite values", repr(arr.tolist()))
-    return arr
-
-
 def _modal(value: Any, name: str, shape: tuple[int, int | None] | tuple[int]) -> np.ndarray:
     """A per-mode array of the given shape (``None``: any width); the message names the argument."""
-    arr = _real_array(value, name)
+    arr = as_array(value, name)
     if shape[0] == 0 and arr.size == 0:
         return arr.reshape((0, *(0 if s is None else s for s in shape[1:])))
     ok = arr.ndim == len(shape) and all(s is None or a == s for a, s in zip(arr.shape, shape, strict=True))
@@ -149,7 +137,7 @@ def hybrid_parameters(
     (1, 349.0)
     """
     j = check_pd(as_matrix(inertia, "inertia", (3, 3)), "inertia")
-    freq = _real_array(frequencies, "frequencies").ravel()
+    freq = as_array(frequencies, "frequencies").ravel()
     n_modes = int(freq.size)
     if np.any(freq <= 0.0):
         raise InvalidArgumentError("frequencies", "modal frequencies > 0 (rad/s)", repr(freq.tolist()))
