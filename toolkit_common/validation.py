@@ -12,6 +12,9 @@ and one message:
 - square matrices given as a scalar, a diagonal or in full (gains, weights, an inertia):
   :func:`as_square_matrix`, :func:`as_inertia`;
 - arguments that were renamed: :func:`renamed_arguments`.
+
+(Length: about 460 lines, most of them the documentation and examples of the checks; one module,
+so that every package finds its argument checks in one place.)
 """
 
 from __future__ import annotations
