@@ -7,7 +7,7 @@ from typing import Any, Literal
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_vector, check_choice, check_positive, check_real
+from toolkit_common.validation import as_positive_values, as_vector, check_choice, check_positive, check_real
 
 __all__ = ["ReactionWheelActuator", "TorqueLimiter"]
 
@@ -96,11 +96,8 @@ class TorqueLimiter:
             self.u_max: float | np.ndarray = check_positive(u_max, "u_max")
         else:
             if kind == "norm":
-                    raise InvalidArgumentError("u_max", "a scalar for kind='norm'", repr(u_max))
-            vec = as_vector(u_max, "u_max")
-            if np.any(vec <= 0):
-                    raise InvalidArgumentError("u_max", "limits > 0", repr(vec.tolist()))
-            self.u_max = vec
+                raise InvalidArgumentError("u_max", "a scalar for kind='norm'", repr(u_max))
+            self.u_max = as_positive_values(u_max, "u_max", None, per="axis", what="limits")
 
     def __call__(self, u: Any) -> np.ndarray:
         """Return the clipped torque."""

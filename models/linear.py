@@ -2,20 +2,104 @@
 
 :func:`zoh` turns ``x' = A x + B u`` into ``x(k+1) = Ad x(k) + Bd u(k)``;
 :class:`PolytopicModel` holds ``x(k+1) = A x(k) + B u(k)`` with ``[A B] in Co{[A_j B_j]}``.
+:func:`operating_point` and :func:`sample_time` read the ``x_op`` and ``dt`` arguments of every
+satellite's ``linearize``, ``discretize``, ``linear_model`` and ``polytope``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from scipy.linalg import expm
 
+from models.attitude.quaternion import quat_to_euler321
+from models.protocols import map_states
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_positive
+from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
 
-__all__ = ["PolytopicModel", "zoh"]
+__all__ = [
+    "ATTITUDE_FORMS",
+    "AttitudeCoordinates",
+    "PolytopicModel",
+    "operating_point",
+    "relative_spread",
+    "sample_time",
+    "zoh",
+]
+
+#: What the first three states of a :class:`PolytopicModel` may hold (``None``: no attitude).
+AttitudeCoordinates = Literal["euler321", "quaternion_vector"]
+ATTITUDE_FORMS: tuple[str, ...] = ("euler321", "quaternion_vector")
+
+
+def operating_point(x_op: Any, size: int, default: Any = None) -> np.ndarray:
+    """The ``x_op`` argument of a linearisation: ``size`` finite values, or ``default`` for ``None``.
+
+    A single number is refused with a message naming ``dt``: ``x_op`` comes first in every
+    family's ``discretize``, ``linear_model`` and ``polytope``, and a sample time passed in its
+    place is the likely mistake.
+
+    Examples
+    --------
+    >>> from models.linear import operating_point
+    >>> operating_point(None, 3).tolist()
+    [0.0, 0.0, 0.0]
+    >>> operating_point(0.04, 6)
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.InvalidArgumentError: x_op: expected an operating point of 6 states (the \
+sample time comes after it: dt=...), but found the number 0.04
+    """
+    if x_op is None:
+        return np.zeros(size) if default is None else as_vector(default, "x_op", size)
+    if np.ndim(x_op) == 0 and not isinstance(x_op, str | bytes):
+        raise InvalidArgumentError(
+            "x_op", f"an operating point of {size} states (the sample time comes after it: dt=...)",
+            f"the number {x_op!r}",
+        )
+    return as_vector(x_op, "x_op", size)
+
+
+def sample_time(dt: Any) -> float:
+    """The ``dt`` argument of a discretisation: a number > 0 (s); ``None`` (left out) is an error.
+
+    Examples
+    --------
+    >>> from models.linear import sample_time
+    >>> sample_time(None)
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.ArgumentTypeError: dt: expected a sample time > 0 (s), but found nothing \
+(dt is required)
+    """
+    if dt is None:
+        raise ArgumentTypeError("dt", "a sample time > 0 (s)", "nothing (dt is required)")
+    return check_positive(dt, "dt")
+
+
+def relative_spread(spread: Any, name: str = "spread") -> float:
+    """The relative half-width ``s`` in ``[0, 1)`` of an inertia uncertainty ``J in [(1 - s) J, (1 + s) J]``.
+
+    ``None`` (left out) is an error naming the argument.
+
+    Examples
+    --------
+    >>> from models.linear import relative_spread
+    >>> relative_spread(0.3)
+    0.3
+    >>> relative_spread(1.2)
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.InvalidArgumentError: spread: expected a relative spread in [0, 1), but found 1.2
+    """
+    if spread is None:
+        raise ArgumentTypeError(name, "a relative spread in [0, 1)", f"nothing ({name} is required)")
+    s = check_positive(spread, name, allow_zero=True)
+    if s >= 1.0:
+        raise InvalidArgumentError(name, "a relative spread in [0, 1)", repr(s))
+    return s
 
 
 def zoh(a: np.ndarray, b: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -72,6 +156,10 @@ class PolytopicModel:
         of the vertices, which lies inside the polytope.
     state_names, input_names : sequence of str, optional
         Names used in reports and in python-control conversions.
+    attitude : {"euler321", "quaternion_vector"} or None
+        What the first three states hold: 3-2-1 Euler angles (rad), the vector part of a unit
+        quaternion with non-negative scalar part, or no attitude (``None``, the default). It
+        tells :meth:`attitude_euler` (and the reports of a run on this model) how to read them.
 
     Examples
     --------
@@ -92,6 +180,7 @@ class PolytopicModel:
         nominal: tuple[Any, Any] | None = None,
         state_names: Sequence[str] | None = None,
         input_names: Sequence[str] | None = None,
+        attitude: AttitudeCoordinates | None = None,
     ) -> None:
         if isinstance(vertices, np.ndarray) or not isinstance(vertices, Sequence):
             raise ArgumentTypeError(
@@ -134,6 +223,13 @@ class PolytopicModel:
         self._nominal = (a_nom, b_nom)
         self.state_names = self._names(state_names, "state_names", n, "x")
         self.input_names = self._names(input_names, "input_names", m, "u")
+        if attitude is not None:
+            check_choice(attitude, "attitude", (*ATTITUDE_FORMS, None))
+            if n < 3:
+                raise InvalidArgumentError(
+                    "attitude", "None for a model with fewer than 3 states", f"{attitude!r} with {n} states"
+                )
+        self._attitude: AttitudeCoordinates | None = attitude
 
     @staticmethod
     def _names(names: Sequence[str] | None, arg: str, size: int, prefix: str) -> tuple[str, ...]:
@@ -185,6 +281,48 @@ class PolytopicModel:
         """The nominal ``(A, B)``."""
         return self._nominal
 
+    @property
+    def attitude(self) -> AttitudeCoordinates | None:
+        """What the first three states hold: ``"euler321"``, ``"quaternion_vector"`` or ``None``."""
+        return self._attitude
+
+    def attitude_euler(self, x: Any) -> np.ndarray:
+        """Roll, pitch and yaw (rad, 3-2-1) of the attitude in the first three states of ``x``.
+
+        Parameters
+        ----------
+        x : array_like, shape (n_states,) or (k, n_states)
+            One state or ``k`` states as rows; the result has shape ``(3,)`` or ``(k, 3)``.
+
+        Raises
+        ------
+        InvalidArgumentError
+            Naming ``attitude`` when the model holds no attitude (``attitude=None``); naming
+            ``x`` when a quaternion vector part has norm above 1.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import PolytopicModel
+        >>> a, b = np.eye(6), np.zeros((6, 3))
+        >>> PolytopicModel([(a, b)], dt=0.1, attitude="euler321").attitude_euler(np.arange(6.0)).tolist()
+        [0.0, 1.0, 2.0]
+        >>> qv = np.sin(0.25) * np.array([1.0, 0.0, 0.0])   # 0.5 rad about x
+        >>> model = PolytopicModel([(a, b)], dt=0.1, attitude="quaternion_vector")
+        >>> bool(np.allclose(model.attitude_euler(np.r_[qv, np.zeros(3)]), [0.5, 0.0, 0.0]))
+        True
+        """
+        if self._attitude is None:
+            raise InvalidArgumentError(
+                "attitude",
+                "'euler321' or 'quaternion_vector' to read an attitude (this model was built with "
+                "attitude=None: its states hold none)",
+                "None",
+            )
+        if self._attitude == "euler321":
+            return map_states(lambda s: s[:3].copy(), x, self.n_states)
+        return map_states(_quaternion_vector_to_euler, x, self.n_states)
+
     def vertex(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         """Return vertex ``index`` as an ``(A, B)`` pair."""
         if not isinstance(index, int | np.integer) or not -self.n_vertices <= index < self.n_vertices:
@@ -226,7 +364,9 @@ class PolytopicModel:
         return [self.to_statespace(j) for j in range(self.n_vertices)]
 
     @classmethod
-    def from_statespace(cls, systems: Any, nominal: Any | None = None) -> PolytopicModel:
+    def from_statespace(
+        cls, systems: Any, nominal: Any | None = None, attitude: AttitudeCoordinates | None = None
+    ) -> PolytopicModel:
         """Build a polytope from python-control discrete-time ``StateSpace`` vertices.
 
         Parameters
@@ -236,6 +376,8 @@ class PolytopicModel:
             and ``B`` are used (the polytope is in the state equation).
         nominal : StateSpace, optional
             The nominal system; defaults to the mean of the vertices.
+        attitude : {"euler321", "quaternion_vector"} or None
+            What the first three states hold (see :class:`PolytopicModel`).
         """
         import control
 
@@ -257,10 +399,23 @@ class PolytopicModel:
         if max(dts) - min(dts) > 1e-12 * max(dts):
             raise InvalidArgumentError("systems", "a common dt", f"dt values {dts}")
         nom = None if nominal is None else (nominal.A, nominal.B)
-        return cls([(s.A, s.B) for s in systems], dt=dts[0], nominal=nom)
+        return cls([(s.A, s.B) for s in systems], dt=dts[0], nominal=nom, attitude=attitude)
 
     def __repr__(self) -> str:
         return (
             f"PolytopicModel(n_states={self.n_states}, n_inputs={self.n_inputs}, "
             f"n_vertices={self.n_vertices}, dt={self.dt:g})"
         )
+
+
+def _quaternion_vector_to_euler(state: np.ndarray) -> np.ndarray:
+    """3-2-1 Euler angles of the unit quaternion ``[sqrt(1 - |q_v|^2), q_v]``, ``q_v = state[:3]``."""
+    qv = state[:3]
+    norm2 = float(qv @ qv)
+    if norm2 > 1.0 + 1e-12:
+        raise InvalidArgumentError(
+            "x", "a quaternion vector part with |q_v| <= 1 in the first three states (attitude="
+            "'quaternion_vector')", f"|q_v| = {np.sqrt(norm2):.6g}",
+        )
+    q0 = np.sqrt(max(0.0, 1.0 - norm2))
+    return quat_to_euler321(np.concatenate(([q0], qv)) / np.sqrt(q0 * q0 + norm2))

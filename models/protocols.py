@@ -24,11 +24,15 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["InputStage", "Plant"]
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector
+
+__all__ = ["InputStage", "Plant", "map_states"]
 
 
 @runtime_checkable
@@ -61,7 +65,12 @@ class Plant(Protocol):
         ...
 
     def attitude_euler(self, x: Any) -> np.ndarray:  # pragma: no cover
-        """Roll, pitch and yaw (rad, 3-2-1 sequence) of the attitude held in the state ``x``."""
+        """Roll, pitch and yaw (rad, 3-2-1 sequence) of the attitude held in the state ``x``.
+
+        ``x`` is one state ``(n_states,)`` (the result has shape ``(3,)``) or a trajectory of
+        states, one per row, ``(k, n_states)`` (the result ``(k, 3)``). The plant's docstring
+        says which frame the angles are relative to.
+        """
         ...
 
 
@@ -82,3 +91,48 @@ class InputStage(Protocol):
 
     def __call__(self, t: float, x: np.ndarray, u: np.ndarray) -> np.ndarray:  # pragma: no cover
         ...
+
+
+def map_states(convert: Callable[[np.ndarray], np.ndarray], x: Any, n_states: int) -> np.ndarray:
+    """Apply ``convert`` (one state to a vector) to one state or to every row of a trajectory.
+
+    The shared body of the plants' :meth:`Plant.attitude_euler`.
+
+    Parameters
+    ----------
+    convert : callable
+        Maps one checked state ``(n_states,)`` to a result vector.
+    x : array_like, shape (n_states,) or (k, n_states)
+        One state, or ``k`` states as rows.
+    n_states : int
+        The plant's state size.
+
+    Returns
+    -------
+    ndarray
+        ``convert(x)`` for one state; the results stacked as rows for a trajectory.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``x`` on a wrong width, more than two dimensions, NaN or inf.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models.protocols import map_states
+    >>> map_states(lambda s: s[:2], np.arange(6.0).reshape(2, 3), 3).tolist()
+    [[0.0, 1.0], [3.0, 4.0]]
+    """
+    try:
+        ndim = 2 if isinstance(x, str | bytes) else np.ndim(x)
+    except ValueError:  # ragged: as_matrix names it
+        ndim = 2
+    if ndim == 1:
+        return convert(as_vector(x, "x", n_states))
+    if ndim != 2:
+        raise InvalidArgumentError(
+            "x", f"one state of length {n_states} or a (k, {n_states}) array of states", f"{ndim}-D input"
+        )
+    rows = as_matrix(x, "x", (None, n_states))
+    return np.array([convert(row) for row in rows]).reshape(rows.shape[0], -1)

@@ -80,7 +80,7 @@ def test_adaptive_smc_converges_with_bounded_gains(sat):
 
 def test_lqr_closed_loop_stable_and_matches_the_linear_prediction(sat):
     ctrl = flexible_lqr(sat)
-    a, b = sat.discretize(DT, attitude="quaternion")
+    a, b = sat.discretize(dt=DT, attitude="quaternion")
     closed = a - b @ ctrl.controller.K
     assert np.max(np.abs(np.linalg.eigvals(closed))) < 1.0
     x0 = sat.state(quat_from_axis_angle([1.0, -1.0, 0.5], np.deg2rad(1.0)))

@@ -18,9 +18,9 @@ import pytest
 from models import FlexibleSatellite, zoh
 from models.flexible.linear import ParameterPoint
 from models.flexible.polytope import (
-    DEFAULT_DAMPING_SCALE,
-    DEFAULT_FREQUENCY_SCALE,
-    DEFAULT_INERTIA_SCALE,
+    DEFAULT_DAMPING_RANGE,
+    DEFAULT_FREQUENCY_RANGE,
+    DEFAULT_INVERSE_INERTIA_RANGE,
     vertex_parameters,
 )
 from toolkit_common.errors import InvalidArgumentError
@@ -33,9 +33,9 @@ def sat() -> FlexibleSatellite:
 
 def _group_weights(kappa: float, f: float, g: float) -> np.ndarray:
     """Multilinear weights of a point in the (kappa, f^2, f g) box, in vertex order."""
-    k_lo, k_hi = DEFAULT_INERTIA_SCALE
-    f_lo, f_hi = DEFAULT_FREQUENCY_SCALE
-    g_lo, g_hi = DEFAULT_DAMPING_SCALE
+    k_lo, k_hi = DEFAULT_INVERSE_INERTIA_RANGE
+    f_lo, f_hi = DEFAULT_FREQUENCY_RANGE
+    g_lo, g_hi = DEFAULT_DAMPING_RANGE
     coords = [
         (kappa - k_lo) / (k_hi - k_lo),
         (f**2 - f_lo**2) / (f_hi**2 - f_lo**2),
@@ -58,9 +58,9 @@ def test_continuous_family_is_in_the_hull_of_the_vertices(sat: FlexibleSatellite
     verts = [sat.linearize(pzt=True, attitude=attitude, parameters=p) for p in points]
     rng = np.random.default_rng(11)
     for _ in range(25):
-        kappa = rng.uniform(*DEFAULT_INERTIA_SCALE)
-        f = rng.uniform(*DEFAULT_FREQUENCY_SCALE)
-        g = rng.uniform(*DEFAULT_DAMPING_SCALE)
+        kappa = rng.uniform(*DEFAULT_INVERSE_INERTIA_RANGE)
+        f = rng.uniform(*DEFAULT_FREQUENCY_RANGE)
+        g = rng.uniform(*DEFAULT_DAMPING_RANGE)
         w = _group_weights(kappa, f, g)
         assert np.all(w >= 0.0) and w.sum() == pytest.approx(1.0, abs=1e-14)
         a, b = sat.linearize(pzt=True, attitude=attitude, parameters=_true_point(sat, kappa, f, g))
@@ -72,7 +72,7 @@ def test_continuous_family_is_in_the_hull_of_the_vertices(sat: FlexibleSatellite
 
 def test_box_mode_holds_every_corner(sat: FlexibleSatellite) -> None:
     small = sat.with_modes(2)
-    poly = small.polytope(0.01, mode="box")
+    poly = small.polytope(dt=0.01, mode="box")
     assert poly.n_vertices == 2 ** (1 + 2 * 2)
     points = vertex_parameters(small, "box")
     # the corner (kappa low, k_1 high, k_2 low, c_1 low, c_2 high) is there, in product order
@@ -80,18 +80,18 @@ def test_box_mode_holds_every_corner(sat: FlexibleSatellite) -> None:
     p = points[index]
     k0 = np.diag(small.stiffness)
     c0 = np.diag(small.damping_matrix)
-    assert p.kappa == DEFAULT_INERTIA_SCALE[0]
+    assert p.kappa == DEFAULT_INVERSE_INERTIA_RANGE[0]
     np.testing.assert_allclose(p.stiffness, [1.1**2 * k0[0], 0.9**2 * k0[1]])
     np.testing.assert_allclose(p.viscous_damping, [0.45 * c0[0], 2.2 * c0[1]])
     np.testing.assert_allclose(poly.vertex(index)[0], zoh(*small.linearize(parameters=p), 0.01)[0])
-    assert sat.polytope(0.01, mode="box").n_vertices == 512
+    assert sat.polytope(dt=0.01, mode="box").n_vertices == 512
 
 
 def test_zoh_residual_is_second_order_in_dt(sat: FlexibleSatellite) -> None:
     w = _group_weights(1.07, 0.95, 1.4)
     residual = []
     for dt in (0.02, 0.01):
-        poly = sat.polytope(dt)
+        poly = sat.polytope(dt=dt)
         a, b = zoh(*sat.linearize(parameters=_true_point(sat, 1.07, 0.95, 1.4)), dt)
         a_hull, b_hull = poly.combination(w)
         residual.append(np.abs(a_hull - a).max())
@@ -101,8 +101,8 @@ def test_zoh_residual_is_second_order_in_dt(sat: FlexibleSatellite) -> None:
 
 
 def test_effectiveness_mode_scales_the_torque_columns(sat: FlexibleSatellite) -> None:
-    poly = sat.polytope(0.01, mode="effectiveness", pzt=True)
-    a0, b0 = sat.discretize(0.01, pzt=True)
+    poly = sat.polytope(dt=0.01, mode="effectiveness", pzt=True)
+    a0, b0 = sat.discretize(dt=0.01, pzt=True)
     assert poly.n_vertices == 2
     for (a, b), e in zip(poly.vertices, (0.8, 1.2), strict=True):
         np.testing.assert_allclose(a, a0, atol=1e-15)
@@ -110,17 +110,17 @@ def test_effectiveness_mode_scales_the_torque_columns(sat: FlexibleSatellite) ->
         np.testing.assert_allclose(b[:, 3:], b0[:, 3:], rtol=1e-12, atol=1e-18)
     np.testing.assert_allclose(poly.nominal[1], b0)
     assert poly.input_names == ("Mx", "My", "Mz", "v_1", "v_2", "v_3", "v_4")
-    assert sat.polytope(0.01, attitude="quaternion").state_names[:3] == ("q1", "q2", "q3")
+    assert sat.polytope(dt=0.01, attitude="quaternion").state_names[:3] == ("q1", "q2", "q3")
 
 
 def test_bad_options_name_the_argument(sat: FlexibleSatellite) -> None:
     with pytest.raises(InvalidArgumentError, match="mode"):
-        sat.polytope(0.01, mode="corners")
-    with pytest.raises(InvalidArgumentError, match="damping_scale"):
-        sat.polytope(0.01, damping_scale=(2.0, 0.5))
-    with pytest.raises(InvalidArgumentError, match="inertia_scale"):
-        sat.polytope(0.01, inertia_scale=(-0.1, 1.2))
+        sat.polytope(dt=0.01, mode="corners")
+    with pytest.raises(InvalidArgumentError, match="damping_range"):
+        sat.polytope(dt=0.01, damping_range=(2.0, 0.5))
+    with pytest.raises(InvalidArgumentError, match="inverse_inertia_range"):
+        sat.polytope(dt=0.01, inverse_inertia_range=(-0.1, 1.2))
     with pytest.raises(InvalidArgumentError, match="dt"):
-        sat.polytope(0.0)
+        sat.polytope(dt=0.0)
     with pytest.raises(InvalidArgumentError, match="stiffness"):
         sat.linearize(parameters=ParameterPoint(stiffness=[1.0, 1.0, -1.0, 1.0]))

@@ -18,7 +18,7 @@ from rmpc import RMPC
 
 DT = 0.5
 SAT = FlexibleSatellite.di_gennaro()
-POLY = SAT.polytope(DT, attitude="quaternion", mode="groups")
+POLY = SAT.polytope(dt=DT, attitude="quaternion", mode="groups")
 Q1, R1 = linear_weights(CONTROLLER_DEFAULTS["RMPC"], SAT.n_modes)
 AXIS = np.ones(3) / np.sqrt(3.0)
 
@@ -66,7 +66,7 @@ def test_rmpc_on_the_groups_polytope_keeps_the_bound_and_its_lyapunov_decrease()
 def test_modal_bound_holds_on_the_linear_polytope_and_binds():
     # The 2-vertex torque-effectiveness polytope, whose solves are a tenth of those on 'groups'
     # (F4 runs the bound on both; tests/test_lmi_ipm_rebalance.py covers the 8-vertex solver case).
-    poly = SAT.polytope(DT, attitude="quaternion", mode="effectiveness")
+    poly = SAT.polytope(dt=DT, attitude="quaternion", mode="effectiveness")
     bound = 0.02  # kg^1/2 m, the unit of eta in the hybrid-coordinate model
     out = modal_output(SAT.n_modes, bound)
     assert np.array_equal(out["output_matrix"] @ np.arange(14.0), np.arange(6.0, 10.0))  # picks eta

@@ -150,7 +150,7 @@ def test_kothare_factors_reproduce_the_coefficients_and_the_ipm_agrees(formulati
 
 def flexible_problem(backend: str, options: dict) -> tuple[KothareProblem, np.ndarray]:
     """The issue's 14-state flexible satellite problem and its initial state (10 deg off)."""
-    a, b = FlexibleSatellite.di_gennaro(4).discretize(0.05)
+    a, b = FlexibleSatellite.di_gennaro(4).discretize(dt=0.05)
     n = a.shape[0]
     prob = KothareProblem(np.array([a, a]), np.array([0.8 * b, 1.2 * b]),
                           np.diag([100.0] * 6 + [1.0] * (n - 6)), np.eye(3), dt=0.05, u_max=2.0,

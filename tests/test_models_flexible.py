@@ -63,7 +63,7 @@ def test_pzt_inputs_and_discretisation(sat: FlexibleSatellite) -> None:
     rate_rows = sat.inertia @ b[3:6] + sat.coupling.T @ b[10:14]
     np.testing.assert_allclose(rate_rows[:, 3:], 0.0, atol=1e-12)
     np.testing.assert_allclose(rate_rows[:, :3], np.eye(3), atol=1e-12)
-    ad, bd = sat.discretize(0.05)
+    ad, bd = sat.discretize(dt=0.05)
     sys_d = control.c2d(control.ss(*sat.linearize(), np.eye(14), np.zeros((14, 3))), 0.05, method="zoh")
     np.testing.assert_allclose(ad, sys_d.A, atol=1e-10)
     np.testing.assert_allclose(bd, sys_d.B, atol=1e-10)

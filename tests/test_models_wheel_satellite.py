@@ -189,7 +189,7 @@ def test_effectiveness_polytope(sat: WheelSatellite) -> None:
     assert (poly.n_vertices, poly.n_states, poly.n_inputs) == (5, 6, 4)
     a_c, _ = sat.linearize()
     for v, lam in enumerate(sat.effectiveness_vertices("single_outage")):
-        _, b_c = sat.linearize(lam)
+        _, b_c = sat.linearize(effectiveness=lam)
         sys_d = control.c2d(control.ss(a_c, b_c, np.eye(6), np.zeros((6, 4))), 0.04, method="zoh")
         np.testing.assert_allclose(poly.A[v], sys_d.A, atol=1e-12)
         np.testing.assert_allclose(poly.B[v], sys_d.B, atol=1e-12)
@@ -197,14 +197,16 @@ def test_effectiveness_polytope(sat: WheelSatellite) -> None:
     # B is linear in Lambda: the polytope holds every member of the single-outage set exactly
     lam = np.array([0.6, 0.7, 1.0, 0.7])  # sum(1 - lambda) = 1
     weights = np.array([0.0, 0.4, 0.3, 0.0, 0.3])
-    np.testing.assert_allclose(poly.combination(weights)[1], sat.discretize(0.04, lam)[1], atol=1e-15)
+    np.testing.assert_allclose(
+        poly.combination(weights)[1], sat.discretize(dt=0.04, effectiveness=lam)[1], atol=1e-15
+    )
     np.testing.assert_allclose(poly.nominal[1], poly.B[0], atol=0.0)
     assert sat.polytope(dt=0.04, effectiveness="box").n_vertices == 16
-    both = sat.polytope(dt=0.04, inertia_spread=0.2)
+    both = sat.polytope(dt=0.04, spread=0.2)
     assert both.n_vertices == 10
     # vertex order: inertia scale 1.2 then 0.8, effectiveness inside; a scale on J is a heavier platform
     for v, scale, lam in ((0, 1.2, [1, 1, 1, 1]), (6, 0.8, [0, 1, 1, 1])):
-        a_s, b_s = sat.replace(inertia=scale * sat.inertia).discretize(0.04, lam)
+        a_s, b_s = sat.replace(inertia=scale * sat.inertia).discretize(dt=0.04, effectiveness=lam)
         np.testing.assert_allclose(both.A[v], a_s, atol=1e-15)
         np.testing.assert_allclose(both.B[v], b_s, atol=1e-15)
 

@@ -51,7 +51,7 @@ def test_rmpc_certified_answer_and_cost_bound_on_an_outage_vertex(poly_w) -> Non
 
 
 def test_product_with_the_inertia_polytope_solves(sat: WheelSatellite) -> None:
-    poly = sat.polytope(dt=0.04, inertia_spread=0.2)
+    poly = sat.polytope(dt=0.04, spread=0.2)
     sol = RMPC(poly, Q, R, u_max=U_MAX, input_constraint="peak").solve(X0)
     assert poly.n_vertices == 10 and sol.status == "optimal" and sol.certificate.ok
 

@@ -44,6 +44,7 @@ __all__ = [
     "Field",
     "MonteCarlo",
     "PlantFamily",
+    "check_bool",
     "check_choice",
     "check_number",
     "check_real",
@@ -216,9 +217,7 @@ class PlantFamily:
     # -- settings ---------------------------------------------------------------------
     def _check_value(self, default: Any, value: Any, where: str) -> Any:
         if isinstance(default, bool):
-            if not isinstance(value, bool):
-                raise ConfigError(where, "true or false", repr(value))
-            return value
+            return check_bool(value, where)
         if isinstance(default, int):
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(where, "a positive integer", repr(value))
@@ -296,6 +295,17 @@ class PlantFamily:
 
 
 # -- field checks families share ---------------------------------------------------------
+def check_bool(value: Any, where: str) -> bool:
+    """``value`` if it is ``true`` or ``false``; a :class:`ConfigError` naming ``where`` otherwise.
+
+    The configuration-file counterpart of :func:`toolkit_common.validation.check_bool` (a TOML
+    boolean, reported as a :class:`ConfigError` with the field's dotted path).
+    """
+    if not isinstance(value, bool):
+        raise ConfigError(where, "true or false", repr(value))
+    return value
+
+
 def check_choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
     """``value`` if it is one of ``choices``; a :class:`ConfigError` naming ``where`` otherwise."""
     if not isinstance(value, str) or value not in choices:

@@ -88,7 +88,7 @@ def polytope(n_vertices: int, spread: float = SPREAD) -> PolytopicModel:
         for c in (1.0 + spread, 1.0 - spread)
     ]
     return PolytopicModel(verts, PAPER_P_SAMPLE_TIME, nominal=sat.discretize(x0, PAPER_P_SAMPLE_TIME),
-                          state_names=STATE_NAMES, input_names=INPUT_NAMES)
+                          state_names=STATE_NAMES, input_names=INPUT_NAMES, attitude="euler321")
 
 
 # -- records --------------------------------------------------------------------------------------

@@ -50,7 +50,7 @@ CVXPY_MAX_STATES = 14
 
 def _satellite(n_modes: int) -> Any:
     from models import FlexibleSatellite
-    from models.flexible.satellite import (
+    from models.flexible.parameters import (
         DI_GENNARO_COUPLING,
         DI_GENNARO_DAMPING,
         DI_GENNARO_FREQUENCIES,
@@ -74,7 +74,7 @@ def scale_problem(n_states: int, n_vertices: int) -> dict[str, Any]:
     if n_vertices not in SCALE_VERTICES:
         raise ValueError(f"n_vertices must be one of {SCALE_VERTICES}, got {n_vertices!r}")
     n_modes = (n_states - 6) // 2
-    a, b = _satellite(n_modes).discretize(SCALE_DT)
+    a, b = _satellite(n_modes).discretize(dt=SCALE_DT)
     if n_vertices == 2:
         gains = [np.full(3, 0.8), np.full(3, 1.2)]
     else:

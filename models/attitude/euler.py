@@ -24,6 +24,7 @@ from toolkit_common.errors import InvalidArgumentError, SingularityError
 
 __all__ = [
     "SINGULARITY_COS_TOL",
+    "euler321_from_matrix",
     "euler_rates",
     "euler_rates_jacobian",
     "kinematics_cover",
@@ -106,6 +107,33 @@ def rotation_matrix(attitude: np.ndarray) -> np.ndarray:
     ry = np.array([[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]])
     rz = np.array([[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]])
     return rz @ ry @ rx
+
+
+def euler321_from_matrix(r: np.ndarray) -> np.ndarray:
+    """3-2-1 Euler angles ``[phi, theta, psi]`` (rad) of a body-to-reference rotation matrix.
+
+    The inverse of :func:`rotation_matrix`: ``theta`` in ``[-pi/2, pi/2]``, ``phi`` and ``psi``
+    in ``(-pi, pi]``. At gimbal lock (``cos(theta) <`` :data:`SINGULARITY_COS_TOL`) only
+    ``psi - phi`` (``theta = +90 deg``) or ``psi + phi`` (``-90 deg``) is defined: the function
+    then returns ``phi = 0`` and puts the whole rotation about the vertical into ``psi`` (exact
+    at ``theta = +-90 deg``, within about ``1e-3`` rad inside the band). Never NaN.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models.attitude.euler import euler321_from_matrix, rotation_matrix
+    >>> np.round(euler321_from_matrix(rotation_matrix([0.1, -0.2, 0.3])), 12).tolist()
+    [0.1, -0.2, 0.3]
+    """
+    sin_t = float(np.clip(-r[2, 0], -1.0, 1.0))
+    theta = float(np.arcsin(sin_t))
+    if np.cos(theta) < SINGULARITY_COS_TOL:
+        # R = [[0, s(phi - psi)... ]]: with phi = 0, R[0, 1] = -sin(psi), R[1, 1] = cos(psi)
+        psi = float(np.arctan2(-r[0, 1], r[1, 1]))
+        return np.array([0.0, theta, psi])
+    phi = float(np.arctan2(r[2, 1], r[2, 2]))
+    psi = float(np.arctan2(r[1, 0], r[0, 0]))
+    return np.array([phi, theta, psi])
 
 
 def _arc_triangle(lo: float, hi: float) -> list[np.ndarray]:

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from models.attitude.euler import SINGULARITY_COS_TOL
+from models.attitude.vectors import cross3, skew
 from toolkit_common.errors import InvalidArgumentError, SingularityError
 from toolkit_common.validation import as_matrix, as_vector, check_positive
 
@@ -69,26 +70,17 @@ __all__ = [
 SHADOW_ZERO_TOL = 1e-300
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` for 3-vectors (``np.cross`` costs ten times more on this size)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 def _dcm(s: np.ndarray) -> np.ndarray:
     """Unchecked ``C(sigma)`` (hot path of the plant and the controllers)."""
     ss = float(s @ s)
-    sk = _skew(s)
+    sk = skew(s)
     return np.eye(3) + (8.0 * sk @ sk - 4.0 * (1.0 - ss) * sk) / (1.0 + ss) ** 2
 
 
 def _kinematics(s: np.ndarray) -> np.ndarray:
     """Unchecked ``N(sigma)``."""
     ss = float(s @ s)
-    return 0.25 * ((1.0 - ss) * np.eye(3) + 2.0 * _skew(s) + 2.0 * np.outer(s, s))
+    return 0.25 * ((1.0 - ss) * np.eye(3) + 2.0 * skew(s) + 2.0 * np.outer(s, s))
 
 
 def _switch(s: np.ndarray, threshold: float = 1.0) -> np.ndarray:
@@ -109,7 +101,7 @@ def _error(s: np.ndarray, sr: np.ndarray) -> np.ndarray:
         s = -s / ss
         ss = 1.0 / ss
         den = 1.0 + rr * ss + 2.0 * float(sr @ s)
-    se = ((1.0 - rr) * s - (1.0 - ss) * sr + 2.0 * _cross(s, sr)) / den
+    se = ((1.0 - rr) * s - (1.0 - ss) * sr + 2.0 * cross3(s, sr)) / den
     return _switch(se)
 
 

@@ -26,13 +26,13 @@ from typing import Any
 
 import numpy as np
 
-from models.attitude.euler import SINGULARITY_COS_TOL
+from models.attitude.euler import euler321_from_matrix
+from models.attitude.vectors import skew
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector
 
 __all__ = [
     "UNIT_NORM_TOL",
-    "cross3",
     "euler321_to_quat",
     "quat_conjugate",
     "quat_error",
@@ -47,21 +47,6 @@ __all__ = [
 
 #: How far from 1 the norm of a quaternion given by the user may be before it is rejected.
 UNIT_NORM_TOL = 1e-6
-
-
-def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` for two 3-vectors, unchecked (``np.cross`` costs about 40 us a call).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from models.attitude.quaternion import cross3
-    >>> cross3(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])).tolist()
-    [0.0, 0.0, 1.0]
-    """
-    a0, a1, a2 = a
-    b0, b1, b2 = b
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def unit_quaternion(q: Any, name: str) -> np.ndarray:
@@ -113,16 +98,14 @@ def quat_to_dcm(q: Any) -> np.ndarray:
     """``R(q) = (q0^2 - q_v'q_v) I + 2 q_v q_v' + 2 q0 [q_v x]`` (body to inertial components)."""
     q = as_vector(q, "q", 4)
     q0, qv = q[0], q[1:]
-    skew = np.array([[0.0, -qv[2], qv[1]], [qv[2], 0.0, -qv[0]], [-qv[1], qv[0], 0.0]])
-    return (q0 * q0 - qv @ qv) * np.eye(3) + 2.0 * np.outer(qv, qv) + 2.0 * q0 * skew
+    return (q0 * q0 - qv @ qv) * np.eye(3) + 2.0 * np.outer(qv, qv) + 2.0 * q0 * skew(qv)
 
 
 def quat_kinematics_matrix(q: Any) -> np.ndarray:
     """The ``4 x 3`` matrix ``E(q)`` with ``q' = E(q) w``: rows ``-q_v'/2`` and ``(q0 I + [q_v x])/2``."""
     q = as_vector(q, "q", 4)
     q0, qv = q[0], q[1:]
-    skew = np.array([[0.0, -qv[2], qv[1]], [qv[2], 0.0, -qv[0]], [-qv[1], qv[0], 0.0]])
-    return 0.5 * np.vstack((-qv, q0 * np.eye(3) + skew))
+    return 0.5 * np.vstack((-qv, q0 * np.eye(3) + skew(qv)))
 
 
 def quat_error(q: Any, q_ref: Any = None) -> np.ndarray:
@@ -172,14 +155,6 @@ def quat_to_euler321(q: Any) -> np.ndarray:
     (``theta = +90 deg``) or ``psi + phi`` (``-90 deg``) is defined: the function then returns
     ``phi = 0`` and puts the whole rotation about the vertical into ``psi`` (exact at
     ``theta = +-90 deg``, within about ``1e-3`` rad inside the band). Never NaN.
+    (:func:`models.attitude.euler.euler321_from_matrix` of :func:`quat_to_dcm`.)
     """
-    r = quat_to_dcm(_unit(q, "q"))
-    sin_t = float(np.clip(-r[2, 0], -1.0, 1.0))
-    theta = float(np.arcsin(sin_t))
-    if np.cos(theta) < SINGULARITY_COS_TOL:
-        # R = [[0, s(phi - psi)... ]]: with phi = 0, R[0, 1] = -sin(psi), R[1, 1] = cos(psi)
-        psi = float(np.arctan2(-r[0, 1], r[1, 1]))
-        return np.array([0.0, theta, psi])
-    phi = float(np.arctan2(r[2, 1], r[2, 2]))
-    psi = float(np.arctan2(r[1, 0], r[0, 0]))
-    return np.array([phi, theta, psi])
+    return euler321_from_matrix(quat_to_dcm(_unit(q, "q")))

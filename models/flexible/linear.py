@@ -1,21 +1,37 @@
-"""The linear ``6 + 2N`` model of the flexible satellite (seed section 2.2) as a pure function.
+"""The linear ``6 + 2N`` model of the flexible satellite (seed section 2.2).
 
-:meth:`models.FlexibleSatellite.linearize` and the uncertainty polytope
-(:mod:`models.flexible.polytope`) both build their matrices here, so a vertex of the polytope is
-the nominal model with some parameters replaced, not a second implementation.
+:func:`linearize` is the body of :meth:`models.FlexibleSatellite.linearize`; it and the
+uncertainty polytope (:mod:`models.flexible.polytope`) both build their matrices with
+:func:`linear_matrices`, so a vertex of the polytope is the nominal model with some parameters
+replaced, not a second implementation.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
-from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive
+from models.attitude.euler import kinematics_matrix
+from models.attitude.vectors import skew
+from models.flexible.parameters import HybridParameters
+from models.linear import operating_point
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_vector, check_choice, check_positive
 
-__all__ = ["ParameterPoint", "linear_matrices"]
+__all__ = [
+    "POLYTOPIC_ATTITUDE",
+    "AttitudeForm",
+    "ParameterPoint",
+    "linear_matrices",
+    "linear_state_names",
+    "linearize",
+]
+
+AttitudeForm = Literal["euler", "quaternion"]
+#: The :attr:`models.PolytopicModel.attitude` of a linear model with each attitude form.
+POLYTOPIC_ATTITUDE: dict[str, str] = {"euler": "euler321", "quaternion": "quaternion_vector"}
 
 
 @dataclass(frozen=True)
@@ -108,3 +124,46 @@ def linear_matrices(
         b_v[3:6] = -p_inv @ coupling.T @ mass_inv @ pzt_matrix
         b_v[6 + n_m:] = g_mat @ pzt_matrix
     return a, np.hstack((b_u, b_v))
+
+
+def linear_state_names(state_names: tuple[str, ...], attitude: AttitudeForm = "euler") -> tuple[str, ...]:
+    """Names of the linear state for ``attitude``, from the nonlinear ``state_names`` (``q0..q3`` first)."""
+    check_choice(attitude, "attitude", ("euler", "quaternion"))
+    att = ("phi", "theta", "psi") if attitude == "euler" else ("q1", "q2", "q3")
+    return att + state_names[4:]
+
+
+def linearize(
+    p: HybridParameters,
+    x_op: Any = None,
+    *,
+    pzt: bool = False,
+    attitude: AttitudeForm = "euler",
+    parameters: ParameterPoint | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous ``(A, B)`` about zero rates and modes; see :meth:`models.FlexibleSatellite.linearize`."""
+    check_choice(attitude, "attitude", ("euler", "quaternion"))
+    n = 6 + 2 * p.n_modes
+    x = operating_point(x_op, n)
+    if np.any(x[3:] != 0.0):
+        raise InvalidArgumentError(
+            "x_op", "zero rates and a zero modal state (the model is linearised there)",
+            f"x_op[3:] = {x[3:].tolist()}",
+        )
+    att = x[:3]
+    if attitude == "euler":
+        kin = kinematics_matrix(att[0], att[1])
+    else:
+        norm2 = float(att @ att)
+        if norm2 > 1.0:
+            raise InvalidArgumentError(
+                "x_op", "a quaternion vector part with |q_v| <= 1", f"|q_v| = {np.sqrt(norm2):.6g}"
+            )
+        kin = 0.5 * (np.sqrt(1.0 - norm2) * np.eye(3) + skew(att))
+    point = ParameterPoint() if parameters is None else parameters
+    if not isinstance(point, ParameterPoint):
+        raise ArgumentTypeError("parameters", "None or a models.flexible.linear.ParameterPoint",
+                                type(parameters).__name__)
+    kappa, k, c, eff = point.resolved(p.stiffness, p.viscous_damping)
+    return linear_matrices(kappa * p.hub_inertia_inv, p.mass_inv, p.coupling, k, c, p.pzt_matrix,
+                           kin, pzt, eff)

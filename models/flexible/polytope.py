@@ -10,12 +10,18 @@ is a convex combination of the models at its corners, with the multilinear (tens
 weights. Treating ``k`` and ``c`` as independent (``c`` over ``[f_lo g_lo, f_hi g_hi]`` whatever
 ``f``) over-bounds the set: valid, conservative.
 
+Each uncertain parameter is given by the ``(low, high)`` range of a multiplier of its nominal
+value, an argument ending in ``_range``: ``inverse_inertia_range`` (``kappa``),
+``frequency_range`` (``f``), ``damping_range`` (``g``) and ``effectiveness_range``. (A single
+multiplier, a point, is a ``*_scale`` elsewhere in the toolkit; an inertia uncertainty symmetric
+about ``J``, ``J in [(1 - s) J, (1 + s) J]``, is a ``spread``.)
+
 Modes (all ranges **assumed**, seed section 9):
 
 - ``"groups"`` (default): one scale each for ``kappa``, all ``k_i`` and all ``c_i``: 8 vertices;
 - ``"box"``: ``kappa`` and every ``k_i``, ``c_i`` independently: ``2^(1 + 2N)`` vertices (512
   for four modes);
-- ``"effectiveness"``: the hub-torque columns of ``B`` scaled by each end of ``effectiveness``,
+- ``"effectiveness"``: the hub-torque columns of ``B`` scaled by each end of ``effectiveness_range``,
   ``A`` nominal: 2 vertices (the torque-effectiveness polytope used for the LMI work).
 
 **Zero-order hold.** The discrete vertices are the ZOH of the continuous ones. ``e^{A dt}`` is
@@ -27,23 +33,21 @@ discretised vertices only up to a residual of order ``dt^2`` (measured in
 from __future__ import annotations
 
 import itertools
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
-from models.flexible.linear import ParameterPoint
-from models.linear import PolytopicModel, zoh
+from models.flexible.linear import POLYTOPIC_ATTITUDE, AttitudeForm, ParameterPoint
+from models.linear import PolytopicModel, sample_time, zoh
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_choice, check_positive
 
-if TYPE_CHECKING:
-    from models.flexible.satellite import FlexibleSatellite
-
 __all__ = [
-    "DEFAULT_DAMPING_SCALE",
-    "DEFAULT_EFFECTIVENESS",
-    "DEFAULT_FREQUENCY_SCALE",
-    "DEFAULT_INERTIA_SCALE",
+    "DEFAULT_DAMPING_RANGE",
+    "DEFAULT_EFFECTIVENESS_RANGE",
+    "DEFAULT_FREQUENCY_RANGE",
+    "DEFAULT_INVERSE_INERTIA_RANGE",
+    "RENAMED_RANGES",
     "PolytopeMode",
     "flexible_polytope",
     "vertex_parameters",
@@ -51,14 +55,48 @@ __all__ = [
 
 PolytopeMode = Literal["groups", "box", "effectiveness"]
 
-#: Range of ``kappa`` on ``J_mb^-1`` (**assumed**; +-20 %).
-DEFAULT_INERTIA_SCALE: tuple[float, float] = (0.8, 1.2)
-#: Range of the scale on the modal frequencies (**assumed**; +-10 %).
-DEFAULT_FREQUENCY_SCALE: tuple[float, float] = (0.9, 1.1)
-#: Range of the scale on the damping ratios, the least known parameter (**assumed**, seed 9).
-DEFAULT_DAMPING_SCALE: tuple[float, float] = (0.5, 2.0)
-#: Hub-torque effectiveness of the ``"effectiveness"`` mode (**assumed**).
-DEFAULT_EFFECTIVENESS: tuple[float, float] = (0.8, 1.2)
+#: Range of ``kappa``, the multiplier of ``J_mb^-1`` (**assumed**; +-20 %).
+DEFAULT_INVERSE_INERTIA_RANGE: tuple[float, float] = (0.8, 1.2)
+#: Range of the multiplier of the modal frequencies (**assumed**; +-10 %).
+DEFAULT_FREQUENCY_RANGE: tuple[float, float] = (0.9, 1.1)
+#: Range of the multiplier of the damping ratios, the least known parameter (**assumed**, seed 9).
+DEFAULT_DAMPING_RANGE: tuple[float, float] = (0.5, 2.0)
+#: Range of the hub-torque effectiveness of the ``"effectiveness"`` mode (**assumed**).
+DEFAULT_EFFECTIVENESS_RANGE: tuple[float, float] = (0.8, 1.2)
+#: The old names of the ranges (a call with one raises an error naming the new one).
+RENAMED_RANGES: dict[str, str] = {
+    "inertia_scale": "inverse_inertia_range",
+    "frequency_scale": "frequency_range",
+    "damping_scale": "damping_range",
+    "effectiveness": "effectiveness_range",
+}
+
+
+class FlexibleLinearisation(Protocol):
+    """What the polytope reads of its satellite (the members of :class:`models.FlexibleSatellite`).
+
+    A structural type, so that this module does not import the satellite's (which imports it).
+    """
+
+    @property
+    def n_modes(self) -> int: ...  # pragma: no cover
+    @property
+    def n_pzt(self) -> int: ...  # pragma: no cover
+    @property
+    def stiffness(self) -> np.ndarray: ...  # pragma: no cover
+    @property
+    def damping_matrix(self) -> np.ndarray: ...  # pragma: no cover
+    @property
+    def input_names(self) -> tuple[str, ...]: ...  # pragma: no cover
+
+    def linear_state_names(
+        self, attitude: AttitudeForm = "euler"
+    ) -> tuple[str, ...]: ...  # pragma: no cover
+
+    def linearize(
+        self, x_op: Any = None, *, pzt: bool = False, attitude: AttitudeForm = "euler",
+        parameters: ParameterPoint | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]: ...  # pragma: no cover
 
 
 def _interval(value: Any, name: str) -> tuple[float, float]:
@@ -71,12 +109,12 @@ def _interval(value: Any, name: str) -> tuple[float, float]:
 
 
 def vertex_parameters(
-    sat: FlexibleSatellite,
+    sat: FlexibleLinearisation,
     mode: PolytopeMode = "groups",
-    inertia_scale: Any = DEFAULT_INERTIA_SCALE,
-    frequency_scale: Any = DEFAULT_FREQUENCY_SCALE,
-    damping_scale: Any = DEFAULT_DAMPING_SCALE,
-    effectiveness: Any = DEFAULT_EFFECTIVENESS,
+    inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
+    frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
+    damping_range: Any = DEFAULT_DAMPING_RANGE,
+    effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
 ) -> list[ParameterPoint]:
     """The parameter points at the corners of the uncertainty box, in vertex order.
 
@@ -86,11 +124,11 @@ def vertex_parameters(
     """
     check_choice(mode, "mode", ("groups", "box", "effectiveness"))
     if mode == "effectiveness":
-        lo, hi = _interval(effectiveness, "effectiveness")
+        lo, hi = _interval(effectiveness_range, "effectiveness_range")
         return [ParameterPoint(effectiveness=e) for e in (lo, hi)]
-    kap = _interval(inertia_scale, "inertia_scale")
-    f_lo, f_hi = _interval(frequency_scale, "frequency_scale")
-    g_lo, g_hi = _interval(damping_scale, "damping_scale")
+    kap = _interval(inverse_inertia_range, "inverse_inertia_range")
+    f_lo, f_hi = _interval(frequency_range, "frequency_range")
+    g_lo, g_hi = _interval(damping_range, "damping_range")
     k0 = np.diag(sat.stiffness).copy()
     c0 = np.diag(sat.damping_matrix).copy()
     k_scales = (f_lo**2, f_hi**2)
@@ -110,24 +148,27 @@ def vertex_parameters(
 
 
 def flexible_polytope(
-    sat: FlexibleSatellite,
-    dt: float,
-    *,
+    sat: FlexibleLinearisation,
     x_op: Any = None,
+    dt: float | None = None,
+    *,
     mode: PolytopeMode = "groups",
-    inertia_scale: Any = DEFAULT_INERTIA_SCALE,
-    frequency_scale: Any = DEFAULT_FREQUENCY_SCALE,
-    damping_scale: Any = DEFAULT_DAMPING_SCALE,
-    effectiveness: Any = DEFAULT_EFFECTIVENESS,
-    attitude: Literal["euler", "quaternion"] = "euler",
+    inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
+    frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
+    damping_range: Any = DEFAULT_DAMPING_RANGE,
+    effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
+    attitude: AttitudeForm = "euler",
     pzt: bool = False,
 ) -> PolytopicModel:
     """The ZOH-discretised polytope; see :meth:`models.FlexibleSatellite.polytope`."""
-    dt = check_positive(dt, "dt")
-    points = vertex_parameters(sat, mode, inertia_scale, frequency_scale, damping_scale, effectiveness)
+    a_nom, b_nom = sat.linearize(x_op, pzt=pzt, attitude=attitude)  # checks x_op before dt
+    dt = sample_time(dt)
+    points = vertex_parameters(
+        sat, mode, inverse_inertia_range, frequency_range, damping_range, effectiveness_range
+    )
     verts = [zoh(*sat.linearize(x_op, pzt=pzt, attitude=attitude, parameters=p), dt) for p in points]
-    nominal = zoh(*sat.linearize(x_op, pzt=pzt, attitude=attitude), dt)
+    nominal = zoh(a_nom, b_nom, dt)
     return PolytopicModel(
         verts, dt, nominal=nominal, state_names=sat.linear_state_names(attitude),
-        input_names=sat.input_names[: 3 + (sat.n_pzt if pzt else 0)],
+        input_names=sat.input_names[: 3 + (sat.n_pzt if pzt else 0)], attitude=POLYTOPIC_ATTITUDE[attitude],
     )

@@ -13,95 +13,58 @@ coordinates and ``v`` the PZT commands. The mass matrix ``[[J, delta'], [delta, 
 positive definite exactly when ``J_mb = J - delta' M^-1 delta`` is (the hub inertia with the
 modes' participation removed); the constructor checks it.
 
-The class holds the parameters, the nonlinear model with a unit-quaternion attitude
-(``7 + 2N`` states: the large slews of paper V cross the 3-2-1 Euler singularity), its energy
-and angular momentum, the linearised ``6 + 2N`` model (seed section 2.2) with Euler or
-quaternion attitude and its ZOH, the uncertainty polytope (:mod:`models.flexible.polytope`), the
-single-axis transfer function and paper S's regime label (:mod:`models.flexible.single_axis`).
+The class holds the states and sizes and delegates each concern to its own module of
+:mod:`models.flexible`: the parameters and their checks (:mod:`~models.flexible.parameters`),
+the nonlinear model with a unit-quaternion attitude (``7 + 2N`` states: the large slews of
+paper V cross the 3-2-1 Euler singularity; :mod:`~models.flexible.dynamics`), its energy and
+angular momentum (:mod:`~models.flexible.energy`), the linearised ``6 + 2N`` model (seed section
+2.2) with Euler or quaternion attitude (:mod:`~models.flexible.linear`), the uncertainty
+polytope (:mod:`~models.flexible.polytope`), the single-axis transfer function and paper S's
+regime label (:mod:`~models.flexible.single_axis`).
+
+(Length: about 550 lines, half of them the documentation of the class's public methods; each
+method is a thin delegate to the module of its concern, so the class reads as the plant's one
+public face.)
 """
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from models.actuators import TorqueLimiter
-from models.attitude.euler import kinematics_matrix
-from models.attitude.quaternion import cross3, quat_error, quat_to_dcm, quat_to_euler321, unit_quaternion
-from models.flexible.linear import ParameterPoint, linear_matrices
+from models.attitude.quaternion import quat_error, quat_to_dcm, quat_to_euler321, unit_quaternion
+from models.flexible import energy as _energy
+from models.flexible import linear as _linear
+from models.flexible import single_axis as _single_axis
+from models.flexible.dynamics import hybrid_rhs, split_inputs
+from models.flexible.linear import POLYTOPIC_ATTITUDE, AttitudeForm, ParameterPoint
+from models.flexible.parameters import (
+    DI_GENNARO_COUPLING,
+    DI_GENNARO_DAMPING,
+    DI_GENNARO_FREQUENCIES,
+    DI_GENNARO_INERTIA,
+    hybrid_parameters,
+)
 from models.flexible.polytope import (
-    DEFAULT_DAMPING_SCALE,
-    DEFAULT_EFFECTIVENESS,
-    DEFAULT_FREQUENCY_SCALE,
-    DEFAULT_INERTIA_SCALE,
+    DEFAULT_DAMPING_RANGE,
+    DEFAULT_EFFECTIVENESS_RANGE,
+    DEFAULT_FREQUENCY_RANGE,
+    DEFAULT_INVERSE_INERTIA_RANGE,
+    RENAMED_RANGES,
     PolytopeMode,
     flexible_polytope,
 )
-from models.flexible.single_axis import regime, single_axis_polynomials
-from models.linear import PolytopicModel, zoh
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_choice, check_pd, check_positive
+from models.linear import PolytopicModel, sample_time, zoh
+from models.protocols import map_states
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_positive_values, as_vector, check_bool, renamed_arguments
 
-__all__ = [
-    "DI_GENNARO_COUPLING",
-    "DI_GENNARO_DAMPING",
-    "DI_GENNARO_FREQUENCIES",
-    "DI_GENNARO_INERTIA",
-    "AttitudeForm",
-    "FlexibleSatellite",
-]
-
-AttitudeForm = Literal["euler", "quaternion"]
-
-#: Modal frequencies ``Lambda_i`` (rad/s) of the published 4-mode set (**likely**; Di Gennaro 2003).
-DI_GENNARO_FREQUENCIES: tuple[float, ...] = (0.7681, 1.1038, 1.8733, 2.5496)
-#: Modal damping ratios ``xi_i`` of the published set (**likely**).
-DI_GENNARO_DAMPING: tuple[float, ...] = (0.0056, 0.0086, 0.0128, 0.0252)
-#: Coupling ``delta`` (rows = modes, columns = x, y, z; kg^1/2 m) of the published set (**likely**).
-DI_GENNARO_COUPLING: tuple[tuple[float, float, float], ...] = (
-    (6.45637, 1.27814, 2.15629),
-    (-1.25619, 0.91756, -1.67264),
-    (1.11687, 2.48901, -0.83674),
-    (1.23637, -2.65810, -1.12503),
-)
-#: Hub inertia (kg m^2) paired with the published modes by Hu & Ma (2005) (**assumed**).
-DI_GENNARO_INERTIA: tuple[tuple[float, float, float], ...] = (
-    (350.0, 3.0, 4.0),
-    (3.0, 270.0, 10.0),
-    (4.0, 10.0, 190.0),
-)
-
+__all__ = ["FlexibleSatellite"]
 
 #: Stand-in for "no limit" in a :class:`TorqueLimiter` (it needs finite values).
 _NO_LIMIT = 1e300
-
-
-def _real_array(value: Any, name: str) -> np.ndarray:
-    if isinstance(value, str | bytes):
-        raise ArgumentTypeError(name, "a numeric array", f"{type(value).__name__} {value!r}")
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise ArgumentTypeError(name, "a numeric array", f"{type(value).__name__} ({err})") from None
-    if not np.all(np.isfinite(arr)):
-        raise InvalidArgumentError(name, "finite values", repr(arr.tolist()))
-    return arr
-
-
-def _modal(value: Any, name: str, shape: tuple[int, int | None] | tuple[int]) -> np.ndarray:
-    """A per-mode array of the given shape (``None``: any width); the message names the argument."""
-    arr = _real_array(value, name)
-    if shape[0] == 0 and arr.size == 0:
-        return arr.reshape((0, *(0 if s is None else s for s in shape[1:])))
-    ok = arr.ndim == len(shape) and all(s is None or a == s for a, s in zip(arr.shape, shape, strict=True))
-    if not ok:
-        want = "(" + ", ".join("n_a" if s is None else str(s) for s in shape) + ")"
-        raise InvalidArgumentError(
-            name, f"shape {want}: one entry (row) per mode, {shape[0]} modes as in frequencies",
-            f"shape {arr.shape}",
-        )
-    return arr
 
 
 class FlexibleSatellite:
@@ -170,46 +133,10 @@ class FlexibleSatellite:
         pzt_matrix: Any = None,
         panel_disturbance: bool = False,
     ) -> None:
-        self._inertia = check_pd(as_matrix(inertia, "inertia", (3, 3)), "inertia")
-        self._freq = _real_array(frequencies, "frequencies").ravel()
-        n_modes = int(self._freq.size)
-        if np.any(self._freq <= 0.0):
-            found = repr(self._freq.tolist())
-            raise InvalidArgumentError("frequencies", "modal frequencies > 0 (rad/s)", found)
-        self._damp = _modal(damping, "damping", (n_modes,))
-        if np.any(self._damp < 0.0):
-            raise InvalidArgumentError("damping", "damping ratios >= 0", repr(self._damp.tolist()))
-        self._delta = _modal(coupling, "coupling", (n_modes, 3))
-        self._mass = np.eye(n_modes)
-        if modal_mass is not None:
-            self._mass = _modal(modal_mass, "modal_mass", (n_modes, n_modes))
-            if n_modes:
-                check_pd(self._mass, "modal_mass")
-        self._gamma_a = np.eye(n_modes)
-        if pzt_matrix is not None:
-            self._gamma_a = _modal(pzt_matrix, "pzt_matrix", (n_modes, None))
-        if not isinstance(panel_disturbance, bool | np.bool_):
-            raise ArgumentTypeError("panel_disturbance", "a bool", type(panel_disturbance).__name__)
-        self._panel_disturbance = bool(panel_disturbance)
-        self._mass_inv = np.linalg.inv(self._mass) if n_modes else np.zeros((0, 0))
-        j_mb = self._inertia - self._delta.T @ self._mass_inv @ self._delta
-        j_mb = 0.5 * (j_mb + j_mb.T)
-        lam_min = float(np.linalg.eigvalsh(j_mb)[0])
-        if lam_min <= 0.0:
-            raise InvalidArgumentError(
-                "coupling",
-                "a coupling delta with J - delta' M^-1 delta positive definite (a positive definite "
-                "mass matrix)",
-                f"smallest eigenvalue of J - delta' M^-1 delta = {lam_min:.6g}",
-            )
-        self._j_mb = j_mb
-        self._j_mb_inv = np.linalg.inv(j_mb)
-        self._couple = self._delta.T @ self._mass_inv  # delta' M^-1 (3 x N)
-        self._k_diag = self._freq**2
-        self._c_diag = 2.0 * self._damp * self._freq
-        for arr in (self._inertia, self._freq, self._damp, self._delta, self._mass, self._gamma_a, j_mb,
-                    self._j_mb_inv, self._mass_inv, self._couple, self._k_diag, self._c_diag):
-            arr.setflags(write=False)
+        self._p = hybrid_parameters(
+            inertia, frequencies, damping, coupling, modal_mass=modal_mass, pzt_matrix=pzt_matrix
+        )
+        self._panel_disturbance = check_bool(panel_disturbance, "panel_disturbance")
 
     @classmethod
     def di_gennaro(cls, n_modes: int = 4, *, panel_disturbance: bool = False) -> FlexibleSatellite:
@@ -236,9 +163,10 @@ class FlexibleSatellite:
         ):
             raise InvalidArgumentError("n_modes", f"an integer in [0, {self.n_modes}]", repr(n_modes))
         k = int(n_modes)
+        p = self._p
         return FlexibleSatellite(
-            self._inertia, self._freq[:k], self._damp[:k], self._delta[:k],
-            modal_mass=self._mass[:k, :k], pzt_matrix=self._gamma_a[:k],
+            p.inertia, p.frequencies[:k], p.damping[:k], p.coupling[:k],
+            modal_mass=p.modal_mass[:k, :k], pzt_matrix=p.pzt_matrix[:k],
             panel_disturbance=self._panel_disturbance,
         )
 
@@ -257,21 +185,18 @@ class FlexibleSatellite:
         >>> lim([3.0, -1.0, -2.5, 100.0, 0.0, 0.0, 0.0]).tolist()
         [2.0, -1.0, -2.0, 100.0, 0.0, 0.0, 0.0]
         """
-        hub = np.broadcast_to(np.asarray(check_positive(u_max, "u_max") if np.ndim(u_max) == 0 else
-                                         as_vector(u_max, "u_max", 3), dtype=float), (3,))
-        if v_max is None:
-            pzt = np.full(self.n_pzt, _NO_LIMIT)
-        elif np.ndim(v_max) == 0:
-            pzt = np.full(self.n_pzt, check_positive(v_max, "v_max"))
-        else:
-            pzt = as_vector(v_max, "v_max", self.n_pzt)
+        hub = as_positive_values(u_max, "u_max", 3, per="axis", what="limits")
+        pzt = (
+            np.full(self.n_pzt, _NO_LIMIT) if v_max is None
+            else as_positive_values(v_max, "v_max", self.n_pzt, per="PZT input", what="limits")
+        )
         return TorqueLimiter(np.concatenate((hub, pzt)))
 
     # -- sizes and names -----------------------------------------------------------------
     @property
     def n_modes(self) -> int:
         """Number of flexible modes ``N``."""
-        return int(self._freq.size)
+        return self._p.n_modes
 
     @property
     def n_states(self) -> int:
@@ -286,7 +211,7 @@ class FlexibleSatellite:
     @property
     def n_pzt(self) -> int:
         """Number of PZT inputs ``n_a`` (columns of ``Gamma_a``)."""
-        return int(self._gamma_a.shape[1])
+        return self._p.n_pzt
 
     @property
     def n_inputs(self) -> int:
@@ -317,58 +242,56 @@ class FlexibleSatellite:
 
     def linear_state_names(self, attitude: AttitudeForm = "euler") -> tuple[str, ...]:
         """Names of the linear state for ``attitude`` ``"euler"`` or ``"quaternion"``."""
-        check_choice(attitude, "attitude", ("euler", "quaternion"))
-        att = ("phi", "theta", "psi") if attitude == "euler" else ("q1", "q2", "q3")
-        return att + self.state_names[4:]
+        return _linear.linear_state_names(self.state_names, attitude)
 
     # -- parameters ----------------------------------------------------------------------
     @property
     def inertia(self) -> np.ndarray:
         """Total inertia ``J`` (kg m^2, read-only)."""
-        return self._inertia
+        return self._p.inertia
 
     @property
     def frequencies(self) -> np.ndarray:
         """Modal frequencies ``Lambda_i`` (rad/s)."""
-        return self._freq
+        return self._p.frequencies
 
     @property
     def damping(self) -> np.ndarray:
         """Modal damping ratios ``xi_i``."""
-        return self._damp
+        return self._p.damping
 
     @property
     def coupling(self) -> np.ndarray:
         """Coupling ``delta`` (N x 3)."""
-        return self._delta
+        return self._p.coupling
 
     @property
     def modal_mass(self) -> np.ndarray:
         """Modal mass ``M`` (N x N)."""
-        return self._mass
+        return self._p.modal_mass
 
     @property
     def pzt_matrix(self) -> np.ndarray:
         """PZT modal-force matrix ``Gamma_a`` (N x n_a)."""
-        return self._gamma_a
+        return self._p.pzt_matrix
 
     @property
     def stiffness(self) -> np.ndarray:
         """``K = diag(Lambda_i^2)`` (assuming ``M = I`` scaling of the modes)."""
-        return np.diag(self._freq**2)
+        return np.diag(self._p.frequencies**2)
 
     @property
     def damping_matrix(self) -> np.ndarray:
         """``C = diag(2 xi_i Lambda_i)``."""
-        return np.diag(2.0 * self._damp * self._freq)
+        return np.diag(2.0 * self._p.damping * self._p.frequencies)
 
     @property
     def hub_inertia(self) -> np.ndarray:
         """``J_mb = J - delta' M^-1 delta`` (kg m^2), symmetric positive definite."""
-        return self._j_mb
+        return self._p.hub_inertia
 
     def __repr__(self) -> str:
-        return f"FlexibleSatellite(n_modes={self.n_modes}, frequencies={self._freq.tolist()})"
+        return f"FlexibleSatellite(n_modes={self.n_modes}, frequencies={self._p.frequencies.tolist()})"
 
     # -- states ---------------------------------------------------------------------------
     def state(
@@ -397,9 +320,22 @@ class FlexibleSatellite:
         out[:4] /= np.linalg.norm(out[:4])
         return out
 
-    def euler_angles(self, x: Any) -> np.ndarray:
-        """3-2-1 Euler angles (rad) of the state's attitude (``quat_to_euler321``)."""
-        return quat_to_euler321(self.split_state(x)[0])
+    def attitude_euler(self, x: Any) -> np.ndarray:
+        """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the inertial frame.
+
+        The angles of the state's quaternion (``quat_to_euler321``, after rescaling it to unit
+        norm). ``x`` is one state or states as rows; see :class:`models.protocols.Plant`.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import FlexibleSatellite
+        >>> sat = FlexibleSatellite.di_gennaro()
+        >>> x = sat.state([np.cos(0.25), 0.0, np.sin(0.25), 0.0])   # 0.5 rad about y
+        >>> np.round(sat.attitude_euler(x), 12).tolist()
+        [0.0, 0.5, 0.0]
+        """
+        return map_states(lambda s: quat_to_euler321(s[:4] / np.linalg.norm(s[:4])), x, self.n_states)
 
     def linear_state(self, x: Any, q_ref: Any = None, attitude: AttitudeForm = "quaternion") -> np.ndarray:
         """Map a nonlinear state to the ``6 + 2N`` linear state about the reference ``q_ref``.
@@ -407,51 +343,15 @@ class FlexibleSatellite:
         The attitude is the error quaternion ``q_ref^-1 * q`` (with ``q0 >= 0``): its vector part
         (``"quaternion"``, the default) or its 3-2-1 Euler angles (``"euler"``).
         """
-        check_choice(attitude, "attitude", ("euler", "quaternion"))
+        _linear.linear_state_names(self.state_names, attitude)  # checks attitude
         q, w, eta, eta_dot = self.split_state(x)
         err = quat_error(q / np.linalg.norm(q), q_ref)
         att = err[1:] if attitude == "quaternion" else quat_to_euler321(err)
         return np.concatenate((att, w, eta, eta_dot))
 
-    # -- nonlinear model ------------------------------------------------------------------
-    def _split_inputs(self, u: Any, d: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(hub torque incl. d, v, d_f)`` from the checked ``u`` and ``d``."""
-        n, n_a = self.n_modes, self.n_pzt
-        if u is None:
-            torque, v = np.zeros(3), np.zeros(n_a)
-        else:
-            u_vec = as_vector(u, "u")
-            if u_vec.size == 3:
-                torque, v = u_vec, np.zeros(n_a)
-            elif u_vec.size == 3 + n_a:
-                torque, v = u_vec[:3], u_vec[3:]
-            else:
-                raise InvalidArgumentError(
-                    "u", f"3 hub torques or 3 + n_a = {3 + n_a} inputs (torques, then PZT commands)",
-                    f"length {u_vec.size}",
-                )
-        d_f = np.zeros(n)
-        if d is not None:
-            d_vec = as_vector(d, "d")
-            if d_vec.size == 3:
-                torque = torque + d_vec
-            elif d_vec.size == 3 + n:
-                torque, d_f = torque + d_vec[:3], d_vec[3:]
-            else:
-                raise InvalidArgumentError(
-                    "d", f"3 hub torques or 3 + N = {3 + n} values (hub torques, then panel forces d_f)",
-                    f"length {d_vec.size}",
-                )
-        return torque, v, d_f
-
+    # -- nonlinear model (models.flexible.dynamics, models.flexible.energy) ------------------
     def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
-        """``x'`` of the nonlinear model (seed 2.1, solved form; no algebraic loop).
-
-        ::
-
-            J_mb w' = -w x (J w + delta' eta') + delta' M^-1 (C eta' + K eta - Gamma_a v - d_f) + u + d
-            eta''   = M^-1 (Gamma_a v + d_f - C eta' - K eta - delta w')
-            q0' = -q_v' w / 2,   q_v' = (q0 I + [q_v x]) w / 2
+        """``x'`` of the nonlinear model (seed 2.1, solved form; :mod:`models.flexible.dynamics`).
 
         Parameters
         ----------
@@ -464,30 +364,12 @@ class FlexibleSatellite:
             Hub disturbance torque (3), optionally followed by the panel forces ``d_f`` (N).
         """
         x = as_vector(x, "x", self.n_states)
-        torque, v, d_f = self._split_inputs(u, d)
-        return self._rhs(x, torque, v, d_f)
-
-    def _rhs(self, x: np.ndarray, torque: np.ndarray, v: np.ndarray, d_f: np.ndarray) -> np.ndarray:
-        """Unchecked right-hand side; ``torque`` already includes the hub disturbance."""
-        n = self.n_modes
-        q0, qv, w = x[0], x[1:4], x[4:7]
-        eta, eta_dot = x[7:7 + n], x[7 + n:]
-        h = self._inertia @ w + self._delta.T @ eta_dot
-        modal_force = self._gamma_a @ v + d_f - self._c_diag * eta_dot - self._k_diag * eta
-        w_dot = self._j_mb_inv @ (torque - cross3(w, h) - self._couple @ modal_force)
-        eta_ddot = self._mass_inv @ (modal_force - self._delta @ w_dot)
-        out = np.empty_like(x)
-        out[0] = -0.5 * (qv @ w)
-        out[1:4] = 0.5 * (q0 * w + cross3(qv, w))
-        out[4:7] = w_dot
-        out[7:7 + n] = eta_dot
-        out[7 + n:] = eta_ddot
-        return out
+        return hybrid_rhs(self._p, x, *split_inputs(self._p, u, d))
 
     def angular_momentum(self, x: Any) -> np.ndarray:
         """Total angular momentum in body components, ``h = J w + delta' eta'`` (N m s)."""
         _, w, _, eta_dot = self.split_state(x)
-        return self._inertia @ w + self._delta.T @ eta_dot
+        return _energy.angular_momentum(self._p, w, eta_dot)
 
     def angular_momentum_inertial(self, x: Any) -> np.ndarray:
         """``R(q) (J w + delta' eta')``: constant without external torques (PZT forces are internal)."""
@@ -497,22 +379,19 @@ class FlexibleSatellite:
     def energy(self, x: Any) -> float:
         """``E = w'J w/2 + w' delta' eta' + eta'' M eta'/2 + eta' K eta/2`` (J): kinetic plus strain."""
         _, w, eta, eta_dot = self.split_state(x)
-        return float(0.5 * w @ self._inertia @ w + w @ self._delta.T @ eta_dot
-                     + 0.5 * eta_dot @ self._mass @ eta_dot + 0.5 * eta @ (self._k_diag * eta))
+        return _energy.energy(self._p, w, eta, eta_dot)
 
     def energy_rate(self, x: Any, u: Any = None, d: Any = None) -> float:
         """``E' = w'(u + d) + eta''(Gamma_a v + d_f) - eta'' C eta'`` (W), the power balance."""
-        x = as_vector(x, "x", self.n_states)
-        torque, v, d_f = self._split_inputs(u, d)
-        w, eta_dot = x[4:7], x[7 + self.n_modes:]
-        return float(w @ torque + eta_dot @ (self._gamma_a @ v + d_f) - eta_dot @ (self._c_diag * eta_dot))
+        _, w, _, eta_dot = self.split_state(x)
+        return _energy.energy_rate(self._p, w, eta_dot, *split_inputs(self._p, u, d))
 
     def modal_energy(self, x: Any) -> float:
         """Energy of the modes alone, ``eta'' M eta'/2 + eta' K eta/2`` (J)."""
         _, _, eta, eta_dot = self.split_state(x)
-        return float(0.5 * eta_dot @ self._mass @ eta_dot + 0.5 * eta @ (self._k_diag * eta))
+        return _energy.modal_energy(self._p, eta, eta_dot)
 
-    # -- linear model -----------------------------------------------------------------------
+    # -- linear model (models.flexible.linear, models.flexible.polytope) -----------------------
     def linearize(
         self,
         x_op: Any = None,
@@ -545,65 +424,43 @@ class FlexibleSatellite:
         -------
         A : (6 + 2N, 6 + 2N) ndarray
         B : (6 + 2N, 3) or (6 + 2N, 3 + n_a) ndarray
-
-        Notes
-        -----
-        With ``P = J_mb^-1`` and ``G = M^-1 + M^-1 delta P delta' M^-1`` (seed section 2.2)::
-
-            A = [[0, Kin, 0,                 0               ],
-                 [0, 0,   P delta' M^-1 K,   P delta' M^-1 C ],
-                 [0, 0,   0,                 I               ],
-                 [0, 0,   -G K,              -G C            ]]
-            B_u = [0; P; 0; -M^-1 delta P],   B_v = [0; -P delta' M^-1; 0; G] Gamma_a
+            The matrices of seed section 2.2, written out in
+            :func:`models.flexible.linear.linear_matrices`.
         """
-        check_choice(attitude, "attitude", ("euler", "quaternion"))
-        n = self.n_linear_states
-        if x_op is None:
-            att = np.zeros(3)
-        else:
-            x = as_vector(x_op, "x_op", n)
-            if np.any(x[3:] != 0.0):
-                raise InvalidArgumentError(
-                    "x_op", "zero rates and a zero modal state (the model is linearised there)",
-                    f"x_op[3:] = {x[3:].tolist()}",
-                )
-            att = x[:3]
-        if attitude == "euler":
-            kin = kinematics_matrix(att[0], att[1])
-        else:
-            norm2 = float(att @ att)
-            if norm2 > 1.0:
-                raise InvalidArgumentError(
-                    "x_op", "a quaternion vector part with |q_v| <= 1", f"|q_v| = {np.sqrt(norm2):.6g}"
-                )
-            kin = 0.5 * (np.sqrt(1.0 - norm2) * np.eye(3) + np.array(
-                [[0.0, -att[2], att[1]], [att[2], 0.0, -att[0]], [-att[1], att[0], 0.0]]
-            ))
-        point = ParameterPoint() if parameters is None else parameters
-        if not isinstance(point, ParameterPoint):
-            raise ArgumentTypeError("parameters", "None or a models.flexible.linear.ParameterPoint",
-                                    type(parameters).__name__)
-        kappa, k, c, eff = point.resolved(self._k_diag, self._c_diag)
-        return linear_matrices(kappa * self._j_mb_inv, self._mass_inv, self._delta, k, c, self._gamma_a,
-                               kin, pzt, eff)
+        return _linear.linearize(self._p, x_op, pzt=pzt, attitude=attitude, parameters=parameters)
 
     def discretize(
-        self, dt: float, x_op: Any = None, *, pzt: bool = False, attitude: AttitudeForm = "euler"
+        self, x_op: Any = None, dt: float | None = None, *, pzt: bool = False,
+        attitude: AttitudeForm = "euler",
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt``."""
+        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
         a, b = self.linearize(x_op, pzt=pzt, attitude=attitude)
-        return zoh(a, b, dt)
+        return zoh(a, b, sample_time(dt))
 
+    def linear_model(
+        self, x_op: Any = None, dt: float | None = None, *, pzt: bool = False,
+        attitude: AttitudeForm = "euler",
+    ) -> PolytopicModel:
+        """:meth:`discretize` as a one-vertex :class:`PolytopicModel`.
+
+        Its ``attitude`` is ``"euler321"`` or ``"quaternion_vector"`` after ``attitude``.
+        """
+        ad, bd = self.discretize(x_op, dt, pzt=pzt, attitude=attitude)
+        inputs = self.input_names[: 3 + (self.n_pzt if pzt else 0)]
+        return PolytopicModel([(ad, bd)], dt, state_names=self.linear_state_names(attitude),
+                              input_names=inputs, attitude=POLYTOPIC_ATTITUDE[attitude])
+
+    @renamed_arguments(**RENAMED_RANGES)
     def polytope(
         self,
-        dt: float,
-        *,
         x_op: Any = None,
+        dt: float | None = None,
+        *,
         mode: PolytopeMode = "groups",
-        inertia_scale: Any = DEFAULT_INERTIA_SCALE,
-        frequency_scale: Any = DEFAULT_FREQUENCY_SCALE,
-        damping_scale: Any = DEFAULT_DAMPING_SCALE,
-        effectiveness: Any = DEFAULT_EFFECTIVENESS,
+        inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
+        frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
+        damping_range: Any = DEFAULT_DAMPING_RANGE,
+        effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
         attitude: AttitudeForm = "euler",
         pzt: bool = False,
     ) -> PolytopicModel:
@@ -611,21 +468,26 @@ class FlexibleSatellite:
 
         Parameters
         ----------
-        dt : float
-            Sample time (s) of the zero-order hold.
         x_op : array_like, optional
-            Operating attitude as in :meth:`linearize`.
+            Operating point as in :meth:`linearize` (default zero).
+        dt : float
+            Sample time (s) of the zero-order hold (required).
         mode : {"groups", "box", "effectiveness"}
-            ``"groups"`` (8 vertices): one scale each for ``kappa`` on ``J_mb^-1``, all modal
-            stiffnesses and all damping coefficients. ``"box"``: ``kappa`` and each ``k_i``,
-            ``c_i`` on its own (``2^(1 + 2N)`` vertices). ``"effectiveness"``: the hub-torque
-            columns of ``B`` scaled by the two ends of ``effectiveness`` (2 vertices).
-        inertia_scale, frequency_scale, damping_scale, effectiveness : (low, high)
-            Ranges of ``kappa``, of the frequency scale ``f`` (``k_i -> f^2 k_i``) and of the
-            damping-ratio scale ``g`` (``c_i -> f g c_i``), and of the torque effectiveness
-            (all **assumed**; see :mod:`models.flexible.polytope`).
+            ``"groups"`` (8 vertices): one multiplier each for ``kappa`` on ``J_mb^-1``, all
+            modal stiffnesses and all damping coefficients. ``"box"``: ``kappa`` and each
+            ``k_i``, ``c_i`` on its own (``2^(1 + 2N)`` vertices). ``"effectiveness"``: the
+            hub-torque columns of ``B`` scaled by the two ends of ``effectiveness_range`` (2
+            vertices).
+        inverse_inertia_range, frequency_range, damping_range, effectiveness_range : (low, high)
+            Ranges of multipliers of nominal values: of ``J_mb^-1`` (``kappa``), of the modal
+            frequencies (``f``: ``k_i -> f^2 k_i``), of the damping ratios (``g``:
+            ``c_i -> f g c_i``) and of the hub torque (all **assumed**; see
+            :mod:`models.flexible.polytope`). They were called ``inertia_scale``,
+            ``frequency_scale``, ``damping_scale`` and ``effectiveness``; the old names raise
+            an error that gives the new one.
         attitude : {"euler", "quaternion"}
-            Attitude coordinates of the linear model.
+            Attitude coordinates of the linear model (the polytope's ``attitude`` is then
+            ``"euler321"`` or ``"quaternion_vector"``).
         pzt : bool
             Include the PZT inputs.
 
@@ -642,11 +504,12 @@ class FlexibleSatellite:
         up to ``O(dt^2)``: check a robust gain on a parameter grid.
         """
         return flexible_polytope(
-            self, dt, x_op=x_op, mode=mode, inertia_scale=inertia_scale, frequency_scale=frequency_scale,
-            damping_scale=damping_scale, effectiveness=effectiveness, attitude=attitude, pzt=pzt,
+            self, x_op, dt, mode=mode, inverse_inertia_range=inverse_inertia_range,
+            frequency_range=frequency_range, damping_range=damping_range,
+            effectiveness_range=effectiveness_range, attitude=attitude, pzt=pzt,
         )
 
-    # -- single axis, regime ------------------------------------------------------------------
+    # -- single axis, regime (models.flexible.single_axis) --------------------------------------
     def single_axis_tf(self, axis: int = 0, *, cancel_uncoupled: bool = True) -> Any:
         """The python-control ``TransferFunction`` ``theta_a / u_a`` about body axis ``axis`` (seed 2.3).
 
@@ -663,19 +526,7 @@ class FlexibleSatellite:
         >>> round(float(abs(g(1e-4j))) * 350.0 * 1e-8, 6)   # J_aa s^2 G(s) -> 1 as s -> 0
         1.0
         """
-        if isinstance(axis, bool) or not isinstance(axis, int | np.integer) or not 0 <= axis <= 2:
-            raise InvalidArgumentError("axis", "0, 1 or 2 (body x, y, z)", repr(axis))
-        masses = np.diag(self._mass)
-        if np.any(self._mass != np.diag(masses)):
-            raise InvalidArgumentError("modal_mass", "a diagonal modal mass for the single-axis model",
-                                       "off-diagonal entries")
-        num, den = single_axis_polynomials(
-            float(self._inertia[axis, axis]), self._delta[:, axis], masses, self._k_diag, self._c_diag,
-            cancel_uncoupled=cancel_uncoupled,
-        )
-        import control
-
-        return control.tf(num, den)
+        return _single_axis.single_axis_tf(self._p, axis, cancel_uncoupled=cancel_uncoupled)
 
     def single_axis_modes(self, axis: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Unconstrained (free-free) natural frequencies (rad/s) and damping ratios about ``axis``.
@@ -683,13 +534,7 @@ class FlexibleSatellite:
         The roots of ``D(s)`` (the poles of :meth:`single_axis_tf` besides the double
         integrator), sorted by frequency.
         """
-        g = self.single_axis_tf(axis)
-        poles = np.asarray(g.poles())
-        osc = poles[np.abs(poles) > 1e-9 * max(1.0, float(np.max(np.abs(poles))))]
-        osc = osc[osc.imag >= 0.0] if np.any(osc.imag > 0) else osc
-        w_n = np.abs(osc)
-        order = np.argsort(w_n)
-        return w_n[order], (-osc.real / w_n)[order]
+        return _single_axis.single_axis_modes(self._p, axis)
 
     def regime(self, bandwidth: float) -> str:
         """Paper S's label of a closed-loop bandwidth (rad/s) against ``Lambda_1``.
@@ -698,4 +543,4 @@ class FlexibleSatellite:
         """
         if self.n_modes == 0:
             return "rigid-like"
-        return regime(bandwidth, float(np.min(self._freq)))
+        return _single_axis.regime(bandwidth, float(np.min(self._p.frequencies)))

@@ -23,6 +23,7 @@ from typing import Any
 import control
 import numpy as np
 
+from models.flexible.parameters import HybridParameters
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
@@ -30,7 +31,9 @@ __all__ = [
     "REGIME_LABELS",
     "flexible_factor",
     "regime",
+    "single_axis_modes",
     "single_axis_polynomials",
+    "single_axis_tf",
 ]
 
 #: Paper S's three regimes (thresholds ``w_1/3`` and ``w_1/2`` **certain**, labels **likely**):
@@ -131,3 +134,31 @@ def regime(bandwidth: float, first_frequency: float) -> str:
     if w_bw <= w_1 / 2.0:
         return REGIME_LABELS[1]
     return REGIME_LABELS[2]
+
+
+def single_axis_tf(
+    p: HybridParameters, axis: int = 0, *, cancel_uncoupled: bool = True
+) -> control.TransferFunction:
+    """``theta_a / u_a`` about body axis ``axis``; see :meth:`models.FlexibleSatellite.single_axis_tf`."""
+    if isinstance(axis, bool) or not isinstance(axis, int | np.integer) or not 0 <= axis <= 2:
+        raise InvalidArgumentError("axis", "0, 1 or 2 (body x, y, z)", repr(axis))
+    masses = np.diag(p.modal_mass)
+    if np.any(p.modal_mass != np.diag(masses)):
+        raise InvalidArgumentError("modal_mass", "a diagonal modal mass for the single-axis model",
+                                   "off-diagonal entries")
+    num, den = single_axis_polynomials(
+        float(p.inertia[axis, axis]), p.coupling[:, axis], masses, p.stiffness, p.viscous_damping,
+        cancel_uncoupled=cancel_uncoupled,
+    )
+    return control.tf(num, den)
+
+
+def single_axis_modes(p: HybridParameters, axis: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Free-free frequencies and damping ratios; see :meth:`models.FlexibleSatellite.single_axis_modes`."""
+    g = single_axis_tf(p, axis)
+    poles = np.asarray(g.poles())
+    osc = poles[np.abs(poles) > 1e-9 * max(1.0, float(np.max(np.abs(poles))))]
+    osc = osc[osc.imag >= 0.0] if np.any(osc.imag > 0) else osc
+    w_n = np.abs(osc)
+    order = np.argsort(w_n)
+    return w_n[order], (-osc.real / w_n)[order]

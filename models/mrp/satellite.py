@@ -23,10 +23,12 @@ from typing import Any
 
 import numpy as np
 
-from models.attitude.mrp import _cross, _dcm, _kinematics
-from models.rigid.satellite import _as_inertia
+from models.attitude.euler import euler321_from_matrix
+from models.attitude.mrp import _dcm, _kinematics
+from models.attitude.vectors import cross3
+from models.protocols import map_states
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive, check_real
+from toolkit_common.validation import as_inertia, as_vector, check_positive, check_real
 
 __all__ = [
     "EARTH_MU",
@@ -85,6 +87,8 @@ class MRPSatellite:
     n_states = 6
     n_inputs = 3
     n_disturbances = 3
+    state_names = ("sigma1", "sigma2", "sigma3", "wx", "wy", "wz")
+    input_names = ("Mx", "My", "Mz")
 
     def __init__(
         self,
@@ -96,7 +100,7 @@ class MRPSatellite:
         mu: float = EARTH_MU,
         earth_radius: float = EARTH_RADIUS,
     ) -> None:
-        self._inertia = _as_inertia(inertia)
+        self._inertia = as_inertia(inertia)
         self._inertia.setflags(write=False)
         self._inertia_inv = np.linalg.inv(self._inertia)
         self._inertia_inv.setflags(write=False)
@@ -179,10 +183,10 @@ class MRPSatellite:
         c = _dcm(s)
         w_bo = w + self.mean_motion * c[:, 1]
         jw = self._inertia @ w
-        total = torque - _cross(w, jw)
+        total = torque - cross3(w, jw)
         if self.gravity_gradient:
             c3 = c[:, 2]
-            total = total + 3.0 * self.mean_motion**2 * _cross(c3, self._inertia @ c3)
+            total = total + 3.0 * self.mean_motion**2 * cross3(c3, self._inertia @ c3)
         return np.concatenate((_kinematics(s) @ w_bo, self._inertia_inv @ total))
 
     def normalize_state(self, x: Any) -> np.ndarray:
@@ -197,6 +201,26 @@ class MRPSatellite:
         if ss <= self.shadow_threshold:
             return x
         return np.concatenate((-s / ss, x[3:]))
+
+    def attitude_euler(self, x: Any) -> np.ndarray:
+        """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the **orbital (LVLH) frame O**.
+
+        The angles of ``C(sigma)`` (:func:`models.attitude.mrp.mrp_to_dcm`, O to body
+        components): the body is reached from O by the yaw ``psi`` about ``o_3``, the pitch
+        ``theta`` about the new 2-axis and the roll ``phi`` about the body 1-axis. Either MRP
+        set gives the same angles. ``x`` is one state or states as rows; see
+        :class:`models.protocols.Plant`.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import MRPSatellite
+        >>> sat = MRPSatellite.paper_m()
+        >>> x = np.array([np.tan(0.5 / 4), 0.0, 0.0, 0.0, 0.0, 0.0])   # 0.5 rad about o_1
+        >>> bool(np.allclose(sat.attitude_euler(x), [0.5, 0.0, 0.0]))
+        True
+        """
+        return map_states(lambda s: euler321_from_matrix(_dcm(s[:3]).T), x, self.n_states)
 
     def relative_rate(self, x: Any) -> np.ndarray:
         """``w_BO = w + n c2(sigma)``: the body rate relative to the orbital frame (B components)."""
@@ -216,7 +240,7 @@ class MRPSatellite:
         from the Earth's centre in body components.
         """
         c3 = _dcm(as_vector(sigma, "sigma", 3))[:, 2]
-        return 3.0 * self.mean_motion**2 * _cross(c3, self._inertia @ c3)
+        return 3.0 * self.mean_motion**2 * cross3(c3, self._inertia @ c3)
 
     def kinetic_energy(self, x: Any) -> float:
         """Rotational kinetic energy ``w' J w / 2`` (J), with ``w`` relative to inertial space."""

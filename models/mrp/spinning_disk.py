@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from models.attitude.mrp import _cross
+from models.attitude.vectors import cross3
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive, check_real
 
@@ -190,7 +190,7 @@ class SpinningDisk:
 
     def _torque(self, t: float, w: np.ndarray) -> np.ndarray:
         jb_a = self._jb @ self._axis
-        return -(self.speed(t) * _cross(w, jb_a) + self.acceleration(t) * jb_a)
+        return -(self.speed(t) * cross3(w, jb_a) + self.acceleration(t) * jb_a)
 
     def torque(self, t: float, x: Any) -> np.ndarray:
         """The true torque on the bus in the state ``x`` (body rate ``x[3:6]``), N m."""

@@ -22,16 +22,11 @@ from models.attitude.euler import (
     kinematics_matrix,
     rotation_matrix,
 )
-from models.linear import PolytopicModel, zoh
+from models.attitude.vectors import skew
+from models.linear import PolytopicModel, operating_point, relative_spread, sample_time, zoh
+from models.protocols import map_states
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import (
-    as_matrix,
-    as_vector,
-    check_choice,
-    check_pd,
-    check_positive,
-    check_real,
-)
+from toolkit_common.validation import as_inertia, as_vector, check_choice, check_real
 
 __all__ = [
     "INPUT_NAMES",
@@ -41,7 +36,6 @@ __all__ = [
     "PAPER_P_TORQUE_LIMIT",
     "STATE_NAMES",
     "RigidSatellite",
-    "skew",
 ]
 
 #: Principal inertias ``(Ixx, Iyy, Izz)`` of paper P in kg m^2 (**likely**, decoded).
@@ -60,29 +54,6 @@ INPUT_NAMES: tuple[str, ...] = ("Mx", "My", "Mz")
 PolytopeMode = Literal["scalar", "box"]
 
 
-def skew(v: np.ndarray) -> np.ndarray:
-    """Return the cross-product matrix ``[v]x`` with ``[v]x w = v x w``."""
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _as_inertia(inertia: Any, name: str = "inertia") -> np.ndarray:
-    arr = None
-    if not isinstance(inertia, str | bytes):
-        try:
-            arr = np.asarray(inertia, dtype=float)
-        except (TypeError, ValueError):
-            arr = None  # not numeric or ragged: as_matrix below raises ArgumentTypeError naming it
-    if arr is not None and arr.ndim == 1:
-        diag = as_vector(arr, name, 3)
-        if np.any(diag <= 0.0):
-            raise InvalidArgumentError(
-                name, "positive principal inertias (kg m^2)", f"{diag.tolist()}"
-            )
-        return np.diag(diag)
-    mat = as_matrix(inertia, name, (3, 3))
-    return check_pd(mat, name)
-
-
 class RigidSatellite:
     """A rigid satellite with a symmetric positive definite inertia matrix.
 
@@ -91,6 +62,14 @@ class RigidSatellite:
     inertia : array_like
         Either the three principal inertias ``[Ixx, Iyy, Izz]`` (a diagonal matrix) or a full
         symmetric positive definite ``3 x 3`` matrix, in kg m^2.
+
+    Notes
+    -----
+    The satellite follows :class:`models.protocols.Plant`: ``n_states``, ``n_inputs``,
+    ``state_names``, ``input_names``, :meth:`dynamics` and :meth:`attitude_euler`. Its
+    linearisation family (:meth:`linearize`, :meth:`discretize`, :meth:`linear_model`,
+    :meth:`polytope`) takes the operating point ``x_op`` first (default: at rest at zero
+    attitude) and the sample time ``dt`` next, as every satellite's does.
 
     Examples
     --------
@@ -107,9 +86,11 @@ class RigidSatellite:
 
     n_states = 6
     n_inputs = 3
+    state_names = STATE_NAMES
+    input_names = INPUT_NAMES
 
     def __init__(self, inertia: Any) -> None:
-        self._inertia = _as_inertia(inertia)
+        self._inertia = as_inertia(inertia)
         self._inertia.setflags(write=False)
         self._inertia_inv = np.linalg.inv(self._inertia)
         self._inertia_inv.setflags(write=False)
@@ -169,6 +150,13 @@ class RigidSatellite:
         w_dot = self._inertia_inv @ (torque - np.cross(w, jw))
         return np.concatenate((kinematics_matrix(x[0], x[1]) @ w, w_dot))
 
+    def attitude_euler(self, x: Any) -> np.ndarray:
+        """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the inertial frame: ``x[:3]``.
+
+        ``x`` is one state ``(6,)`` or states as rows ``(k, 6)``; see :class:`models.protocols.Plant`.
+        """
+        return map_states(lambda s: s[:3].copy(), x, self.n_states)
+
     def kinetic_energy(self, x: Any) -> float:
         """Rotational kinetic energy ``w' J w / 2`` (J)."""
         w = as_vector(x, "x", 6)[3:]
@@ -180,8 +168,10 @@ class RigidSatellite:
         return rotation_matrix(x[:3]) @ (self._inertia @ x[3:])
 
     # -- linearisation -----------------------------------------------------------------
-    def linearize(self, x_op: Any, u_op: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def linearize(self, x_op: Any = None, u_op: Any = None) -> tuple[np.ndarray, np.ndarray]:
         """Continuous-time Jacobians ``(A, B)`` of the nonlinear model at ``(x_op, u_op)``.
+
+        ``x_op`` (6 values) defaults to the rest state at zero attitude, ``np.zeros(6)``.
 
         Derived analytically, gyroscopic terms included:
 
@@ -193,7 +183,7 @@ class RigidSatellite:
         is affine in the torque, so ``u_op`` does not change ``A`` or ``B``; it is accepted for
         symmetry with python-control's ``linearize``.
         """
-        x_op = as_vector(x_op, "x_op", 6)
+        x_op = operating_point(x_op, 6)
         if u_op is not None:
             as_vector(u_op, "u_op", 3)
         w = x_op[3:]
@@ -205,15 +195,19 @@ class RigidSatellite:
         b[3:, :] = self._inertia_inv
         return a, b
 
-    def discretize(self, x_op: Any, dt: float, u_op: Any = None) -> tuple[np.ndarray, np.ndarray]:
-        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt``."""
+    def discretize(
+        self, x_op: Any = None, dt: float | None = None, u_op: Any = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
         a, b = self.linearize(x_op, u_op)
-        return zoh(a, b, dt)
+        return zoh(a, b, sample_time(dt))
 
-    def linear_model(self, x_op: Any, dt: float) -> PolytopicModel:
-        """The discretised linearisation as a one-vertex :class:`PolytopicModel`."""
+    def linear_model(self, x_op: Any = None, dt: float | None = None) -> PolytopicModel:
+        """The discretised linearisation as a one-vertex :class:`PolytopicModel` (Euler attitude)."""
         ad, bd = self.discretize(x_op, dt)
-        return PolytopicModel([(ad, bd)], dt, state_names=STATE_NAMES, input_names=INPUT_NAMES)
+        return PolytopicModel(
+            [(ad, bd)], dt, state_names=STATE_NAMES, input_names=INPUT_NAMES, attitude="euler321"
+        )
 
     # -- uncertainty -------------------------------------------------------------------
     def inertia_vertices(self, spread: float, mode: PolytopeMode = "scalar") -> list[np.ndarray]:
@@ -235,9 +229,7 @@ class RigidSatellite:
         ``1/((1 + s) J_i)`` and ``1/((1 - s) J_i)``. Every inertia inside the box maps to a
         ``J^-1`` inside their convex hull, which is what the returned matrices span.
         """
-        s = check_positive(spread, "spread", allow_zero=True)
-        if s >= 1.0:
-            raise InvalidArgumentError("spread", "a relative spread in [0, 1)", repr(s))
+        s = relative_spread(spread)
         check_choice(mode, "mode", ("scalar", "box"))
         if mode == "scalar":
             return [(1.0 + s) * self._inertia, (1.0 - s) * self._inertia]
@@ -254,9 +246,9 @@ class RigidSatellite:
 
     def polytope(
         self,
-        x_op: Any,
-        dt: float,
-        spread: float,
+        x_op: Any = None,
+        dt: float | None = None,
+        spread: float | None = None,
         mode: PolytopeMode = "scalar",
         attitude_range: Any = None,
     ) -> PolytopicModel:
@@ -264,13 +256,15 @@ class RigidSatellite:
 
         Parameters
         ----------
-        x_op : array_like, shape (6,)
-            Operating point of the linearisation (paper P: the initial attitude, zero rates).
+        x_op : array_like, shape (6,), optional
+            Operating point of the linearisation (paper P: the initial attitude, zero rates);
+            default the rest state at zero attitude.
         dt : float
-            Sample time (s) of the zero-order-hold discretisation.
+            Sample time (s) of the zero-order-hold discretisation (required).
         spread : float
-            Relative inertia uncertainty in ``[0, 1)``. Paper P leaves the base level out; the
-            toolkit assumes 0.3, and E5 uses 0.7.
+            Relative inertia uncertainty ``s`` in ``[0, 1)``, ``J in [(1 - s) J, (1 + s) J]``
+            (required). Paper P leaves the base level out; the toolkit assumes 0.3, and E5 uses
+            0.7.
         mode : {"scalar", "box"}
             See :meth:`inertia_vertices`.
         attitude_range : (3,) array_like, optional
@@ -285,7 +279,7 @@ class RigidSatellite:
         PolytopicModel
             One vertex per inertia corner (times the kinematics vertices with
             ``attitude_range``); the nominal model is the linearisation at ``x_op`` with this
-            satellite's own inertia.
+            satellite's own inertia; ``attitude="euler321"``.
 
         Notes
         -----
@@ -314,8 +308,8 @@ class RigidSatellite:
         >>> sat.polytope(x_op, dt=0.01, spread=0.3, attitude_range=np.radians([15, 20, 0])).n_vertices
         18
         """
-        x_op = as_vector(x_op, "x_op", 6)
-        dt = check_positive(dt, "dt")
+        x_op = operating_point(x_op, 6)
+        dt = sample_time(dt)
         if attitude_range is not None:
             return self._covering_polytope(x_op, dt, spread, mode, attitude_range)
         verts = []
@@ -323,7 +317,7 @@ class RigidSatellite:
             verts.append(RigidSatellite(inertia).discretize(x_op, dt))
         nominal = self.discretize(x_op, dt)
         return PolytopicModel(
-            verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES
+            verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES, attitude="euler321"
         )
 
     def _covering_polytope(
@@ -363,7 +357,9 @@ class RigidSatellite:
                 b[3:] = dt * j_inv
                 verts.append((a, b))
         nominal = self.discretize(x_op, dt)
-        return PolytopicModel(verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES)
+        return PolytopicModel(
+            verts, dt, nominal=nominal, state_names=STATE_NAMES, input_names=INPUT_NAMES, attitude="euler321"
+        )
 
     # -- python-control ----------------------------------------------------------------
     def to_nlsys(self, with_disturbance: bool = False) -> Any:

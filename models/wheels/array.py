@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_positive_values, as_vector
 
 __all__ = [
     "PAPER_W_MOMENTUM_MAX",
@@ -42,27 +42,6 @@ RANK_TOL: float = 1e-9
 
 #: Tolerance on ``|D[:, j]| = 1``.
 _UNIT_TOL = 1e-9
-
-
-def _per_wheel(value: Any, name: str, m: int, allow_inf: bool = False) -> np.ndarray:
-    """A scalar (the same for every wheel) or one value per wheel, each > 0 (``inf`` if allowed)."""
-    if isinstance(value, str | bytes | bool):
-        raise ArgumentTypeError(name, "a number or one number per wheel", f"{type(value).__name__} {value!r}")
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ArgumentTypeError(name, "a number or one number per wheel", type(value).__name__) from None
-    if arr.ndim == 0:
-        arr = np.full(m, float(arr))
-    if arr.shape != (m,):
-        raise InvalidArgumentError(
-            name, f"a number or one number per wheel ({m} wheels)", f"shape {arr.shape}"
-        )
-    ok = (arr > 0.0) & (np.isfinite(arr) | (allow_inf & (arr == np.inf)))
-    if not np.all(ok):
-        expected = "limits > 0 (inf for none)" if allow_inf else "finite values > 0"
-        raise InvalidArgumentError(name, expected, repr(arr.tolist()))
-    return arr
 
 
 class WheelArray:
@@ -124,9 +103,10 @@ class WheelArray:
             )
         m = d.shape[1]
         self._d = d
-        self._torque_max = _per_wheel(torque_max, "torque_max", m, allow_inf=True)
-        self._momentum_max = _per_wheel(momentum_max, "momentum_max", m, allow_inf=True)
-        self._wheel_inertia = _per_wheel(wheel_inertia, "wheel_inertia", m)
+        limits = {"allow_inf": True, "per": "wheel", "what": "limits"}
+        self._torque_max = as_positive_values(torque_max, "torque_max", m, **limits)
+        self._momentum_max = as_positive_values(momentum_max, "momentum_max", m, **limits)
+        self._wheel_inertia = as_positive_values(wheel_inertia, "wheel_inertia", m, per="wheel")
         for arr in (self._d, self._torque_max, self._momentum_max, self._wheel_inertia):
             arr.setflags(write=False)
 

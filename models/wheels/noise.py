@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive, check_real
+from toolkit_common.validation import as_positive_values, check_positive, check_real
 
 __all__ = ["ANGLE_NOISE_SIGMA", "AttitudeNoiseSensor", "WheelDisturbance"]
 
@@ -140,13 +140,9 @@ class AttitudeNoiseSensor:
     """
 
     def __init__(self, sigma: Any = ANGLE_NOISE_SIGMA, seed: int | None = 0) -> None:
-        if np.ndim(sigma) == 0:
-            sig = np.full(3, check_positive(sigma, "sigma", allow_zero=True))
-        else:
-            sig = as_vector(sigma, "sigma", 3)
-            if np.any(sig < 0.0):
-                raise InvalidArgumentError("sigma", "standard deviations >= 0", repr(sig.tolist()))
-        self.sigma = sig
+        self.sigma = as_positive_values(
+            sigma, "sigma", 3, allow_zero=True, per="axis", what="standard deviations"
+        )
         self.seed = _check_seed(seed)
         self._rng = np.random.default_rng(self.seed)
 

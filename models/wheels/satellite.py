@@ -33,11 +33,20 @@ from typing import Any, Literal
 import numpy as np
 
 from models.attitude.euler import kinematics_matrix, rotation_matrix
-from models.linear import PolytopicModel, zoh
-from models.rigid.satellite import _as_inertia, skew
+from models.attitude.vectors import skew
+from models.linear import PolytopicModel, sample_time, zoh
+from models.protocols import map_states
+from models.wheels import linear
 from models.wheels.array import WheelArray, _rank
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_choice, check_positive
+from toolkit_common.validation import (
+    as_inertia,
+    as_positive_values,
+    as_vector,
+    check_bool,
+    check_choice,
+    renamed_arguments,
+)
 
 __all__ = [
     "PAPER_W_ATTITUDE_RANGE_DEG",
@@ -62,10 +71,7 @@ PAPER_W_SAMPLE_TIME: float = 0.04
 PAPER_W_ATTITUDE_RANGE_DEG: tuple[float, float, float] = (40.0, 40.0, 180.0)
 
 GravityMode = Literal["pendulous", "inverted", "off"]
-EffectivenessSpec = Literal["single_outage", "box"] | str
 _GRAVITY_SIGN = {"pendulous": 1.0, "inverted": -1.0, "off": 0.0}
-
-STATE_NAMES_6: tuple[str, ...] = ("phi", "theta", "psi", "p", "q", "r")
 
 
 def gravity_direction(phi: float, theta: float) -> np.ndarray:
@@ -73,12 +79,6 @@ def gravity_direction(phi: float, theta: float) -> np.ndarray:
     s_p, c_p = np.sin(phi), np.cos(phi)
     s_t, c_t = np.sin(theta), np.cos(theta)
     return np.array([-s_t, s_p * c_t, c_p * c_t])
-
-
-def _check_bool(value: Any, name: str) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
-    return bool(value)
 
 
 class WheelSatellite:
@@ -102,6 +102,14 @@ class WheelSatellite:
         ``b`` in N m s/rad per wheel (default 0).
     coulomb_friction : float or (m,) array_like
         ``c`` in N m per wheel (default 0).
+
+    Notes
+    -----
+    The satellite follows :class:`models.protocols.Plant`. Its linear model
+    (:mod:`models.wheels.linear`: :meth:`linearize`, :meth:`discretize`, :meth:`linear_model`,
+    :meth:`polytope`) takes the operating point ``x_op`` first, the level attitude at rest
+    (default, and the only point where the model is linearised), and the sample time ``dt``
+    next, as every satellite's does.
 
     Examples
     --------
@@ -130,7 +138,7 @@ class WheelSatellite:
         viscous_friction: Any = 0.0,
         coulomb_friction: Any = 0.0,
     ) -> None:
-        self._inertia = _as_inertia(inertia)
+        self._inertia = as_inertia(inertia)
         if not isinstance(wheels, WheelArray):
             raise ArgumentTypeError("wheels", "a models.WheelArray", type(wheels).__name__)
         self._wheels = wheels
@@ -141,32 +149,16 @@ class WheelSatellite:
         self._imbalance = imb
         self._gravity = check_choice(gravity, "gravity", tuple(_GRAVITY_SIGN))
         self._sign = _GRAVITY_SIGN[gravity]
-        self._gyroscopic = _check_bool(wheel_gyroscopic, "wheel_gyroscopic")
+        self._gyroscopic = check_bool(wheel_gyroscopic, "wheel_gyroscopic")
         m = wheels.n_wheels
-        self._viscous = self._friction(viscous_friction, "viscous_friction", m)
-        self._coulomb = self._friction(coulomb_friction, "coulomb_friction", m)
+        friction = {"allow_zero": True, "per": "wheel", "what": "friction coefficients"}
+        self._viscous = as_positive_values(viscous_friction, "viscous_friction", m, **friction)
+        self._coulomb = as_positive_values(coulomb_friction, "coulomb_friction", m, **friction)
         self._inertia_inv = np.linalg.inv(self._inertia)
         self._g2 = self._inertia_inv @ wheels.D
-        for arr in (
-            self._inertia,
-            self._inertia_inv,
-            self._imbalance,
-            self._viscous,
-            self._coulomb,
-            self._g2,
-        ):
+        for arr in (self._inertia, self._inertia_inv, self._imbalance, self._viscous, self._coulomb):
             arr.setflags(write=False)
-
-    @staticmethod
-    def _friction(value: Any, name: str, m: int) -> np.ndarray:
-        vec = (
-            np.full(m, check_positive(value, name, allow_zero=True))
-            if np.ndim(value) == 0
-            else as_vector(value, name, m)
-        )
-        if np.any(vec < 0.0):
-            raise InvalidArgumentError(name, "friction coefficients >= 0", repr(vec.tolist()))
-        return vec
+        self._g2.setflags(write=False)
 
     @classmethod
     def paper_w(cls, gravity: GravityMode = "pendulous", **options: Any) -> WheelSatellite:
@@ -212,6 +204,16 @@ class WheelSatellite:
     def n_inputs(self) -> int:
         """``m`` wheel torques."""
         return self.n_wheels
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """``phi, theta, psi, p, q, r, h1..hm``."""
+        return (*linear.LINEAR_STATE_NAMES, *(f"h{j + 1}" for j in range(self.n_wheels)))
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """``u1..um``: the wheel torques."""
+        return tuple(f"u{j + 1}" for j in range(self.n_wheels))
 
     @property
     def inertia(self) -> np.ndarray:
@@ -311,6 +313,14 @@ class WheelSatellite:
         eta_dot = kinematics_matrix(x[0], x[1]) @ w
         return np.concatenate((eta_dot, self._inertia_inv @ torque, -wheel_torque))
 
+    def attitude_euler(self, x: Any) -> np.ndarray:
+        """Roll, pitch and yaw (rad, 3-2-1) of the platform relative to the level frame: ``x[:3]``.
+
+        The level frame is the reference of the state's Euler angles (z down along gravity).
+        ``x`` is one state or states as rows; see :class:`models.protocols.Plant`.
+        """
+        return map_states(lambda s: s[:3].copy(), x, self.n_states)
+
     def angular_momentum_body(self, x: Any) -> np.ndarray:
         """Total angular momentum in body axes, ``J w + D h`` (N m s)."""
         x = as_vector(x, "x", self.n_states)
@@ -328,36 +338,38 @@ class WheelSatellite:
         return -self._sign * skew(self._imbalance) @ dk
 
     def linearize(
-        self, effectiveness: Any = None, inertia_scale: float = 1.0
+        self, x_op: Any = None, effectiveness: Any = None, inertia_scale: float = 1.0
     ) -> tuple[np.ndarray, np.ndarray]:
         """Continuous ``(A, B)`` of the attitude and rates at level attitude, zero rates and momenta.
 
         Seed section 8: ``A = [[0, I3], [-J^-1 K_g, 0]]``, ``B = [0; J^-1 D Lambda]`` with
         ``Lambda = diag(effectiveness)`` (default all wheels healthy) and ``J`` scaled by
-        ``inertia_scale``. The wheel momenta do not enter the attitude (``h' = -u`` is left
-        out; it is the plant's business, through the momentum limit).
+        ``inertia_scale`` (one multiplier, a point). The wheel momenta do not enter the attitude
+        (``h' = -u`` is left out; it is the plant's business, through the momentum limit).
+
+        ``x_op`` = ``[phi, theta, psi, p, q, r]`` is the level attitude at rest (default zero; any
+        yaw); any other point is an error naming ``x_op``.
         """
-        s = check_positive(inertia_scale, "inertia_scale")
-        lam = (
-            np.ones(self.n_wheels)
-            if effectiveness is None
-            else as_vector(effectiveness, "effectiveness", self.n_wheels)
+        return linear.linearize(
+            self._wheels, self._inertia_inv, self.gravity_stiffness(), x_op, effectiveness, inertia_scale
         )
-        d_lam = self._wheels.effective_matrix(lam)
-        j_inv = self._inertia_inv / s
-        a = np.zeros((6, 6))
-        a[:3, 3:] = np.eye(3)
-        a[3:, :3] = -j_inv @ self.gravity_stiffness()
-        b = np.zeros((6, self.n_wheels))
-        b[3:, :] = j_inv @ d_lam
-        return a, b
 
     def discretize(
-        self, dt: float, effectiveness: Any = None, inertia_scale: float = 1.0
+        self, x_op: Any = None, dt: float | None = None, effectiveness: Any = None, inertia_scale: float = 1.0
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt``."""
-        a, b = self.linearize(effectiveness, inertia_scale)
-        return zoh(a, b, check_positive(dt, "dt"))
+        """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
+        a, b = self.linearize(x_op, effectiveness, inertia_scale)
+        return zoh(a, b, sample_time(dt))
+
+    def linear_model(
+        self, x_op: Any = None, dt: float | None = None, effectiveness: Any = None, inertia_scale: float = 1.0
+    ) -> PolytopicModel:
+        """:meth:`discretize` as a one-vertex :class:`PolytopicModel` (Euler attitude, ``m`` wheel inputs)."""
+        ad, bd = self.discretize(x_op, dt, effectiveness, inertia_scale)
+        return PolytopicModel(
+            [(ad, bd)], dt, state_names=linear.LINEAR_STATE_NAMES, input_names=self.input_names,
+            attitude="euler321",
+        )
 
     def effectiveness_vertices(
         self, effectiveness: Any = "single_outage", lambda_min: float = 0.2
@@ -374,54 +386,40 @@ class WheelSatellite:
         lambda_min : float
             Lower corner of the box, in ``[0, 1)`` (default 0.2, **assumed**).
         """
-        m = self.n_wheels
-        if isinstance(effectiveness, str):
-            check_choice(effectiveness, "effectiveness", ("single_outage", "box"))
-            if effectiveness == "single_outage":
-                return np.vstack((np.ones(m), 1.0 - np.eye(m)))
-            lo = check_positive(lambda_min, "lambda_min", allow_zero=True)
-            if lo >= 1.0:
-                raise InvalidArgumentError("lambda_min", "a lower corner in [0, 1)", repr(lambda_min))
-            grid = np.array(np.meshgrid(*([[1.0, lo]] * m), indexing="ij")).reshape(m, -1).T
-            return grid
-        verts = np.array(effectiveness, dtype=float) if not isinstance(effectiveness, bytes) else None
-        if verts is None or verts.ndim != 2 or verts.shape[1] != m or verts.shape[0] == 0:
-            raise InvalidArgumentError(
-                "effectiveness",
-                f"'single_outage', 'box' or a (k, {m}) array of vertices",
-                repr(effectiveness),
-            )
-        for i, row in enumerate(verts):
-            if not np.all(np.isfinite(row)) or np.any((row < 0.0) | (row > 1.0)):
-                raise InvalidArgumentError(f"effectiveness[{i}]", "values in [0, 1]", repr(row.tolist()))
-        return verts
+        return linear.effectiveness_vertices(self.n_wheels, effectiveness, lambda_min)
 
+    @renamed_arguments(inertia_spread="spread")
     def polytope(
         self,
-        dt: float = PAPER_W_SAMPLE_TIME,
+        x_op: Any = None,
+        dt: float | None = None,
         effectiveness: Any = "single_outage",
         *,
         lambda_min: float = 0.2,
-        inertia_spread: float | None = None,
+        spread: float | None = None,
     ) -> PolytopicModel:
         """The wheel-effectiveness polytope of the linear model (seed section 8).
 
         Parameters
         ----------
+        x_op : (6,) array_like, optional
+            The level attitude at rest, as in :meth:`linearize` (default zero).
         dt : float
-            Sample time of the zero-order hold (default 0.04 s, paper W's loop).
+            Sample time of the zero-order hold (required; paper W's loop: 0.04 s,
+            :data:`PAPER_W_SAMPLE_TIME`).
         effectiveness, lambda_min
             The effectiveness vertices, see :meth:`effectiveness_vertices`.
-        inertia_spread : float, optional
-            Relative inertia error ``s`` in ``[0, 1)``: the product with the scalar inertia
-            polytope ``J in {(1 + s) J, (1 - s) J}`` (S4: 0.2, 2 x 5 = 10 vertices).
+        spread : float, optional
+            Relative inertia uncertainty ``s`` in ``[0, 1)``, ``J in [(1 - s) J, (1 + s) J]``:
+            the product with the scalar inertia polytope ``J in {(1 + s) J, (1 - s) J}`` (S4:
+            0.2, 2 x 5 = 10 vertices). ``None`` (default): the nominal inertia only.
 
         Returns
         -------
         PolytopicModel
-            ``x = [phi, theta, psi, p, q, r]``, ``m`` wheel-torque inputs; vertices ordered
-            inertia scale first (``1 + s``, then ``1 - s``), effectiveness inside; the nominal
-            model is the healthy array at the nominal inertia.
+            ``x = [phi, theta, psi, p, q, r]`` (``attitude="euler321"``), ``m`` wheel-torque
+            inputs; vertices ordered inertia scale first (``1 + s``, then ``1 - s``),
+            effectiveness inside; the nominal model is the healthy array at the nominal inertia.
 
         Raises
         ------
@@ -433,29 +431,8 @@ class WheelSatellite:
 
         Notes
         -----
-        ``B`` is linear in ``Lambda`` and the zero-order hold at a fixed ``A`` is linear in
-        ``B``, so the effectiveness vertices are exact. ``A`` and ``B`` are also affine in
-        ``J^-1``, but the hold is not linear in ``A``: with ``inertia_spread`` the vertex
-        products cover the continuous-time set, and their discretisations approximate the
-        discrete one.
+        The effectiveness vertices are exact; with ``spread`` they approximate the discrete set
+        (see :mod:`models.wheels.linear`).
         """
-        dt = check_positive(dt, "dt")
-        lam = self.effectiveness_vertices(effectiveness, lambda_min)
-        for i, row in enumerate(lam):
-            rank = _rank(self._wheels.D * row)
-            if rank < 3:
-                raise InvalidArgumentError(
-                    "effectiveness",
-                    "vertices whose healthy wheels span three axes (B != 0, rank(D Lambda) = 3)",
-                    f"vertex {i} (lambda = {row.tolist()}) with rank(D Lambda) = {rank}",
-                )
-        scales = [1.0]
-        if inertia_spread is not None:
-            s = check_positive(inertia_spread, "inertia_spread", allow_zero=True)
-            if s >= 1.0:
-                raise InvalidArgumentError("inertia_spread", "a relative spread in [0, 1)", repr(s))
-            scales = [1.0 + s, 1.0 - s]
-        verts = [self.discretize(dt, row, scale) for scale in scales for row in lam]
-        nominal = self.discretize(dt)
-        names = tuple(f"u{j + 1}" for j in range(self.n_wheels))
-        return PolytopicModel(verts, dt, nominal=nominal, state_names=STATE_NAMES_6, input_names=names)
+        platform = (self._wheels, self._inertia_inv, self.gravity_stiffness())
+        return linear.wheel_polytope(*platform, x_op, dt, effectiveness, lambda_min, spread)

@@ -29,14 +29,9 @@ from models.wheels.array import WheelArray
 from models.wheels.faults import FaultSchedule, WheelFault, _as_schedule
 from models.wheels.noise import WheelDisturbance
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import check_bool
 
 __all__ = ["WheelInputStage"]
-
-
-def _check_bool(value: Any, name: str) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
-    return bool(value)
 
 
 class WheelInputStage:
@@ -96,8 +91,8 @@ class WheelInputStage:
                     f"{wheel_disturbance.n_wheels} wheels",
                 )
         self.wheel_disturbance = wheel_disturbance
-        self.torque_limit = _check_bool(torque_limit, "torque_limit")
-        self.momentum_limit = _check_bool(momentum_limit, "momentum_limit")
+        self.torque_limit = check_bool(torque_limit, "torque_limit")
+        self.momentum_limit = check_bool(momentum_limit, "momentum_limit")
         if (
             isinstance(momentum_index, bool)
             or not isinstance(momentum_index, int | np.integer)

@@ -43,8 +43,8 @@ import numpy as np
 
 from lmi import LMISolution
 from rmpc.mpc.mras import ParameterIntegrator, SensitivityFilter
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_positive
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_bool, check_positive
 
 __all__ = [
     "DEFAULT_ALPHA",
@@ -360,10 +360,7 @@ class MITRule(AdaptationRule):
         reference_gain: Any = None,
         error_output: Any = None,
     ) -> None:
-        if not isinstance(normalized, bool | np.bool_):
-            found = f"{type(normalized).__name__} {normalized!r}"
-            raise ArgumentTypeError("normalized", "True or False", found)
-        self.normalized = bool(normalized)
+        self.normalized = check_bool(normalized, "normalized")
         self.alpha = check_positive(alpha, "alpha")
         self.gain = check_positive(gain, "gain", allow_zero=True)
         self.reset_period = None if reset_period is None else check_positive(reset_period, "reset_period")

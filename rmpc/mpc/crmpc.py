@@ -55,10 +55,9 @@ from lmi.data import input_bound_vector
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
 from rmpc.mpc.adaptation import AdaptationRule, LyapunovRule
-from rmpc.mpc.mras import projection_bound
 from rmpc.mpc.robust_mpc import RMPC, input_constraint_kind
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_choice
+from toolkit_common.validation import as_optional_limits, as_vector, check_choice
 
 __all__ = ["CRMPC"]
 
@@ -227,7 +226,7 @@ class CRMPC:
             if self.u_max is None:
                 return None
             return DEFAULT_THETA_FRACTION * np.broadcast_to(self.u_max, (m,)).copy()
-        bound = projection_bound(value, "theta_bound", m)
+        bound = as_optional_limits(value, "theta_bound", m, per="input")
         if self.torque_budget != "none":
             if bound is None:
                 raise InvalidArgumentError(

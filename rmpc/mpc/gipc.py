@@ -47,7 +47,12 @@ from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.qp import QP, QPBackend, make_backend
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_pd, check_psd, check_real
+from toolkit_common.validation import (
+    as_matrix,
+    as_optional_limits,
+    as_square_matrix,
+    as_vector,
+)
 
 __all__ = ["GIPC", "prediction_matrices", "velocity_form"]
 
@@ -93,33 +98,6 @@ def prediction_matrices(
         for i in range(j, n_p):
             phi[i * q:(i + 1) * q, j * m:(j + 1) * m] = markov[i - j]
     return f, phi
-
-
-def _weight(value: Any, name: str, size: int, definite: bool) -> np.ndarray:
-    """A weight given as a scalar, a diagonal (vector) or a full matrix."""
-    arr = np.asarray(value, dtype=float) if not isinstance(value, str | bytes) else None
-    if arr is None:
-        raise ArgumentTypeError(name, "a number, a vector or a matrix", type(value).__name__)
-    if arr.ndim == 0:
-        mat = check_real(float(arr), name) * np.eye(size)
-    elif arr.ndim == 1:
-        mat = np.diag(as_vector(arr, name, size))
-    else:
-        mat = as_matrix(arr, name, (size, size))
-    return check_pd(mat, name) if definite else check_psd(mat, name)
-
-
-def _limit(value: Any, name: str, size: int) -> np.ndarray | None:
-    """``None`` (no bound) or a positive bound per input (a scalar is broadcast)."""
-    if value is None:
-        return None
-    if isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool):
-        arr = np.full(size, check_real(value, name))
-    else:
-        arr = as_vector(value, name, size)
-    if np.any(arr <= 0):
-        raise InvalidArgumentError(name, "positive bounds (or None for no bound)", f"{arr.tolist()}")
-    return arr
 
 
 def _horizon(value: Any, name: str, upper: int | None = None) -> int:
@@ -237,10 +215,10 @@ class GIPC:
             c = as_matrix(C, "C", (None, n))
         q = c.shape[0]
         self.C = c
-        self.Qy = _weight(Qy, "Qy", q, definite=False)
-        self.R_du = _weight(R_du, "R_du", m, definite=True)
-        self.u_max = _limit(u_max, "u_max", m)
-        self.du_max = _limit(du_max, "du_max", m)
+        self.Qy = as_square_matrix(Qy, "Qy", q, allow_zero=True, definite="psd")
+        self.R_du = as_square_matrix(R_du, "R_du", m)
+        self.u_max = as_optional_limits(u_max, "u_max", m, per="input")
+        self.du_max = as_optional_limits(du_max, "du_max", m, per="input")
         self.x_ref = np.zeros(n) if x_ref is None else as_vector(x_ref, "x_ref", n)
         self.u0 = np.zeros(m) if u0 is None else as_vector(u0, "u0", m)
         if self.u_max is not None and np.any(np.abs(self.u0) > self.u_max):

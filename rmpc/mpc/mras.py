@@ -14,22 +14,9 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_positive, check_real
+from toolkit_common.validation import as_matrix, as_optional_limits, as_vector, check_positive, check_real
 
-__all__ = ["ParameterIntegrator", "SensitivityFilter", "projection_bound"]
-
-
-def projection_bound(value: Any, name: str, size: int) -> np.ndarray | None:
-    """``None`` or positive bounds, one per parameter (a scalar is broadcast); errors name ``name``."""
-    if value is None:
-        return None
-    if np.ndim(value) == 0:
-        arr = np.full(size, check_real(value, name))
-    else:
-        arr = as_vector(value, name, size)
-    if np.any(arr <= 0.0):
-        raise InvalidArgumentError(name, "positive bounds (or None)", repr(arr.tolist()))
-    return arr
+__all__ = ["ParameterIntegrator", "SensitivityFilter"]
 
 
 class ParameterIntegrator:
@@ -62,7 +49,7 @@ class ParameterIntegrator:
         self.dt = check_positive(dt, "dt")
         n_p = self.n_params
         self.theta0 = np.zeros(n_p) if theta0 is None else as_vector(theta0, "theta0", n_p)
-        self.bound = projection_bound(bound, "bound", self.n_params)
+        self.bound = as_optional_limits(bound, "bound", self.n_params, per="parameter")
         if self.bound is not None and np.any(np.abs(self.theta0) > self.bound):
             raise InvalidArgumentError(
                 "theta0", f"|theta0_i| <= bound_i = {self.bound.tolist()}", repr(self.theta0.tolist())

@@ -22,7 +22,7 @@ from lmi.status import INFEASIBLE, OPTIMAL
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
+from toolkit_common.validation import as_matrix, as_vector, check_bool, check_choice, check_positive
 
 if TYPE_CHECKING:  # lmi.offline imports cvxpy (~0.5 s); it is imported when a controller is built
     from lmi.offline import OfflineTable
@@ -135,7 +135,7 @@ class OfflineRMPC:
             raise InvalidArgumentError("n_ellipsoids", "a positive integer", repr(n_ellipsoids))
         if not check_positive(shrink, "shrink") < 1.0:
             raise InvalidArgumentError("shrink", "a number in (0, 1)", repr(shrink))
-        _check_bool(interpolate, "interpolate")
+        check_bool(interpolate, "interpolate")
         self.path = check_choice(path, "path", ("ray", "trajectory"))
         self.plant = plant
         from lmi.offline import NestedKothareProblem
@@ -169,7 +169,7 @@ class OfflineRMPC:
 
     @interpolate.setter
     def interpolate(self, value: bool) -> None:
-        self._interpolate = _check_bool(value, "interpolate")
+        self._interpolate = check_bool(value, "interpolate")
         if self.table is not None:
             self._store(self.table)
 
@@ -293,8 +293,3 @@ class OfflineRMPC:
         )
         return u
 
-
-def _check_bool(value: Any, name: str) -> bool:
-    if not isinstance(value, bool):
-        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
-    return value

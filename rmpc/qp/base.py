@@ -20,6 +20,7 @@ import numpy as np
 from rmpc.qp.problem import QP, QPResult, SolverResiduals
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
 from toolkit_common.status import Status
+from toolkit_common.validation import check_bool
 
 __all__ = ["BackendSettings", "QPBackend"]
 
@@ -54,8 +55,7 @@ class BackendSettings:
                 raise InvalidArgumentError(f"{label}.{name}", "a positive integer", repr(value))
         for name in self._FLAGS:
             value = getattr(self, name)
-            if not isinstance(value, bool):
-                raise ArgumentTypeError(f"{label}.{name}", "True or False", repr(value))
+            check_bool(value, f"{label}.{name}")
         for name, options in self._CHOICES.items():
             value = getattr(self, name)
             if value not in options:

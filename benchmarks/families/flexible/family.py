@@ -56,7 +56,15 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import CaseResult, Field, PlantFamily, check_choice, check_real, controller_specs
+from benchmarks.core.family import (
+    CaseResult,
+    Field,
+    PlantFamily,
+    check_bool,
+    check_choice,
+    check_real,
+    controller_specs,
+)
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import CONSTRAINED, CONTROLLERS, FlexibleModel, settings_check
@@ -80,19 +88,13 @@ def _optional_angle(value: Any, where: str) -> float | None:
     return None if value is None else check_real(value, where, low=0.0, high=180.0)
 
 
-def _bool(value: Any, where: str) -> bool:
-    if not isinstance(value, bool):
-        raise ConfigError(where, "true or false", repr(value))
-    return value
-
-
 FIELDS: Mapping[str, Field] = {
     "plant": Field("flexible", lambda v, w: check_choice(v, w, ("flexible",))),
     "experiment": Field("vslew", lambda v, w: check_choice(v, w, tuple(defaults.EXPERIMENT_ANGLES))),
     "angle_deg": Field(None, _optional_angle),
     "saturation": Field("limiter", lambda v, w: check_choice(v, w, ("none", "limiter", "constraint"))),
     "u_max": Field(defaults.U_MAX, _positive),
-    "avc": Field(False, _bool),
+    "avc": Field(False, check_bool),
     "switch": Field("tanh", lambda v, w: check_choice(v, w, ("tanh", "sign"))),
     "epsilon": Field(0.01, _positive),
     "integral_gain": Field(0.0, lambda v, w: check_real(v, w, low=0.0)),
@@ -171,12 +173,9 @@ def paper_scenario(scenario: Any) -> Any:
 
 
 def _polytope(sat: Any, dt: float, kind: str) -> Any:
-    from models import PolytopicModel
-
     if kind == "nominal":
-        a, b = sat.discretize(dt, attitude="quaternion")
-        return PolytopicModel([(a, b)], dt)
-    return sat.polytope(dt, attitude="quaternion", mode=kind)
+        return sat.linear_model(dt=dt, attitude="quaternion")
+    return sat.polytope(dt=dt, attitude="quaternion", mode=kind)
 
 
 def _design_state(sat: Any, case: Any) -> np.ndarray:
@@ -203,7 +202,7 @@ def _bandwidth(scenario: Any, settings: Mapping[str, Any], sat: Any, gain: np.nd
         return float(np.abs(np.linalg.eigvals(a)).max())
     if gain is None:
         return None
-    a, b = sat.discretize(scenario.dt, attitude="quaternion")
+    a, b = sat.discretize(dt=scenario.dt, attitude="quaternion")
     z = np.linalg.eigvals(a[:6, :6] + b[:6] @ np.asarray(gain)[:, :6])
     return float(np.abs(np.log(z.astype(complex))).max() / scenario.dt)
 

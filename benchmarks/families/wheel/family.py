@@ -232,7 +232,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     spread = scenario.inertia_spread
     if spread is None and scale != 1.0:
         spread = 0.2
-    poly = nominal.polytope(scenario.dt, inertia_spread=spread)
+    poly = nominal.polytope(dt=scenario.dt, spread=spread)
     built = CONTROLLERS[scenario.controller](WheelModel(nominal, poly), scenario, settings)
     n = nominal.n_wheels
     schedule = FaultSchedule(case_faults(scenario), n, duration)

@@ -24,11 +24,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import FlexibleSatellite
-from models.attitude.quaternion import cross3
+from models.attitude.vectors import cross3
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms, gain_matrix
-from toolkit_common.errors import ArgumentTypeError
-from toolkit_common.validation import check_positive
+from toolkit_common.validation import check_bool, check_positive
 
 __all__ = ["AttitudePD"]
 
@@ -83,9 +82,7 @@ class AttitudePD:
         self.dt = check_positive(dt, "dt")
         self.K_p = gain_matrix(K_p, "K_p")
         self.K_d = gain_matrix(K_d, "K_d")
-        if not isinstance(disturbance_observer, bool):
-            raise ArgumentTypeError("disturbance_observer", "a bool", type(disturbance_observer).__name__)
-        self.disturbance_observer = disturbance_observer
+        self.disturbance_observer = check_bool(disturbance_observer, "disturbance_observer")
         self.L_o = check_positive(L_o, "L_o")
         self.u_max = None if u_max is None else check_positive(u_max, "u_max")
         self.name: str = "PD-DOB" if disturbance_observer else "PD"

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from models import FlexibleSatellite, PolytopicModel
+from models import FlexibleSatellite
 from rmpc.mpc.lqr import LQR
 from rmpc.wrappers import MappedController
 from toolkit_common.errors import ArgumentTypeError
@@ -64,8 +64,7 @@ def flexible_lqr(
         raise ArgumentTypeError("plant", "a models.FlexibleSatellite", type(plant).__name__)
     dt = check_positive(dt, "dt")
     n = plant.n_linear_states
-    a, b = plant.discretize(dt, attitude="quaternion")
-    model = PolytopicModel([(a, b)], dt)
+    model = plant.linear_model(dt=dt, attitude="quaternion")
     if Q is None:
         Q = np.zeros((n, n))
         Q[:3, :3] = 4.0 * np.eye(3)

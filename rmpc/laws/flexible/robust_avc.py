@@ -33,25 +33,13 @@ import numpy as np
 from models import FlexibleSatellite
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.laws.flexible.terms import FlexibleTerms
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_positive_values, as_vector, check_positive
 
 __all__ = ["RobustAVC"]
 
 #: Condition number of ``Gamma_a`` above which it is taken as not invertible.
 PZT_COND_MAX = 1e12
-
-
-def _modal_gain(value: Any, name: str, n: int) -> np.ndarray:
-    """A diagonal gain given as a scalar or ``n`` values (> 0), returned as ``n`` values."""
-    if isinstance(value, str | bytes):
-        raise ArgumentTypeError(name, f"a scalar or {n} values", type(value).__name__)
-    if np.ndim(value) == 0:
-        return np.full(n, check_positive(value, name))
-    vec = as_vector(value, name, n)
-    if np.any(vec <= 0.0):
-        raise InvalidArgumentError(name, "values > 0", repr(vec.tolist()))
-    return vec
 
 
 class RobustAVC:
@@ -109,8 +97,8 @@ class RobustAVC:
         if n == 0:
             raise InvalidArgumentError("plant", "a satellite with flexible modes", "n_modes = 0")
         self.dt = check_positive(dt, "dt")
-        self.Lam = _modal_gain(Lam, "Lam", n)
-        self.K_v = _modal_gain(K_v, "K_v", n)
+        self.Lam = as_positive_values(Lam, "Lam", n, per="mode")
+        self.K_v = as_positive_values(K_v, "K_v", n, per="mode")
         self.b0 = check_positive(b0, "b0", allow_zero=True)
         self.b1 = check_positive(b1, "b1", allow_zero=True)
         self.b2 = check_positive(b2, "b2", allow_zero=True)

@@ -19,9 +19,10 @@ from typing import Any, Literal
 import numpy as np
 
 from models import FlexibleSatellite
-from models.attitude.quaternion import cross3, quat_error, unit_quaternion
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_choice, check_positive
+from models.attitude.quaternion import quat_error, unit_quaternion
+from models.attitude.vectors import cross3
+from toolkit_common.errors import ArgumentTypeError
+from toolkit_common.validation import as_square_matrix, as_vector, check_bool, check_choice
 
 __all__ = ["AttitudeError", "FlexibleTerms", "SwitchKind", "gain_matrix", "switching"]
 
@@ -36,21 +37,12 @@ def switching(sigma: np.ndarray, eps: float, kind: SwitchKind) -> np.ndarray:
 
 
 def gain_matrix(value: Any, name: str) -> np.ndarray:
-    """A gain given as a scalar, three per-axis values or a 3 x 3 matrix, returned as 3 x 3."""
-    arr = np.asarray(value, dtype=float) if not isinstance(value, str | bytes) else None
-    if arr is None or arr.ndim > 2:
-        raise ArgumentTypeError(name, "a scalar, 3 values or a 3 x 3 matrix", type(value).__name__)
-    if arr.ndim == 0:
-        mat = check_positive(float(arr), name, allow_zero=True) * np.eye(3)
-    elif arr.ndim == 1:
-        vec = as_vector(arr, name, 3)
-        if np.any(vec < 0.0):
-            raise InvalidArgumentError(name, "gains >= 0", repr(vec.tolist()))
-        mat = np.diag(vec)
-    else:
-        if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
-            raise InvalidArgumentError(name, "a finite 3 x 3 matrix", f"shape {arr.shape}")
-        mat = arr.copy()
+    """A gain of the flexible laws as a read-only 3 x 3 matrix: a scalar, 3 per-axis values or in full.
+
+    The scalar and the per-axis values are >= 0; a full matrix is taken as given (finite).
+    One reading, :func:`toolkit_common.validation.as_square_matrix`, with the flexible laws' options.
+    """
+    mat = as_square_matrix(value, name, 3, allow_zero=True, definite=None, entries="gains")
     mat.setflags(write=False)
     return mat
 
@@ -94,11 +86,9 @@ class FlexibleTerms:
     def __init__(self, plant: FlexibleSatellite, q_ref: Any = None, flex_feedforward: bool = True) -> None:
         if not isinstance(plant, FlexibleSatellite):
             raise ArgumentTypeError("plant", "a models.FlexibleSatellite", type(plant).__name__)
-        if not isinstance(flex_feedforward, bool):
-            raise ArgumentTypeError("flex_feedforward", "a bool", type(flex_feedforward).__name__)
         self.plant = plant
         self.q_ref = np.array([1.0, 0.0, 0.0, 0.0]) if q_ref is None else unit_quaternion(q_ref, "q_ref")
-        self.flex_feedforward = flex_feedforward
+        self.flex_feedforward = check_bool(flex_feedforward, "flex_feedforward")
         self.n_modes = plant.n_modes
         self.n_pzt = plant.n_pzt
         self.inertia = plant.inertia

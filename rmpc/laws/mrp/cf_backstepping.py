@@ -29,8 +29,9 @@ from typing import Any
 import numpy as np
 
 from models import MRPSatellite
+from models.attitude.vectors import cross3
 from models.mrp.tracking import MRPTrackingError, tracking_error
-from rmpc.laws.continuous import ContinuousTimeController, LawOutput, cross3
+from rmpc.laws.continuous import ContinuousTimeController, LawOutput
 from rmpc.laws.mrp.command_filter import CommandFilter
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive

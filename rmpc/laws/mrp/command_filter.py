@@ -28,22 +28,9 @@ import numpy as np
 
 from rmpc.controller import StepInfo
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive
+from toolkit_common.validation import as_optional_limits, as_vector, check_positive
 
 __all__ = ["CommandFilter"]
-
-
-def _limit(value: Any, name: str, size: int) -> np.ndarray | None:
-    """``None`` or a positive per-component limit (a scalar is broadcast)."""
-    if value is None:
-        return None
-    arr = np.asarray(value, dtype=float) if not isinstance(value, str | bytes) else None
-    if arr is not None and arr.ndim == 0:
-        return np.full(size, check_positive(float(arr), name))
-    vec = as_vector(value, name, size)
-    if np.any(vec <= 0.0):
-        raise InvalidArgumentError(name, "None or limits > 0", repr(vec.tolist()))
-    return vec
 
 
 class CommandFilter:
@@ -97,8 +84,8 @@ class CommandFilter:
         if isinstance(size, bool) or not isinstance(size, int | np.integer) or size < 1:
             raise InvalidArgumentError("size", "a positive integer", repr(size))
         self.size = int(size)
-        self.magnitude_limit = _limit(magnitude_limit, "magnitude_limit", self.size)
-        self.rate_limit = _limit(rate_limit, "rate_limit", self.size)
+        self.magnitude_limit = as_optional_limits(magnitude_limit, "magnitude_limit", self.size)
+        self.rate_limit = as_optional_limits(rate_limit, "rate_limit", self.size)
         self.dt = check_positive(dt, "dt")
         self._state: np.ndarray | None = None
         self.last: StepInfo | None = None

@@ -37,9 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from rmpc.laws.continuous import cross3, model_inertia
+from models.attitude.vectors import cross3
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive
+from toolkit_common.validation import as_inertia, as_positive_values, as_vector, check_positive
 
 __all__ = ["NESO", "fal"]
 
@@ -79,16 +79,6 @@ def fal(e: Any, alpha: float, delta: float) -> np.ndarray:
 def _fal(e: np.ndarray, alpha: float, delta: float) -> np.ndarray:
     abs_e = np.abs(e)
     return np.where(abs_e > delta, np.sign(e) * abs_e**alpha, e / delta ** (1.0 - alpha))
-
-
-def _gain(value: Any, name: str) -> np.ndarray:
-    arr = np.asarray(value, dtype=float) if not isinstance(value, str | bytes) else None
-    if arr is not None and arr.ndim == 0:
-        return np.full(3, check_positive(float(arr), name))
-    vec = as_vector(value, name, 3)
-    if np.any(vec <= 0.0):
-        raise InvalidArgumentError(name, "values > 0 (a scalar or one per axis)", repr(vec.tolist()))
-    return vec
 
 
 class NESO:
@@ -133,14 +123,14 @@ class NESO:
         delta: float = 0.01,
         bound: Any = 0.05,
     ) -> None:
-        self._inertia = model_inertia(inertia)
+        self._inertia = as_inertia(inertia)
         self._inertia_inv = np.linalg.inv(self._inertia)
-        self.gain1 = _gain(gain1, "gain1")
-        self.gain2 = _gain(gain2, "gain2")
+        self.gain1 = as_positive_values(gain1, "gain1", 3, per="axis")
+        self.gain2 = as_positive_values(gain2, "gain2", 3, per="axis")
         self.alpha1 = _exponent(alpha1, "alpha1")
         self.alpha2 = _exponent(alpha2, "alpha2")
         self.delta = check_positive(delta, "delta")
-        self.bound = _gain(bound, "bound")
+        self.bound = as_positive_values(bound, "bound", 3, per="axis")
         self.bandwidth: float | None = None
         for arr in (self._inertia, self._inertia_inv, self.gain1, self.gain2, self.bound):
             arr.setflags(write=False)

@@ -23,10 +23,11 @@ from typing import Any
 import numpy as np
 
 from models import MRPSatellite
+from models.attitude.vectors import cross3
 from models.mrp.tracking import MRPTrackingError, tracking_error
-from rmpc.laws.continuous import ContinuousTimeController, LawOutput, cross3
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_vector, check_positive
+from rmpc.laws.continuous import ContinuousTimeController, LawOutput
+from toolkit_common.errors import ArgumentTypeError
+from toolkit_common.validation import as_positive_values, as_vector, check_positive
 
 __all__ = ["TuningFunctionAB"]
 
@@ -92,13 +93,7 @@ class TuningFunctionAB(ContinuousTimeController):
         self.target.setflags(write=False)
         self.c1 = check_positive(c1, "c1")
         self.c2 = check_positive(c2, "c2")
-        if not isinstance(gamma, str | bytes) and np.ndim(gamma) == 0:
-            self.gamma = np.full(3, check_positive(gamma, "gamma"))
-        else:
-            self.gamma = as_vector(gamma, "gamma", 3)
-            if np.any(self.gamma <= 0.0):
-                found = repr(self.gamma.tolist())
-                raise InvalidArgumentError("gamma", "a gain > 0 (a scalar or one per axis)", found)
+        self.gamma = as_positive_values(gamma, "gamma", 3, per="axis", what="gains")
         self.gamma.setflags(write=False)
         self.n_internal = 3
 

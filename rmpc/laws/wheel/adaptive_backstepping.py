@@ -54,7 +54,13 @@ from models.attitude.euler import kinematics_matrix
 from models.attitude.euler_inverse import inverse_kinematics_matrix, inverse_kinematics_rate
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_vector, check_pd, check_positive
+from toolkit_common.validation import (
+    as_matrix,
+    as_square_matrix,
+    as_vector,
+    check_bool,
+    check_positive,
+)
 
 __all__ = ["ABFTCRates", "AdaptiveBacksteppingFTC", "wrap_angle"]
 
@@ -95,19 +101,6 @@ class ABFTCRates:
     alpha1: np.ndarray
     alpha1_dot: np.ndarray
     f2: np.ndarray
-
-
-def _gain_matrix(value: Any, name: str) -> np.ndarray:
-    """A scalar ``g`` (meaning ``g I3``) or a 3 x 3 symmetric positive definite matrix."""
-    if np.ndim(value) == 0:
-        return check_positive(value, name) * np.eye(3)
-    return check_pd(as_matrix(value, name, (3, 3)), name)
-
-
-def _check_bool(value: Any, name: str) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
-    return bool(value)
 
 
 class AdaptiveBacksteppingFTC:
@@ -202,11 +195,13 @@ class AdaptiveBacksteppingFTC:
         m = plant.n_wheels
         self.c1 = check_positive(c1, "c1")
         self.c2 = check_positive(c2, "c2")
-        self.gamma_g = _gain_matrix(gamma_g, "gamma_g")
+        self.gamma_g = as_square_matrix(gamma_g, "gamma_g", 3)
         if np.ndim(gamma_theta) == 0 or np.shape(gamma_theta) == (3, 3):
-            self.gamma_theta = (_gain_matrix(gamma_theta, "gamma_theta"),) * m
+            self.gamma_theta = (as_square_matrix(gamma_theta, "gamma_theta", 3),) * m
         elif isinstance(gamma_theta, Sequence) and len(gamma_theta) == m:
-            self.gamma_theta = tuple(_gain_matrix(g, f"gamma_theta[{j}]") for j, g in enumerate(gamma_theta))
+            self.gamma_theta = tuple(
+                as_square_matrix(g, f"gamma_theta[{j}]", 3) for j, g in enumerate(gamma_theta)
+            )
         else:
             raise InvalidArgumentError(
                 "gamma_theta", f"a scalar, a 3 x 3 matrix or one of them per wheel ({m})", repr(gamma_theta)
@@ -218,8 +213,8 @@ class AdaptiveBacksteppingFTC:
         self.g_hat0 = self.g_nom.copy() if g_hat0 is None else as_matrix(g_hat0, "g_hat0", (3, 3))
         self.projection = self._radii(projection)
         self.leakage = check_positive(leakage, "leakage", allow_zero=True)
-        self.freeze = _check_bool(freeze, "freeze")
-        self.gyroscopic_compensation = _check_bool(gyroscopic_compensation, "gyroscopic_compensation")
+        self.freeze = check_bool(freeze, "freeze")
+        self.gyroscopic_compensation = check_bool(gyroscopic_compensation, "gyroscopic_compensation")
         self.singular_pitch = check_positive(singular_pitch, "singular_pitch")
         if self.singular_pitch > math.pi / 2:
             raise InvalidArgumentError(
