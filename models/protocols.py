@@ -52,7 +52,14 @@ class Plant(Protocol):
 
     - ``n_disturbances`` (int): the size of ``d`` (default ``n_inputs``);
     - ``normalize_state(x) -> x``: applied by the integrators after every step (the MRP
-      shadow-set switch, the renormalisation of a quaternion).
+      shadow-set switch, the renormalisation of a quaternion);
+    - ``dynamics_unchecked(x, u, d) -> x'``: the same right-hand side without argument checks,
+      for the inner loop of an integrator, which calls it thousands of times per run; ``x``
+      and ``u`` are finite float arrays of sizes ``n_states`` and ``n_inputs``, ``d`` is
+      ``None`` or of size ``n_disturbances``;
+    - ``second_order_layout`` (mapping of ``"quaternion"``, ``"rate"``, ``"position"``,
+      ``"velocity"`` to index slices): the second-order structure Newmark-beta needs
+      (:class:`rmpc.sim.integrators.Newmark`).
     """
 
     n_states: int

@@ -27,7 +27,8 @@ from rmpc.mpc.offline import OfflineRMPC
 from rmpc.mpc.robust_mpc import RMPC
 from rmpc.mpc.scheduled import ScheduledRMPC
 from rmpc.sim.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
-from rmpc.sim.simulate import Trajectory, simulate
+from rmpc.sim.simulate import simulate
+from rmpc.sim.trajectory import Trajectory
 from rmpc.wrappers import MappedController
 
 __all__ = [

@@ -47,7 +47,7 @@ from rmpc import (
     flexible_lqr,
     simulate,
 )
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.status import SOLVER_STATUSES, is_usable
 
@@ -177,7 +177,7 @@ def test_pzt_channel_end_to_end_through_flexible_hybrid() -> None:
     sat, x0 = _flexible()
     dt = 0.01
     hybrid = FlexibleHybrid(MTSMC(sat, dt), RobustAVC(sat, dt))
-    traj = simulate(hybrid, NonlinearPlant(sat, dt, method="RK4"), x0, duration=0.1, dt=dt)
+    traj = simulate(hybrid, SampledPlant(sat, dt, integrator="RK4"), x0, duration=0.1, dt=dt)
     law, avc, blind = MTSMC(sat, dt), RobustAVC(sat, dt), MTSMC(sat, dt)
     cancelled = 0
     for k in range(traj.n_steps):

@@ -131,7 +131,7 @@ def test_scenario_plant_and_wheel_plant() -> None:
     plant = scenario_plant(s4, seed=5)
     np.testing.assert_allclose(plant.model.inertia, 1.2 * WheelSatellite.paper_w().inertia, atol=1e-15)
     assert plant.input_stage.wheel_disturbance.seed == 5
-    assert (plant.method, plant.n_substeps, plant.dt) == ("RK4", 8, 0.04)
+    assert (plant.integrator.name, plant.n_substeps, plant.dt) == ("RK4", 8, 0.04)
     light = scenario_plant(s4, inertia_scale=0.8)
     np.testing.assert_allclose(light.model.inertia, 0.8 * WheelSatellite.paper_w().inertia, atol=1e-15)
     free = wheel_plant(WheelSatellite.paper_w(), torque_limit=False, momentum_limit=False)

@@ -25,7 +25,7 @@ from rmpc import (
     flexible_lqr,
     simulate,
 )
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import InvalidArgumentError
 
 DT = 0.01
@@ -37,7 +37,7 @@ def sat() -> FlexibleSatellite:
 
 
 def _run(sat, ctrl, x0, horizon, disturbance=None):
-    return simulate(ctrl, NonlinearPlant(sat, DT, method="RK4"), x0, horizon, disturbance=disturbance)
+    return simulate(ctrl, SampledPlant(sat, DT, integrator="RK4"), x0, horizon, disturbance=disturbance)
 
 
 def test_pd_equilibrium_closed_form_and_observer_removes_the_error(sat):

@@ -22,7 +22,7 @@ from models.flexible.scenario import (
     steady_error_scenario,
 )
 from rmpc import StepInfo, simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 
@@ -45,7 +45,7 @@ def sat() -> FlexibleSatellite:
 
 
 def _run(sat, u, x0, horizon=2.0):
-    return simulate(_Constant(u), NonlinearPlant(sat, 0.01, method="RK4"), x0, horizon,
+    return simulate(_Constant(u), SampledPlant(sat, 0.01, integrator="RK4"), x0, horizon,
                     limiter=sat.input_limiter(2.0))
 
 

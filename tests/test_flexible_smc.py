@@ -28,7 +28,7 @@ from models.attitude.quaternion import quat_from_axis_angle, rotation_angle
 from models.flexible.scenario import PaperVDisturbance, paper_v_scenario, steady_error_scenario
 from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, StepInputs, simulate
 from rmpc.sim.disturbances import ConstantDisturbance
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 DT = 0.01
@@ -50,7 +50,7 @@ def _paper_v_disturbance() -> PaperVDisturbance:
 
 
 def _run(sat, ctrl, x0, horizon=HORIZON, disturbance=None, limit=True):
-    plant = NonlinearPlant(sat, DT, method="RK4")
+    plant = SampledPlant(sat, DT, integrator="RK4")
     limiter = sat.input_limiter(2.0) if limit else None
     return simulate(ctrl, plant, x0, horizon, limiter=limiter, disturbance=disturbance)
 
@@ -208,7 +208,7 @@ def slew_runs(sat):
     for name, make in (("MTSMC", lambda: MTSMC(sat)), ("CSMC", lambda: CSMC(sat, switch="tanh"))):
         for suffix, avc in (("", None), ("+AVC", RobustAVC)):
             ctrl = FlexibleHybrid(make(), None if avc is None else avc(sat))
-            traj = simulate(ctrl, NonlinearPlant(sat, DT, method="RK4"), scenario.initial_state(),
+            traj = simulate(ctrl, SampledPlant(sat, DT, integrator="RK4"), scenario.initial_state(),
                             scenario.duration, limiter=scenario.limiter(), disturbance=scenario.disturbance)
             runs[name + suffix] = flexible_metrics(traj, sat, bandwidth=0.05)
     return runs
@@ -262,7 +262,7 @@ def test_steady_error_under_constant_disturbance(sat):
 def test_integral_action_removes_the_steady_error(sat):
     """k_I = 0.01 1/s^2 (theta_I = 5 deg): below 0.1 deg at 250 s (measured 0.0013 deg)."""
     scenario = steady_error_scenario(satellite=sat)
-    traj = simulate(MTSMC(sat, k_I=0.01), NonlinearPlant(sat, DT, method="RK4"), scenario.initial_state(),
+    traj = simulate(MTSMC(sat, k_I=0.01), SampledPlant(sat, DT, integrator="RK4"), scenario.initial_state(),
                     scenario.duration, disturbance=scenario.disturbance)
     assert rotation_angle(traj.x[-1, :4]) < np.deg2rad(0.1)
 

@@ -33,7 +33,7 @@ from models.attitude.mrp import (
 )
 from models.mrp.tracking import RMPCStateMap, rmpc_state, tracking_error
 from rmpc import simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SingularityError
 
 SIGMA0 = [0.195676, -0.096964, 0.130312]
@@ -174,7 +174,7 @@ def test_tumbling_run_switches_twice_and_matches_a_quaternion_run() -> None:
     sat = MRPSatellite([3.0, 3.0, 2.0])
     n = sat.mean_motion
     x0 = np.array([0.0, 0.0, 0.0, 0.1, 0.05, 0.5])
-    run = simulate(Zero(), NonlinearPlant(sat, 1e-3, method="RK4"), x0, duration=20.0)
+    run = simulate(Zero(), SampledPlant(sat, 1e-3, integrator="RK4"), x0, duration=20.0)
     jumps = np.linalg.norm(np.diff(run.x[:, :3], axis=0), axis=1)
     assert int(np.sum(jumps > 0.5)) == 2
     assert np.all(np.sum(run.x[:, :3] ** 2, axis=1) <= 1.0)

@@ -21,7 +21,7 @@ from scipy.integrate import solve_ivp
 
 from models import RigidSatellite
 from rmpc import LQR, simulate
-from rmpc.sim.plants import NonlinearSatellitePlant
+from rmpc.sim.plants import SampledPlant
 
 ENERGY_TOL = 1e-11
 MOMENTUM_TOL = 3e-10
@@ -99,9 +99,9 @@ def test_momentum_drift_measures_integration_error():
 
 
 def test_plant_class_directly_over_one_long_sample():
-    """``NonlinearSatellitePlant.advance`` over a single 100 s interval conserves both too."""
+    """``SampledPlant.advance`` (DOP853) over a single 100 s interval conserves both too."""
     sat, x0 = _paper_p_case()
-    plant = NonlinearSatellitePlant(sat, dt=100.0)
+    plant = SampledPlant(sat, dt=100.0)
     x1 = plant.advance(x0, np.zeros(3), 0.0, None)
     e_drift, h_drift = _drifts(sat, np.vstack((x0, x1)))
     assert e_drift < ENERGY_TOL  # measured 1.4e-12
@@ -114,7 +114,7 @@ def test_applied_torque_changes_energy_at_the_work_rate():
     sat = RigidSatellite.paper_p()
     x0 = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.5])
     torque = np.array([0.0, 0.0, 0.2])
-    plant = NonlinearSatellitePlant(sat, dt=2.0)
+    plant = SampledPlant(sat, dt=2.0)
     x1 = plant.advance(x0, torque, 0.0, None)
     # pure spin about a principal axis: r(t) = r0 + t Mz / Izz, E = Izz r^2 / 2
     r1 = 0.5 + 2.0 * 0.2 / 4.2953
@@ -141,7 +141,7 @@ def _closed_loop_reference(sat: RigidSatellite, lqr: LQR, x0: np.ndarray, dt: fl
 def test_integrator_accuracy_over_a_100s_closed_loop():
     """Defaults vs rtol = 1e-13, atol = 1e-14, and vs an independent RK45 reference.
 
-    NonlinearSatellitePlant's docstring quotes this measurement (2.5e-16 and 1.7e-14 here).
+    The docstring of rmpc.sim.integrators.DOP853 quotes this measurement (2.5e-16 and 1.7e-14 here).
     """
     sat = RigidSatellite.paper_p()
     x0 = sat.initial_state()

@@ -24,7 +24,7 @@ from models import (
 )
 from models.protocols import InputStage
 from rmpc import StepInfo, simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 WHEELS = WheelArray.paper_w()
@@ -115,7 +115,7 @@ def test_stuck_wheel_reaches_its_momentum_limit_and_is_flagged() -> None:  # see
     sat = WheelSatellite.paper_w()
     stage = WheelInputStage(sat.wheels, [WheelFault(2, "stuck", 0.0, value=0.05)])
     assert isinstance(stage, InputStage)
-    plant = NonlinearPlant(sat, 0.04, method="RK4", substep=0.005, input_stage=stage)
+    plant = SampledPlant(sat, 0.04, integrator="RK4", substep=0.005, input_stage=stage)
     run = simulate(ZeroCommand(), plant, np.zeros(10), duration=14.0)
     h2 = run.x[:, 7]
     # h' = -0.05 N m from h = 0: the limit 0.625 N m s is reached at 12.5 s

@@ -19,7 +19,7 @@ from scipy.integrate import solve_ivp
 from models import MRPSatellite, paper_m_scenario
 from models.attitude.mrp import mrp_error_angle
 from rmpc import MAB, NESO, CFBackstepping, CommandFilter, ConstantDisturbance, TuningFunctionAB, simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 CONTROLLERS = {"BS": CFBackstepping, "MAB": MAB, "TFAB": TuningFunctionAB}
@@ -158,7 +158,7 @@ def m2_sampled(m2):
         sc = paper_m_scenario("M2", duration=60.0, dt=dt)
         for name, cls in CONTROLLERS.items():
             ctrl = cls(sc.model(), target=sc.sigma_ref, dt=dt)
-            plant = NonlinearPlant(sc.true_satellite(), dt, method="RK4", substep=0.01)
+            plant = SampledPlant(sc.true_satellite(), dt, integrator="RK4", substep=0.01)
             out[name, dt] = simulate(ctrl, plant, sc.initial_state(), duration=sc.duration,
                                      disturbance=sc.disturbance())
     return out
@@ -195,7 +195,7 @@ def test_m3_torque_limit_and_model_error() -> None:
     for scale in (1.3, 0.7):
         sc = paper_m_scenario("M3", inertia_scale=scale, duration=40.0, dt=0.05)
         mab = MAB(sc.model(), target=sc.sigma_ref, dt=sc.dt, u_max=sc.u_max)
-        plant = NonlinearPlant(sc.true_satellite(), sc.dt, method="RK4", substep=0.01)
+        plant = SampledPlant(sc.true_satellite(), sc.dt, integrator="RK4", substep=0.01)
         traj = simulate(mab, plant, sc.initial_state(), duration=sc.duration, disturbance=sc.disturbance())
         assert np.abs(traj.u_applied).max() <= 1.0
         assert traj.info[0].extra["saturated"]

@@ -229,7 +229,7 @@ def recovery_time(t: Any, e: Any, t_on: float, band: float) -> float | None:
 
 def check_trajectory(traj: Any, name: str = "traj") -> Any:
     """``traj`` if it is an :class:`rmpc.Trajectory`; an ``ArgumentTypeError`` naming ``name`` otherwise."""
-    from rmpc.sim.simulate import Trajectory  # here: the metrics above load without the controllers
+    from rmpc.sim.trajectory import Trajectory  # here: the metrics above load without the controllers
 
     if not isinstance(traj, Trajectory):
         raise ArgumentTypeError(name, "an rmpc.Trajectory", type(traj).__name__)

@@ -5,7 +5,7 @@ import numpy as np
 from benchmarks.families.flexible.metrics import flexible_metrics
 from models.flexible.scenario import paper_v_scenario
 from rmpc import CSMC, MTSMC, FlexibleHybrid, RobustAVC, simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 
 scenario = paper_v_scenario(duration=20.0)  # 160 deg about (1, 1, 1), u_max = 2 N m, d(t) of paper V
 sat = scenario.satellite
@@ -18,7 +18,7 @@ laws = (lambda: MTSMC(sat), lambda: CSMC(sat, switch="tanh"))
 for make in laws:
     for avc in (None, RobustAVC(sat)):
         ctrl = FlexibleHybrid(make(), avc)
-        plant = NonlinearPlant(sat, scenario.dt, rtol=1e-8)  # DOP853 between samples
+        plant = SampledPlant(sat, scenario.dt, rtol=1e-8)  # DOP853 between samples
         traj = simulate(ctrl, plant, scenario.initial_state(), scenario.duration,
                         limiter=scenario.limiter(), disturbance=scenario.disturbance)
         m = flexible_metrics(traj, sat, bandwidth=0.05)

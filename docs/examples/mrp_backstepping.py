@@ -5,7 +5,7 @@ import numpy as np
 from models import paper_m_scenario
 from models.attitude.mrp import mrp_error_angle
 from rmpc import MAB, CFBackstepping, TuningFunctionAB, simulate
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 
 m2 = paper_m_scenario("M2", duration=40.0, dt=0.05)  # window [20, 40] s; the seed's is 100 s
 print(f"initial error {m2.initial_error_deg:.2f} deg, window {m2.steady_window} s")
@@ -14,7 +14,7 @@ for ctrl in (
     MAB(m2.model(), target=m2.sigma_ref, dt=m2.dt),
     TuningFunctionAB(m2.model(), target=m2.sigma_ref, dt=m2.dt),
 ):
-    plant = NonlinearPlant(m2.true_satellite(), m2.dt, method="RK4", substep=0.01)
+    plant = SampledPlant(m2.true_satellite(), m2.dt, integrator="RK4", substep=0.01)
     traj = simulate(ctrl, plant, m2.initial_state(), duration=m2.duration, disturbance=m2.disturbance())
     phi = np.degrees([mrp_error_angle(x[:3], m2.sigma_ref) for x in traj.x])
     steady = phi[traj.t >= m2.steady_window[0]].max()

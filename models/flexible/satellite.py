@@ -314,6 +314,18 @@ class FlexibleSatellite:
         n = self.n_modes
         return x[:4], x[4:7], x[7:7 + n], x[7 + n:]
 
+    @property
+    def second_order_layout(self) -> dict[str, slice]:
+        """Where the parts of the state sit, for a second-order integrator (Newmark-beta).
+
+        ``"quaternion"`` (the unit attitude quaternion, scalar first), ``"rate"`` (``w``),
+        ``"position"`` (``eta``) and ``"velocity"`` (``eta'``): index slices of the
+        ``7 + 2N`` states. See :class:`rmpc.sim.integrators.Newmark`.
+        """
+        n = self.n_modes
+        return {"quaternion": slice(0, 4), "rate": slice(4, 7), "position": slice(7, 7 + n),
+                "velocity": slice(7 + n, 7 + 2 * n)}
+
     def normalize_state(self, x: np.ndarray) -> np.ndarray:
         """The state with its quaternion rescaled to unit norm (the simulator calls this)."""
         out = np.array(x, dtype=float)

@@ -192,7 +192,7 @@ class MRPSatellite:
     def normalize_state(self, x: Any) -> np.ndarray:
         """The shadow-set switch: ``sigma := -sigma / sigma' sigma`` when ``sigma' sigma > threshold``.
 
-        :class:`rmpc.sim.plants.NonlinearPlant` applies it after every integration step. The
+        :class:`rmpc.sim.plants.SampledPlant` applies it after every integration step. The
         attitude ``C(sigma)`` and the rate are unchanged.
         """
         x = np.asarray(x, dtype=float)

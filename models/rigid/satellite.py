@@ -143,6 +143,15 @@ class RigidSatellite:
         u_vec, d_vec = self._inputs(u, d)
         return self._rhs(x, u_vec + d_vec)
 
+    def dynamics_unchecked(self, x: np.ndarray, u: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`dynamics` without argument checks, for the inner loop of an integrator.
+
+        ``x`` (6) and ``u`` (3) are finite float arrays, ``d`` is ``None`` or 3 values; the
+        simulator calls this thousands of times per run (an optional member of
+        :class:`models.protocols.Plant`).
+        """
+        return self._rhs(x, u if d is None else u + d)
+
     def _rhs(self, x: np.ndarray, torque: np.ndarray) -> np.ndarray:
         """Unchecked right-hand side (hot path of the simulator)."""
         w = x[3:]

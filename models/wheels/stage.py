@@ -1,7 +1,7 @@
 """Everything between the controller's wheel commands and the torques the wheels apply.
 
 One object, :class:`WheelInputStage`, follows the input-stage protocol of
-:class:`rmpc.sim.plants.NonlinearPlant` (``stage(t, x, u_cmd) -> u_applied``, ``reset()``,
+:class:`rmpc.sim.plants.SampledPlant` (``stage(t, x, u_cmd) -> u_applied``, ``reset()``,
 ``begin_sample(t, x, u_cmd) -> dict``). In order (seed sections 2.3, 3 and 5):
 
 1. wheel-level disturbance (S4): ``u = u_cmd + d_w(t)`` (:class:`~models.WheelDisturbance`);

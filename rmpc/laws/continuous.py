@@ -24,8 +24,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
-from rmpc.sim.plants import disturbance_at
-from toolkit_common.errors import ArgumentTypeError
+from rmpc.sim.rhs import model_dynamics, plant_derivative
 from toolkit_common.validation import as_optional_limits, as_vector, check_positive
 
 __all__ = ["ContinuousTimeController", "LawOutput"]
@@ -130,21 +129,21 @@ class ContinuousTimeController:
         Parameters
         ----------
         plant : object with ``dynamics(x, u, d=None)``
-            The true plant (its ``normalize_state`` is not applied: keep joint runs away from
+            The true plant, evaluated through :func:`rmpc.sim.rhs.plant_derivative` as the
+            simulator does (its ``normalize_state`` is not applied: keep joint runs away from
             shadow-set switches).
         disturbance : callable, optional
             ``d(t)``, or ``d(t, x)`` when its ``state_dependent`` attribute is true.
         """
-        if not callable(getattr(plant, "dynamics", None)):
-            raise ArgumentTypeError("plant", "a model with dynamics(x, u, d=None)", type(plant).__name__)
+        dynamics = model_dynamics(plant)
         n = self.n_states
 
         def rhs(t: float, y: np.ndarray) -> np.ndarray:
             x, z = y[:n], y[n:]
             geometry = self._geometry(x)
             u = self._evaluate(x, z, geometry).u
-            d = None if disturbance is None else disturbance_at(disturbance, t, x)
-            return np.concatenate((plant.dynamics(x, u, d), self._derivative(x, z, u, geometry)))
+            x_dot = plant_derivative(dynamics, t, x, u, disturbance)
+            return np.concatenate((x_dot, self._derivative(x, z, u, geometry)))
 
         return rhs
 

@@ -11,7 +11,16 @@ import numpy as np
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive, check_real
 
-__all__ = ["ConstantDisturbance", "SineDisturbance", "StepDisturbance", "as_disturbance"]
+__all__ = [
+    "ConstantDisturbance",
+    "DisturbanceFn",
+    "SineDisturbance",
+    "StepDisturbance",
+    "as_disturbance",
+    "disturbance_at",
+]
+
+DisturbanceFn = Callable[..., np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -106,3 +115,10 @@ def as_disturbance(value: Any, size: int, x0: Any = None) -> Callable[..., np.nd
             "disturbance", f"d(t) of shape ({size},)", f"shape {probe.shape}"
         )
     return value
+
+
+def disturbance_at(disturbance: DisturbanceFn, t: float, x: np.ndarray) -> np.ndarray:
+    """``d(t, x)`` for a state-dependent disturbance (``state_dependent = True``), else ``d(t)``."""
+    if getattr(disturbance, "state_dependent", False):
+        return disturbance(t, x)
+    return disturbance(t)

@@ -3,95 +3,18 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from models import ReactionWheelActuator, TorqueLimiter
-from rmpc.sim.disturbances import as_disturbance
-from rmpc.sim.plants import disturbance_at, make_plant
+from rmpc.sim.disturbances import as_disturbance, disturbance_at
+from rmpc.sim.plants import as_sampled_plant
+from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["Trajectory", "simulate"]
-
-
-@dataclass
-class Trajectory:
-    """A closed-loop run.
-
-    Attributes
-    ----------
-    t : (N + 1,) ndarray
-        Sample times (s), ``t[0] = 0``.
-    x : (N + 1, n) ndarray
-        States at the sample times.
-    u_cmd : (N, m) ndarray
-        Controller outputs.
-    u_applied : (N, m) ndarray
-        Inputs applied to the plant (after the limiter, the actuator and, for a
-        :class:`~rmpc.sim.plants.NonlinearPlant` with an input stage, the stage evaluated at the
-        start of the sample), without ``d``.
-    d : (N, n_d) ndarray
-        Disturbance at the start of each sample.
-    status : list of str
-        Each step's controller status.
-    solve_time : (N,) ndarray
-        Each step's optimiser time as reported by the controller (s).
-    step_time : (N,) ndarray
-        Wall time of each ``controller.step`` call (s).
-    gamma : (N,) ndarray
-        Each step's cost bound where the controller has one, NaN elsewhere.
-    info : list
-        The controller's ``last`` object after each step.
-    plant : str
-        ``"linear"`` or ``"nonlinear"``.
-    dt : float
-        Sample time (s).
-    stage_log : dict of ndarray
-        What the input stage reported at the start of each sample (``begin_sample``), one
-        array per name with the samples along the first axis; empty without a stage.
-    """
-
-    t: np.ndarray
-    x: np.ndarray
-    u_cmd: np.ndarray
-    u_applied: np.ndarray
-    d: np.ndarray
-    status: list[str]
-    solve_time: np.ndarray
-    step_time: np.ndarray
-    gamma: np.ndarray
-    info: list[Any] = field(repr=False)
-    plant: str
-    dt: float
-    stage_log: dict[str, np.ndarray] = field(default_factory=dict)
-
-    @property
-    def n_steps(self) -> int:
-        """Number of controller steps."""
-        return int(self.u_cmd.shape[0])
-
-    @property
-    def attitude_deg(self) -> np.ndarray:
-        """Roll, pitch, yaw in degrees, shape ``(N + 1, 3)`` (satellite states only)."""
-        return np.degrees(self.x[:, :3])
-
-    def status_counts(self) -> dict[str, int]:
-        """How many steps ended with each status."""
-        counts: dict[str, int] = {}
-        for s in self.status:
-            counts[s] = counts.get(s, 0) + 1
-        return counts
-
-    def save_npz(self, path: str) -> None:
-        """Write the numeric arrays (and statuses) to a ``.npz`` file."""
-        np.savez_compressed(
-            path, t=self.t, x=self.x, u_cmd=self.u_cmd, u_applied=self.u_applied, d=self.d,
-            solve_time=self.solve_time, step_time=self.step_time, gamma=self.gamma,
-            status=np.asarray(self.status), plant=self.plant, dt=self.dt,
-        )
+__all__ = ["simulate"]
 
 
 def simulate(
@@ -123,11 +46,14 @@ def simulate(
     ----------
     controller : object with ``step(x)``
         Any controller of the toolkit (see :class:`rmpc.controller.Controller`).
-    plant : PolytopicModel, RigidSatellite, NonlinearPlant or a model with ``dynamics``
-        A polytope (the linear plant; ``true_plant`` picks the member), the nonlinear
-        satellite or any model with ``dynamics(x, u, d=None)`` (``dt`` required), or a
-        :class:`~rmpc.sim.plants.NonlinearPlant` that fixes the integrator and an input stage
-        (faults, actuator limits; see :class:`~models.protocols.InputStage`).
+    plant : PolytopicModel, a Plant or a SampledPlant
+        A polytope (the linear plant; ``true_plant`` picks the member), any continuous plant
+        with ``dynamics(x, u, d=None)`` (:class:`models.protocols.Plant`: paper P's
+        :class:`~models.RigidSatellite`, the wheel, MRP and flexible satellites, a user's
+        model; ``dt`` required; integrated by DOP853 at ``rtol``/``atol``), or a
+        :class:`~rmpc.sim.plants.SampledPlant` that fixes the integrator (``"DOP853"``,
+        ``"RK4"``, ``"Newmark"``) and an input stage (faults, actuator limits; see
+        :class:`~models.protocols.InputStage`). See :func:`rmpc.sim.plants.as_sampled_plant`.
     x0 : array_like
         Initial state.
     duration : float, optional
@@ -138,7 +64,7 @@ def simulate(
         Sample time; for a polytope it defaults to (and must equal) ``plant.dt``.
     true_plant : None, int, weights or (A, B), optional
         For a polytope: the nominal model (default), a vertex, a convex combination, or an
-        explicit pair. See :func:`rmpc.sim.plants.make_plant`.
+        explicit pair.
     actuator : ReactionWheelActuator, optional
         Actuator dynamics between command and torque; reset at the start.
     limiter : TorqueLimiter, optional
@@ -147,7 +73,8 @@ def simulate(
         Disturbance torque ``d(t)`` (e.g. :class:`rmpc.StepDisturbance`), or ``d(t, x)`` for an
         object whose ``state_dependent`` attribute is true.
     rtol, atol : float
-        Tolerances of the nonlinear integrator.
+        Tolerances of DOP853 for a plant given as a model (a ready
+        :class:`~rmpc.sim.plants.SampledPlant` keeps its own integrator).
     reset : bool
         Call ``controller.reset()`` first (default).
     progress : callable, optional
@@ -160,6 +87,8 @@ def simulate(
     Returns
     -------
     Trajectory
+        With the roll, pitch and yaw of every sample (:attr:`Trajectory.attitude_euler`)
+        computed by the plant's ``attitude_euler(x)`` when it has one.
 
     Examples
     --------
@@ -175,7 +104,7 @@ def simulate(
     """
     if not callable(getattr(controller, "step", None)):
         raise ArgumentTypeError("controller", "an object with a step(x) method", type(controller).__name__)
-    sim_plant = make_plant(plant, dt, true_plant, rtol=rtol, atol=atol)
+    sim_plant = as_sampled_plant(plant, dt, true_plant, rtol=rtol, atol=atol)
     step_dt = sim_plant.dt
     n, m = sim_plant.n_states, sim_plant.n_inputs
     x = as_vector(x0, "x0", n)
@@ -251,10 +180,14 @@ def simulate(
         xs[k + 1] = x
         if progress is not None:
             progress(k + 1, n_steps)
+    attitude = (
+        np.array([sim_plant.attitude_euler(x_k) for x_k in xs])
+        if getattr(sim_plant, "has_attitude", False) else None
+    )
     return Trajectory(
         t=np.arange(n_steps + 1) * step_dt, x=xs, u_cmd=u_cmd, u_applied=u_app, d=d_log,
         status=status, solve_time=solve_time, step_time=step_time, gamma=gamma, info=info,
-        plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows),
+        plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows), attitude_euler=attitude,
     )
 
 

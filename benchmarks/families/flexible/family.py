@@ -240,7 +240,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 
     from benchmarks.families.flexible.metrics import flexible_metrics
     from rmpc import simulate
-    from rmpc.sim.plants import NonlinearPlant
+    from rmpc.sim.plants import SampledPlant
 
     case = paper_scenario(scenario)
     sat = case.satellite
@@ -255,7 +255,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     )
     build_time = time.perf_counter() - start
     limiter = case.limiter() if built.needs_limiter else None
-    plant = NonlinearPlant(sat, scenario.dt, rtol=1e-8)
+    plant = SampledPlant(sat, scenario.dt, rtol=1e-8)
     traj = simulate(built.controller, plant, x0, case.duration, limiter=limiter, disturbance=case.disturbance)
     gain = _linear_gain(built.controller, traj)
     bandwidth = _bandwidth(scenario, settings, sat, gain)

@@ -30,7 +30,7 @@ import numpy as np
 from benchmarks.core.metrics import check_trajectory, last_time_above
 from models import FlexibleSatellite
 from models.attitude.quaternion import rotation_angle
-from rmpc.sim.simulate import Trajectory
+from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_positive
 

@@ -108,7 +108,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     from models.attitude.mrp import mrp_error_angle
     from models.mrp.tracking import RMPCStateMap
     from rmpc import simulate
-    from rmpc.sim.plants import NonlinearPlant
+    from rmpc.sim.plants import SampledPlant
 
     case = paper_scenario(scenario)
     model = case.model()
@@ -127,7 +127,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         MRPModel(model, case.sigma_ref, poly, state_map), scenario, settings
     )
     limiter = TorqueLimiter(scenario.u_max) if built.needs_limiter else None
-    plant = NonlinearPlant(case.true_satellite(), scenario.dt, method="RK4", substep=scenario.plant_step)
+    plant = SampledPlant(case.true_satellite(), scenario.dt, integrator="RK4", substep=scenario.plant_step)
     traj = simulate(
         built.controller, plant, x0, duration=case.duration, disturbance=case.disturbance(), limiter=limiter
     )

@@ -21,7 +21,7 @@ import numpy as np
 
 from benchmarks.core.metrics import AXES, check_trajectory, recovery_time
 from models import FaultSchedule, WheelArray, rank_deficient_windows
-from rmpc.sim.simulate import Trajectory
+from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_positive
 

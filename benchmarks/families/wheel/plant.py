@@ -4,8 +4,8 @@ Seed ``paper-W-wheel-faults.md`` section 2.5 (**assumed**): the controller runs 
 zero-order hold and the plant is integrated with classical RK4 at 5 ms, the input stage
 (wheel disturbance, faults, torque and momentum limits; :class:`models.WheelInputStage`)
 acting inside the integration. :func:`wheel_plant` builds exactly that
-:class:`~rmpc.sim.plants.NonlinearPlant`; :func:`scenario_plant` does it for one of paper W's
-scenarios.
+:class:`~rmpc.sim.plants.SampledPlant` (integrator ``"RK4"``); :func:`scenario_plant` does it for
+one of paper W's scenarios.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 from models import WheelDisturbance, WheelInputStage, WheelSatellite, WheelScenario
-from rmpc.sim.plants import NonlinearPlant
+from rmpc.sim.plants import SampledPlant
 from toolkit_common.errors import ArgumentTypeError
 from toolkit_common.validation import check_positive
 
@@ -26,11 +26,11 @@ def wheel_plant(
     *,
     dt: float = 0.04,
     substep: float = 0.005,
-    method: str = "RK4",
+    integrator: str = "RK4",
     wheel_disturbance: WheelDisturbance | None = None,
     torque_limit: bool = True,
     momentum_limit: bool = True,
-) -> NonlinearPlant:
+) -> SampledPlant:
     """The wheel satellite as a sampled plant for :func:`rmpc.sim.simulate`.
 
     Parameters
@@ -43,9 +43,9 @@ def wheel_plant(
         Control period (default 0.04 s).
     substep : float
         RK4 step (default 0.005 s).
-    method : {"RK4", "DOP853"}
+    integrator : {"RK4", "DOP853"}
         The integrator (default RK4, the seed's choice; the input stage switches inside a
-        sample when a momentum limit is reached).
+        sample when a momentum limit is reached). See :mod:`rmpc.sim.integrators`.
     wheel_disturbance : WheelDisturbance, optional
         S4's wheel-level disturbance.
     torque_limit, momentum_limit : bool
@@ -53,7 +53,7 @@ def wheel_plant(
 
     Returns
     -------
-    NonlinearPlant
+    SampledPlant
         Its ``input_stage`` is the :class:`~models.WheelInputStage`.
 
     Examples
@@ -61,16 +61,16 @@ def wheel_plant(
     >>> from models import WheelFault, WheelSatellite
     >>> from benchmarks.families.wheel.plant import wheel_plant
     >>> plant = wheel_plant(WheelSatellite.paper_w(), [WheelFault(2, "stuck", 8.0, 37.0, value=0.05)])
-    >>> plant.dt, plant.n_substeps, plant.n_states, plant.n_inputs, plant.n_disturbances
-    (0.04, 8, 10, 4, 3)
+    >>> plant.dt, plant.integrator, plant.n_substeps, plant.n_states, plant.n_inputs, plant.n_disturbances
+    (0.04, RK4(substep=0.005), 8, 10, 4, 3)
     """
     if not isinstance(satellite, WheelSatellite):
         raise ArgumentTypeError("satellite", "a models.WheelSatellite", type(satellite).__name__)
     stage = WheelInputStage(
         satellite.wheels, faults, wheel_disturbance, torque_limit=torque_limit, momentum_limit=momentum_limit
     )
-    return NonlinearPlant(
-        satellite, check_positive(dt, "dt"), method=method, substep=substep, input_stage=stage
+    return SampledPlant(
+        satellite, check_positive(dt, "dt"), integrator=integrator, substep=substep, input_stage=stage
     )
 
 
@@ -81,7 +81,7 @@ def scenario_plant(
     inertia_scale: float | None = None,
     seed: int | None = 0,
     **options: Any,
-) -> NonlinearPlant:
+) -> SampledPlant:
     """The plant of one of paper W's scenarios (:func:`models.paper_w_scenario`).
 
     Parameters

@@ -89,10 +89,10 @@ class CFBackstepping(ContinuousTimeController):
     >>> import numpy as np
     >>> from models import MRPSatellite, paper_m_scenario
     >>> from rmpc import CFBackstepping, simulate
-    >>> from rmpc.sim.plants import NonlinearPlant
+    >>> from rmpc.sim.plants import SampledPlant
     >>> m1 = paper_m_scenario("M1")
     >>> bs = CFBackstepping(m1.model(), target=m1.sigma_ref, dt=0.05)
-    >>> plant = NonlinearPlant(m1.true_satellite(), 0.05, method="RK4")
+    >>> plant = SampledPlant(m1.true_satellite(), 0.05, integrator="RK4")
     >>> traj = simulate(bs, plant, m1.initial_state(), duration=20.0)
     >>> bool(np.degrees(traj.info[-1].extra["error_angle"]) < 0.1)
     True

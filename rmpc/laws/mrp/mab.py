@@ -96,10 +96,10 @@ class MAB(CFBackstepping):
     >>> import numpy as np
     >>> from models import paper_m_scenario
     >>> from rmpc import MAB, simulate
-    >>> from rmpc.sim.plants import NonlinearPlant
+    >>> from rmpc.sim.plants import SampledPlant
     >>> m2 = paper_m_scenario("M2")
     >>> mab = MAB(m2.model(), target=m2.sigma_ref, dt=0.05)
-    >>> plant = NonlinearPlant(m2.true_satellite(), 0.05, method="RK4")
+    >>> plant = SampledPlant(m2.true_satellite(), 0.05, integrator="RK4")
     >>> traj = simulate(mab, plant, m2.initial_state(), duration=20.0, disturbance=m2.disturbance())
     >>> err = np.abs(traj.info[-1].extra["torque_estimate"] - traj.d[-1])
     >>> bool(err.max() < 2e-3)     # the disk's torque is estimated to 2e-3 N m

@@ -142,7 +142,9 @@ def test_trajectory_shapes_statuses_and_progress(sat, x0, lqr, tmp_path):
     # no limiter, no actuator: what was commanded was applied, u = F x
     np.testing.assert_array_equal(traj.u_applied, traj.u_cmd)
     np.testing.assert_allclose(traj.u_cmd, traj.x[:-1] @ lqr.F.T, rtol=1e-12, atol=1e-15)
-    np.testing.assert_allclose(traj.attitude_deg, np.degrees(traj.x[:, :3]))
+    # paper P's states are the roll, pitch and yaw themselves
+    np.testing.assert_array_equal(traj.attitude_euler, traj.x[:, :3])
+    np.testing.assert_array_equal(traj.attitude_deg, np.degrees(traj.x[:, :3]))
     assert calls == [(k, n) for k in range(1, n + 1)]
     assert traj.dt == DT
     # n_steps instead of duration gives the same run
@@ -153,6 +155,7 @@ def test_trajectory_shapes_statuses_and_progress(sat, x0, lqr, tmp_path):
     traj.save_npz(str(path))
     with np.load(path) as data:
         np.testing.assert_array_equal(data["x"], traj.x)
+        np.testing.assert_array_equal(data["attitude_deg"], traj.attitude_deg)
         assert list(data["status"]) == traj.status
 
 
