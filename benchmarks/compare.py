@@ -1,0 +1,171 @@
+"""Compare two runs of a suite record by record, field by field: what a change to shared code changed.
+
+A change to shared machinery (the harness, the LMI solver, the layout) must keep every suite's
+records, or name what it changed on purpose. :func:`compare_runs` reads the ``results.json`` (a
+suite) or ``timing.json`` (``rmpc timing``) of two output folders, pairs the records, walks every
+field and lists each difference. Fields that measure time or the machine (``solve_time_p50``,
+``p95_s``, ``step_time_max``, ``machine``, ...) differ from run to run and are left out.
+
+``python -m benchmarks.compare BEFORE AFTER [--rtol R]`` prints the differences and exits 1 when
+there are any, 0 when there are none, 2 on bad input.
+
+Examples
+--------
+>>> from benchmarks.compare import compare_records
+>>> before = [{"experiment": "E1", "label": "RMPC", "metrics": {"iae": 1.0, "solve_time_p50": 0.1}}]
+>>> after = [{"experiment": "E1", "label": "RMPC", "metrics": {"iae": 1.5, "solve_time_p50": 0.2}}]
+>>> compare_records(before, after)
+['E1 | RMPC: metrics.iae: 1.0 -> 1.5']
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import check_positive
+
+__all__ = ["compare_records", "compare_runs", "is_run_dependent", "main"]
+
+#: Parts of a field name that mark a measurement of time or of the machine.
+_RUN_DEPENDENT = ("time", "machine", "versions", "load", "wall", "elapsed")
+#: Field names that contain one of those parts but are settings of the case.
+_SETTINGS = frozenset({"duration", "disturbance_start", "t_on", "t_off", "time_scale"})
+
+
+def is_run_dependent(name: str) -> bool:
+    """Whether a field named ``name`` measures the run (time, machine) rather than the result."""
+    key = str(name).lower()
+    if key in _SETTINGS:
+        return False
+    if key.endswith(("_s", "_ms")) or "p50" in key or "p95" in key:
+        return True
+    return any(part in key for part in _RUN_DEPENDENT)
+
+
+def _record_key(record: dict[str, Any], index: int, timing: bool) -> str:
+    if timing:
+        parts = [record.get(k) for k in ("problem", "formulation", "backend", "vertices", "n_states")]
+        return " | ".join(str(p) for p in parts if p is not None) + f" | #{index}"
+    label = record.get("label") or record.get("case_id")
+    return " | ".join(str(p) for p in (record.get("experiment"), label) if p is not None)
+
+
+def _walk(a: Any, b: Any, path: str, rtol: float, out: list[str]) -> None:
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(set(a) | set(b), key=str):
+            if is_run_dependent(key):
+                continue
+            where = f"{path}.{key}" if path else str(key)
+            if key not in a:
+                out.append(f"{where}: added {json.dumps(b[key])[:120]}")
+            elif key not in b:
+                out.append(f"{where}: removed")
+            else:
+                _walk(a[key], b[key], where, rtol, out)
+    elif isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            out.append(f"{path}: length {len(a)} -> {len(b)}")
+            return
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _walk(x, y, f"{path}[{i}]", rtol, out)
+    elif _is_number(a) and _is_number(b):
+        same = a == b or (math.isnan(a) and math.isnan(b))
+        if not same and not (rtol > 0.0 and abs(a - b) <= rtol * max(abs(a), abs(b))):
+            out.append(f"{path}: {a!r} -> {b!r}")
+    elif a != b:
+        out.append(f"{path}: {json.dumps(a)[:100]} -> {json.dumps(b)[:100]}")
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def compare_records(
+    before: Sequence[dict[str, Any]], after: Sequence[dict[str, Any]], rtol: float = 0.0,
+    *, timing: bool = False,
+) -> list[str]:
+    """Every difference between two lists of records, one line each (empty: the same records).
+
+    Parameters
+    ----------
+    before, after : sequence of dict
+        The records of two runs: suite records are paired by ``experiment`` and ``label``,
+        timing records (``timing=True``) by problem, formulation, back-end, vertices, size and
+        position.
+    rtol : float
+        Numbers within this relative difference count as equal (default 0: bit for bit).
+    timing : bool
+        The records are ``rmpc timing``'s.
+    """
+    rtol = check_positive(rtol, "rtol", allow_zero=True)
+    pairs_a = {_record_key(r, i, timing): r for i, r in enumerate(before)}
+    pairs_b = {_record_key(r, i, timing): r for i, r in enumerate(after)}
+    out: list[str] = []
+    for key in sorted(set(pairs_a) | set(pairs_b)):
+        if key not in pairs_a:
+            out.append(f"{key}: record added")
+        elif key not in pairs_b:
+            out.append(f"{key}: record removed")
+        else:
+            found: list[str] = []
+            _walk(pairs_a[key], pairs_b[key], "", rtol, found)
+            out.extend(f"{key}: {line}" for line in found)
+    return out
+
+
+def _load(folder: Path) -> tuple[list[dict[str, Any]], bool]:
+    for name, timing in (("results.json", False), ("timing.json", True)):
+        path = folder / name
+        if path.is_file():
+            try:
+                data = json.loads(path.read_text())
+            except (OSError, ValueError) as err:
+                raise InvalidArgumentError(str(path), "a readable JSON file", str(err)) from None
+            records = data.get("records", []) if isinstance(data, dict) else data
+            if not isinstance(records, list):
+                raise InvalidArgumentError(str(path), "a list of records", type(records).__name__)
+            return records, timing
+    raise InvalidArgumentError(str(folder), "a folder with results.json or timing.json", "neither")
+
+
+def compare_runs(before: str | Path, after: str | Path, rtol: float = 0.0) -> list[str]:
+    """:func:`compare_records` on the records of two output folders (both suites or both timing)."""
+    records_a, timing_a = _load(Path(before))
+    records_b, timing_b = _load(Path(after))
+    if timing_a != timing_b:
+        raise InvalidArgumentError("after", "the same kind of output as before", "a suite and a timing run")
+    return compare_records(records_a, records_b, rtol, timing=timing_a)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m benchmarks.compare BEFORE AFTER [--rtol R]``: exit 0 same, 1 different, 2 bad input."""
+    import argparse
+
+    parser = argparse.ArgumentParser(
+        prog="python -m benchmarks.compare",
+        description="Compare two output folders of a suite (or of rmpc timing) record by record, "
+                    "field by field, leaving out the fields that measure time or the machine.",
+    )
+    parser.add_argument("before")
+    parser.add_argument("after")
+    parser.add_argument("--rtol", type=float, default=0.0, help="relative tolerance on numbers (default 0)")
+    args = parser.parse_args(argv)
+    try:
+        lines = compare_runs(args.before, args.after, args.rtol)
+    except InvalidArgumentError as err:
+        print(f"python -m benchmarks.compare: {err}", file=sys.stderr)
+        return 2
+    for line in lines:
+        print(line)
+    print(f"{len(lines)} difference{'s' if len(lines) != 1 else ''}")
+    return 1 if lines else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
