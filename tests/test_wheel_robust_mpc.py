@@ -5,14 +5,15 @@ wheel-effectiveness polytope (6 states, 4 wheel torques, single-outage vertices)
 the nonlinear wheel plant through :class:`rmpc.MappedController` (they see attitude and rates,
 not the wheel momenta). The closed loops are short (8 s, wheel 2 out from 1 s): they check that
 the controllers hold the attitude through the outage, not paper W's scenarios, which are the
-benchmark's business. The per-step solve time is reported in the issue's closing note, not
-asserted here (it depends on the machine's load).
+benchmark's business. The per-step solve times are quoted in ``docs/wheel_faults.rst``, not
+asserted here (they depend on the machine's load).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from solve_guard import forbid_solves
 
 from benchmarks.families.wheel.plant import wheel_plant
 from models import WheelFault, WheelSatellite
@@ -88,4 +89,19 @@ def test_offline_rmpc_on_the_same_polytope(poly_w) -> None:
     levels = np.einsum("ki,ij,kj->k", run.x, q1_inv, run.x)
     assert np.all(levels <= 1.0 + 1e-6)
     assert np.max(np.abs(run.u_cmd)) <= U_MAX * (1 + 1e-6)
-    assert np.max(run.solve_time) < 0.04  # a lookup fits the 40 ms period
+
+
+def test_offline_rmpc_lookup_solves_nothing_on_the_wheel_polytope(poly_w, monkeypatch) -> None:
+    """Designed once, then 200 steps (8 s) answered by the table with every SDP solve forbidden.
+
+    This is what lets a lookup fit the 40 ms period; the time itself is quoted in
+    ``docs/wheel_faults.rst`` (measured, not asserted).
+    """
+    ctrl = OfflineRMPC(poly_w, Q, R, u_max=U_MAX, input_constraint="peak", x_design=X0, n_ellipsoids=6)
+    table = ctrl.table
+    attempts = forbid_solves(monkeypatch)
+    run = simulate(ctrl, poly_w, X0, duration=8.0, true_plant=2)
+    assert attempts == []
+    assert ctrl.table is table
+    assert run.n_steps == 200 and run.status_counts() == {"optimal": 200}
+    assert [info.extra["design_time"] for info in run.info if "design_time" in info.extra] == [0.0]
