@@ -75,8 +75,9 @@ def _disagreements(printed: list[str], documented: list[str]) -> list[str]:
     of it, ``5 * 10**(e-1)``. The printed number ``p`` and the documented number ``d`` can be
     roundings of one value only if ``|p - d| < h(p) + h(d)``: with the same digits they must be
     equal, ``"0.009716"`` against ``"0.009717"`` or ``"0.0080"`` fails. No margin on top: the
-    examples print the same digits from run to run, with 1 or 2 OpenBLAS threads and with
-    OpenBLAS's Prescott kernels in place of the machine's own (measured: every number equal).
+    examples print the same digits from run to run, with 1 or 2 OpenBLAS threads, and with
+    ``OPENBLAS_CORETYPE=Prescott`` (SSE kernels in place of the machine's AVX-512 ones); measured
+    on every example: every number equal.
     """
     bad = []
     for p, d in zip(printed, documented, strict=True):
