@@ -23,6 +23,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
@@ -201,6 +203,31 @@ def _write(
     return files
 
 
+def inconsistencies(inertia: np.ndarray) -> list[str]:
+    """Paper P's values that no physical satellite has, checked on ``inertia`` (the suite's).
+
+    The principal moments of inertia of a rigid body obey the triangle inequality, each at most
+    the sum of the other two (equality for a flat plate). Paper P's decoded values break it; the
+    suite runs them as printed and says so here.
+    """
+    moments = np.sort(np.linalg.eigvalsh(np.asarray(inertia, dtype=float)))
+    excess = moments[2] - (moments[0] + moments[1])
+    lines = ["## Inconsistencies in paper P (reported, not hidden)", ""]
+    if excess > 0:
+        listed = ", ".join(f"{j:.4f}" for j in moments)
+        share = excess / (moments[0] + moments[1])
+        lines.append(
+            f"- The principal inertias {listed} kg m^2 break the triangle inequality of a rigid body: "
+            f"the largest exceeds the sum of the other two by {excess:.4f} kg m^2 ({share:.0%}), so no "
+            "rigid satellite has them. The suite runs them as decoded; the attitude dynamics "
+            "J w' = -w x (J w) + u + d hold for any positive definite J, so the control results "
+            "stand as results about this model."
+        )
+    else:
+        lines.append("- None found in the values this suite uses.")
+    return [*lines, ""]
+
+
 def _markdown(
     records: list[dict],
     outcome: PaperOutcome,
@@ -242,6 +269,7 @@ def _markdown(
             f"![gamma]({gamma.relative_to(out).as_posix()})",
             "",
         ]
+    lines += inconsistencies(np.diag(PAPER_P_INERTIA))
     lines += failed_cases(outcome.failures)
     intro = (
         "Every value paper P leaves out is the toolkit's choice "
