@@ -31,8 +31,8 @@ def flexible_group_figure(items: Sequence[tuple[str, dict]], title: str) -> Figu
     Returns
     -------
     matplotlib.figure.Figure
-        Four panels sharing the time axis (rotation error on a log axis, max_i |u_i|, eta_1,
-        max_j |v_j|), one line per run in each panel where the run has that signal.
+        Four panels sharing the time axis (rotation error on a log axis, ``max_i |u_i|``, ``eta_1``,
+        ``max_j |v_j|``), one line per run in each panel where the run has that signal.
     """
     fig = Figure(figsize=(9.0, 11.0))
     FigureCanvasAgg(fig)

@@ -31,7 +31,7 @@ def mrp_group_figure(items: Sequence[tuple[dict, dict]], title: str) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        Three panels sharing the time axis: the error angle (log axis) and max_i |u_i|, one
+        Three panels sharing the time axis: the error angle (log axis) and ``max_i |u_i|``, one
         line per run; the disturbance torque, one dashed line per estimating run and the three
         axes of the true torque.
     """
