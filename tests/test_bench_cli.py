@@ -8,8 +8,11 @@ import sys
 from pathlib import Path
 
 import pytest
+from figure_checks import capture, curves, hline_values, visible_axes, vlines
 
+import benchmarks.reports.figures as paper_figures
 from benchmarks.cli import main
+from benchmarks.families.rigid.defaults import U_MAX
 from benchmarks.suites.paper import EXPERIMENTS, paper_cases
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -17,7 +20,9 @@ ROOT = Path(__file__).resolve().parent.parent
 _CONTRACT_METRICS = ("sum_abs_err", "final_abs_err", "max_abs_u", "solve_time_p50")
 
 
-def test_paper_suite_short_writes_every_file(tmp_path, capsys):
+def test_paper_suite_short_writes_every_file(tmp_path, capsys, monkeypatch):
+    responses = capture(monkeypatch, paper_figures, "responses_figure")
+    gammas = capture(monkeypatch, paper_figures, "gamma_figure")
     out = tmp_path / "paper"
     status = main(["bench", "paper", "--out", str(out), "--short", "--workers", "2"])
     stdout = capsys.readouterr().out
@@ -60,6 +65,38 @@ def test_paper_suite_short_writes_every_file(tmp_path, capsys):
     assert "disturbance axes" in md and "figures/gamma.png" in md
     assert "\\begin{tabular}" in (out / "results.tex").read_text()
     assert (out / "results.csv").read_text().count("\n") == 22  # header + 21 cases
+    _check_paper_figures(records, responses, gammas)
+
+
+def _check_paper_figures(records, responses, gammas):
+    """What the suite drew: per experiment one curve per run in each of the six panels, the
+    +-U_MAX lines in the torque panels, the disturbance onset where there is one; gamma(k) of
+    the runs with a cost bound (RMPC, CRMPC), one log panel per experiment."""
+    runs = {}
+    for rec in records:
+        runs.setdefault(rec["experiment"], []).append(rec)
+    runs["E3_linear_vs_nonlinear"] = runs["E2"] + runs["E3"]
+    drawn = []
+    for args, fig in responses:
+        title = args[1]
+        exp = "E3_linear_vs_nonlinear" if title.startswith("E2 (linear") else title.split(":")[0]
+        drawn.append(exp)
+        assert args[2] == U_MAX
+        grid = visible_axes(fig)
+        assert len(grid) == 6
+        for ax in grid:
+            assert len(curves(ax)) == len(runs[exp]), (exp, ax.get_ylabel())
+        for ax in grid[1::2]:  # the torque column
+            assert ax.get_ylabel().endswith("(N m)") and hline_values(ax) == [-U_MAX, U_MAX]
+        onsets = [r for r in runs[exp] if r["settings"]["disturbance"]]
+        assert len(vlines(grid[0])) == len(onsets)
+    assert sorted(drawn) == sorted([*EXPERIMENTS, "E3_linear_vs_nonlinear"])
+    ((_groups,), fig) = gammas[0]
+    bounded = sorted({r["experiment"] for r in records if r["controller"] in ("RMPC", "CRMPC")})
+    assert [ax.get_title() for ax in visible_axes(fig)] == bounded
+    for ax in visible_axes(fig):
+        expected = [r for r in runs[ax.get_title()] if r["controller"] in ("RMPC", "CRMPC")]
+        assert ax.get_yscale() == "log" and len(curves(ax)) == len(expected)
 
 
 def _sweep_file(tmp_path: Path, text: str) -> Path:

@@ -5,14 +5,18 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
+from figure_checks import capture, curves, hline_values, spans, visible_axes
 
+import benchmarks.reports.fault_figures as fault_figures
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import expand, load_sweep
 from benchmarks.families.wheel.family import case_faults
 from benchmarks.suites.faults import fault_cases
+from models import WheelArray
 from toolkit_common.errors import ConfigError
 
 
@@ -74,7 +78,8 @@ def test_shipped_faults_sweep_expands_over_kind_wheel_onset_and_controller():
     assert len({c.case_id for c in cases}) == len(cases)
 
 
-def test_bench_faults_short_writes_every_file(tmp_path, capsys):
+def test_bench_faults_short_writes_every_file(tmp_path, capsys, monkeypatch):
+    built = capture(monkeypatch, fault_figures, "fault_case_group_figure")
     out = tmp_path / "faults"
     status = main(["bench", "faults", "--out", str(out), "--short", "--workers", "0",
                    "--experiments", "W1", "--no-progress"])
@@ -93,6 +98,23 @@ def test_bench_faults_short_writes_every_file(tmp_path, capsys):
     for section in ("## W1", "## Paper W's reported results", "## Inconsistencies in paper W", "## Settings"):
         assert section in md
     assert "13x" in md and "smoke run" in md
+    # the figure: per controller attitude (3 curves), applied and commanded torque per wheel with
+    # the torque limits, the wheel momenta with the momentum limits, the fault window shaded
+    ((items, windows, title, torque_max, momentum_max), fig) = built[0]
+    assert len(built) == 1 and title.startswith("W1: ")
+    wheels = WheelArray.paper_w()
+    assert torque_max == np.max(wheels.torque_max) and momentum_max == np.max(wheels.momentum_max)
+    assert [rec["controller"] for rec, _ in items] == [r["controller"] for r in records]
+    grid = np.array(visible_axes(fig)).reshape(3, len(items))
+    for col in range(len(items)):
+        att, tor, mom = grid[:, col]
+        assert len(curves(att)) == 3 and len(curves(tor)) == 2 * 4 and len(curves(mom)) == 4
+        assert hline_values(tor) == [-torque_max, torque_max]
+        assert hline_values(mom) == [-momentum_max, momentum_max]
+        t_end = float(items[col][1]["t"][-1])
+        assert spans(att) == [(t0, min(t1, t_end)) for t0, t1 in windows] and len(windows) == 1
+    assert grid[1, 0].get_ylabel().startswith("wheel torque (N m)")
+    assert grid[2, 0].get_ylabel() == "wheel momentum (N m s)"
 
 
 def test_a_run_shorter_than_the_scenario_faults_is_refused():

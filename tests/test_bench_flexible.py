@@ -6,7 +6,9 @@ import json
 
 import numpy as np
 import pytest
+from figure_checks import capture, curves, visible_axes
 
+import benchmarks.reports.flexible_figures as flexible_figures
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
@@ -186,7 +188,8 @@ def test_inconsistency_lines_follow_the_numbers():
     assert any("couples mainly to x" in line for line in falling)
 
 
-def test_bench_flexible_short_writes_every_file(tmp_path, capsys):
+def test_bench_flexible_short_writes_every_file(tmp_path, capsys, monkeypatch):
+    built = capture(monkeypatch, flexible_figures, "flexible_group_figure")
     out = tmp_path / "flex"
     args = ["bench", "flexible", "--out", str(out), "--short", "--workers", "0", "--experiments", "F1"]
     status = main([*args, "--no-progress"])
@@ -202,6 +205,18 @@ def test_bench_flexible_short_writes_every_file(tmp_path, capsys):
     for section in ("## F1", "## Paper V's reported results", "## Inconsistencies", "## Settings", "**V4**"):
         assert section in md
     assert (out / "figures" / "F1.png").stat().st_size > 0
+    # the figure: the four closed loops in each panel; the PZT commands are zero without AVC
+    ((items, title), fig) = built[0]
+    assert len(built) == 1 and title.startswith("F1: ")
+    err, tor, mode, pzt = visible_axes(fig)
+    names = [name for name, _ in items]
+    assert len(names) == 4 and err.get_yscale() == "log"
+    for ax in (err, tor, mode, pzt):
+        assert [line.get_label() for line in curves(ax)] == names
+    assert tor.get_ylabel() == "max_i |u_i| (N m)" and pzt.get_ylabel() == "max_j |v_j| (PZT)"
+    for line, (name, trace) in zip(curves(pzt), items, strict=True):  # the suite's tags: CSMC_AVC, ...
+        np.testing.assert_allclose(line.get_ydata(), np.abs(trace["v"]).max(axis=1))
+        assert (np.max(line.get_ydata()) > 0.0) == name.endswith("_AVC"), name
     assert len(list((out / "traces").glob("F1_*.npz"))) == 4
     assert len((out / "results.csv").read_text().strip().splitlines()) == 5
     assert json.loads((out / "run.json").read_text())["done"] == 4

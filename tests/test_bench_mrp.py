@@ -5,7 +5,10 @@ from __future__ import annotations
 import json
 
 import pytest
+from figure_checks import capture, curves, visible_axes
+from regression import check
 
+import benchmarks.reports.mrp_figures as mrp_figures
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
@@ -57,7 +60,7 @@ def test_mab_reports_its_disturbance_estimate_error():
     rec = run_scenario(Scenario.from_dict({"family": "mrp", "controller": "MAB", "scenario": "M2",
                                            "duration": 4.0, "dt": 0.05}))
     assert rec["metrics"]["td_est_err_max"] is not None
-    assert rec["metrics"]["td_est_err_max"] < 0.05  # the disk's torque is about 0.06 N m at most
+    check("bench_mrp", "mab_m2_torque_estimate_error_max", rec["metrics"]["td_est_err_max"])
 
 
 def test_shipped_gain_sweep_expands():
@@ -67,7 +70,8 @@ def test_shipped_gain_sweep_expands():
     assert bandwidths == {5.0, 10.0, 20.0, 40.0}
 
 
-def test_bench_mrp_short_writes_every_file(tmp_path, capsys):
+def test_bench_mrp_short_writes_every_file(tmp_path, capsys, monkeypatch):
+    built = capture(monkeypatch, mrp_figures, "mrp_group_figure")
     out = tmp_path / "mrp"
     status = main(["bench", "mrp", "--out", str(out), "--short", "--workers", "0", "--experiments", "M1",
                    "--no-progress"])
@@ -83,3 +87,16 @@ def test_bench_mrp_short_writes_every_file(tmp_path, capsys):
     for section in ("## M1", "## Paper M's reported results", "## Settings", "(a) paper M's disk"):
         assert section in md
     assert (out / "figures" / "M1.png").stat().st_size > 0
+    # the figure: one error-angle curve (log axis) and one torque curve per controller; M1 has
+    # no disturbance torque, so the third panel holds only the estimates of MAB and TF-AB
+    ((items, title), fig) = built[0]
+    assert len(built) == 1 and title.startswith("M1: ")
+    err, tor, dist = visible_axes(fig)
+    names = [rec["controller"] for rec, _ in items]
+    assert sorted(names) == sorted(r["controller"] for r in records)
+    assert err.get_yscale() == "log" and [line.get_label() for line in curves(err)] == names
+    assert tor.get_ylabel() == "max_i |u_i| (N m)" and [line.get_label() for line in curves(tor)] == names
+    estimating = [name for name, (_, trace) in zip(names, items, strict=True) if "torque_estimate" in trace]
+    assert {"MAB", "TFAB"} <= set(estimating)
+    assert [line.get_label() for line in curves(dist)][: len(estimating)] == [
+        f"{name} estimate (x)" for name in estimating]

@@ -9,7 +9,10 @@ import math
 
 import numpy as np
 import pytest
+from figure_checks import capture, visible_axes
 
+import benchmarks.timing.plots as timing_plots
+import benchmarks.timing.scale as timing_scale
 from benchmarks.timing import VERTEX_COUNTS, add_timing_parser, config_from_args, polytope
 from toolkit_common.errors import InvalidArgumentError
 
@@ -23,7 +26,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     return parser.parse_args(["timing", *argv])
 
 
-def test_quick_run_writes_the_report(tmp_path, capsys):
+def test_quick_run_writes_the_report(tmp_path, capsys, monkeypatch):
+    built = capture(monkeypatch, timing_plots, "distributions_figure")
     out = tmp_path / "timing"
     # 2 RMPC states on the 2-vertex polytope (every path), 5 ellipsoids, 50 GIPC QPs: ~10 s.
     args = _parse(["--out", str(out), "--quick", "--steps", "2", "--vertices", "2", "--no-progress"])
@@ -84,6 +88,17 @@ def test_quick_run_writes_the_report(tmp_path, capsys):
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
     samples = np.load(out / "timing_samples.npz")
     assert len(samples.files) == len(records)
+    # the figure: one log panel per problem, one box per record, labelled with its path
+    ((_args, fig),) = built
+    panels = visible_axes(fig)
+    problems = [p for p in ("RMPC", "OfflineRMPC", "GIPC") if any(r["problem"] == p for r in records)]
+    assert [ax.get_title().split(":")[0] for ax in panels] == problems
+    for ax, problem in zip(panels, problems, strict=True):
+        recs = [r for r in records if r["problem"] == problem]
+        labels = [r["backend"] if problem == "GIPC"
+                  else f"{r['backend']} / {r['formulation']} / {r['vertices']}v" for r in recs]
+        assert ax.get_yscale() == "log" and ax.get_ylabel() == "time per step (s)"
+        assert [t.get_text() for t in ax.get_xticklabels()] == labels and len(ax.patches) == len(recs)
 
 
 @pytest.mark.parametrize(
@@ -140,7 +155,7 @@ def test_polytopes_hold_the_nominal_plant(count):
         assert np.allclose(b_rates[:, 0], b_rates[:, 1])
 
 
-def test_scale_section_quick_run(tmp_path):
+def test_scale_section_quick_run(tmp_path, monkeypatch):
     """``--problems Scale --quick``: the 6-state rigid hub of the flexible model at 2 and 8
     vertices, 2 states each, and cvxpy + Clarabel (textbook and delta LMIs) on the first state
     (~6 s). Every path has a record with its state dimension and formulation; the IPM ends
@@ -153,6 +168,7 @@ def test_scale_section_quick_run(tmp_path):
     8 vertices (nothing to compare, error ``None``). Asserted: at least the 2-vertex comparisons
     happen, the error is ``None`` exactly when nothing was compared, and below 1e-6 (6x the
     measured 1.7e-7; both solvers stop at a relative gap of 1e-8)."""
+    built = capture(monkeypatch, timing_scale, "scale_figure")
     out = tmp_path / "scale"
     args = _parse(["--out", str(out), "--quick", "--problems", "Scale", "--no-progress",
                    "--scale-cvxpy-steps", "1"])
@@ -180,6 +196,15 @@ def test_scale_section_quick_run(tmp_path):
     md = (out / "timing.md").read_text()
     assert "## Scale" in md and "timing_scale.png" in md
     assert (out / "timing_scale.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the figure: one line per path and vertex count at the state dimension, at its p50
+    ((_args, fig),) = built
+    (ax,) = visible_axes(fig)
+    assert ax.get_yscale() == "log" and ax.get_xlabel() == "state dimension"
+    lines = {c.get_label(): c.lines[0] for c in ax.containers}
+    assert set(lines) == {f"{b} {f}, {v} vertices" for b, f in paths for v in (2, 8)}
+    for rec in records:
+        line = lines[f"{rec['backend']} {rec['formulation']}, {rec['vertices']} vertices"]
+        assert list(line.get_xdata()) == [6] and list(line.get_ydata()) == [rec["p50_s"]]
 
 
 @pytest.mark.parametrize("argv", [["--scale-sizes", "7"], ["--scale-steps", "0"],

@@ -1,5 +1,9 @@
 """Figures of the wheel-fault suite: attitude, wheel torques (commanded and applied, with the
-limits) and wheel momenta per controller, with the fault windows shaded."""
+limits) and wheel momenta per controller, with the fault windows shaded.
+
+:func:`fault_case_group_figure` builds the :class:`matplotlib.figure.Figure` (matplotlib's object
+API on an Agg canvas, no pyplot state); :func:`plot_fault_case_group` writes it as a PNG.
+"""
 
 from __future__ import annotations
 
@@ -8,8 +12,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-__all__ = ["plot_fault_case_group"]
+__all__ = ["fault_case_group_figure", "plot_fault_case_group"]
 
 
 def _shade(ax: Any, windows: Sequence[tuple[float, float]], t_end: float) -> None:
@@ -17,14 +23,13 @@ def _shade(ax: Any, windows: Sequence[tuple[float, float]], t_end: float) -> Non
         ax.axvspan(t0, min(t1, t_end), color="tab:red", alpha=0.12, lw=0)
 
 
-def plot_fault_case_group(
+def fault_case_group_figure(
     items: Sequence[tuple[dict, dict]],
     windows: Sequence[tuple[float, float]],
-    path: Path,
     title: str,
     torque_max: float,
     momentum_max: float,
-) -> Path:
+) -> Figure:
     """One column per run (controller): attitude (deg), wheel torques, wheel momenta.
 
     Parameters
@@ -33,20 +38,22 @@ def plot_fault_case_group(
         The runs; traces hold ``t``, ``x`` (``[eta, w, h]``), ``u_cmd``, ``u_applied``.
     windows : sequence of (t_on, t_off)
         Fault windows, shaded in every panel.
-    path : Path
-        The PNG to write.
     title : str
         The figure's title.
     torque_max, momentum_max : float
         The wheel limits, drawn as dotted lines.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A 3 x ``len(items)`` grid of panels: three attitude lines; per wheel an applied and a
+        dashed commanded torque line with the +-``torque_max`` lines; per wheel a momentum line
+        with the +-``momentum_max`` lines; the fault windows shaded.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     n = max(len(items), 1)
-    fig, axes = plt.subplots(3, n, figsize=(4.2 * n, 8.0), sharex="col", squeeze=False)
+    fig = Figure(figsize=(4.2 * n, 8.0))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(3, n, sharex="col", squeeze=False)
     colors = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
     for col, (rec, trace) in enumerate(items):
         t, x = np.asarray(trace["t"]), np.asarray(trace["x"])
@@ -81,6 +88,31 @@ def plot_fault_case_group(
     note = " (fault windows shaded; dotted: limits; commands clipped at 3x for display)"
     fig.suptitle(title + note, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig
+
+
+def plot_fault_case_group(
+    items: Sequence[tuple[dict, dict]],
+    windows: Sequence[tuple[float, float]],
+    path: Path,
+    title: str,
+    torque_max: float,
+    momentum_max: float,
+) -> Path:
+    """Write :func:`fault_case_group_figure` as a PNG at ``path`` (90 dpi) and return ``path``.
+
+    Parameters
+    ----------
+    items : sequence of (record, trace)
+        The runs; traces hold ``t``, ``x`` (``[eta, w, h]``), ``u_cmd``, ``u_applied``.
+    windows : sequence of (t_on, t_off)
+        Fault windows, shaded in every panel.
+    path : Path
+        The PNG to write.
+    title : str
+        The figure's title.
+    torque_max, momentum_max : float
+        The wheel limits, drawn as dotted lines.
+    """
+    fault_case_group_figure(items, windows, title, torque_max, momentum_max).savefig(path, dpi=90)
     return path

@@ -1,7 +1,8 @@
 """Figures in the style of paper P: attitude in degrees, torques with the limit lines, gamma(k).
 
 Matplotlib's object API with the Agg renderer (no pyplot, no global state, no display): each
-function builds a :class:`matplotlib.figure.Figure` and writes a PNG. Within a figure the
+``*_figure`` function builds and returns a :class:`matplotlib.figure.Figure` (what the tests
+inspect), and each ``plot_*`` function writes that figure as a PNG. Within a figure the
 colour tells the controller and saturation handling apart, the line style the plant
 (solid: nonlinear, dashed: linear), so linear and nonlinear runs overlay directly.
 """
@@ -15,7 +16,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_gamma", "plot_responses"]
+__all__ = ["gamma_figure", "plot_gamma", "plot_responses", "responses_figure"]
 
 _AXIS_LABELS = ("roll $\\phi$", "pitch $\\theta$", "yaw $\\psi$")
 _TORQUE_LABELS = ("$M_x$", "$M_y$", "$M_z$")
@@ -46,19 +47,23 @@ def _colors(runs: Sequence[Run]) -> dict[str, str]:
     return {k: _COLORS[i % len(_COLORS)] for i, k in enumerate(keys)}
 
 
-def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: float) -> Path:
+def responses_figure(runs: Sequence[Run], title: str, u_max: float) -> Figure:
     """Attitude (deg) and applied torque per axis for several runs, with the +-``u_max`` lines.
 
     Parameters
     ----------
     runs : sequence of (record, trace)
         ``trace`` has ``t``, ``x`` and ``u_applied`` (see :func:`benchmarks.core.runner.simulate_scenario`).
-    path : str or Path
-        Output PNG.
     title : str
         Figure title.
     u_max : float
         Torque limit drawn as dotted lines (N m).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Six panels (rows: roll, pitch, yaw; columns: attitude, applied torque), one line per
+        run in each, and the two limit lines in each torque panel.
     """
     fig = Figure(figsize=(11, 8), layout="constrained")
     axes = fig.subplots(3, 2, sharex=True)
@@ -93,15 +98,41 @@ def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: flo
     if handles:
         fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)), fontsize="small")
     fig.suptitle(title)
+    return fig
+
+
+def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: float) -> Path:
+    """Write :func:`responses_figure` as a PNG at ``path`` (110 dpi) and return ``path``.
+
+    Parameters
+    ----------
+    runs : sequence of (record, trace)
+        As for :func:`responses_figure`.
+    path : str or Path
+        Output PNG.
+    title : str
+        Figure title.
+    u_max : float
+        Torque limit drawn as dotted lines (N m).
+    """
     path = Path(path)
-    fig.savefig(path, dpi=110)
+    responses_figure(runs, title, u_max).savefig(path, dpi=110)
     return path
 
 
-def plot_gamma(groups: Mapping[str, Sequence[Run]], path: str | Path) -> Path | None:
+def gamma_figure(groups: Mapping[str, Sequence[Run]]) -> Figure | None:
     """The cost bound gamma(k) on a log axis, one panel per experiment (steps that solved only).
 
-    Returns ``None`` (and writes nothing) when no run has a gamma.
+    Parameters
+    ----------
+    groups : mapping of str to sequence of (record, trace)
+        The runs of each experiment; ``trace`` has ``t`` and ``gamma`` (NaN where no bound).
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        One visible panel per experiment with a finite gamma, one line per such run; ``None``
+        when no run has a gamma.
     """
     panels = {
         name: [(rec, tr) for rec, tr in runs if np.any(np.isfinite(np.asarray(tr["gamma"])))]
@@ -136,6 +167,17 @@ def plot_gamma(groups: Mapping[str, Sequence[Run]], path: str | Path) -> Path | 
     for ax in axes[len(panels) :]:
         ax.set_visible(False)
     fig.suptitle("cost bound gamma(k) of the robust MPC (at the steps that solved)")
+    return fig
+
+
+def plot_gamma(groups: Mapping[str, Sequence[Run]], path: str | Path) -> Path | None:
+    """Write :func:`gamma_figure` as a PNG at ``path`` (110 dpi) and return ``path``.
+
+    Returns ``None`` (and writes nothing) when no run has a gamma.
+    """
+    fig = gamma_figure(groups)
+    if fig is None:
+        return None
     path = Path(path)
     fig.savefig(path, dpi=110)
     return path

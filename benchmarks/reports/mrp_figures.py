@@ -1,5 +1,9 @@
 """Figures of paper M's suite: the error angle (log axis), the torques, and the disk's torque
-next to the estimates of MAB and TF-AB."""
+next to the estimates of MAB and TF-AB.
+
+:func:`mrp_group_figure` builds the :class:`matplotlib.figure.Figure` (matplotlib's object API on
+an Agg canvas, no pyplot state); :func:`plot_mrp_group` writes it as a PNG.
+"""
 
 from __future__ import annotations
 
@@ -7,11 +11,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-__all__ = ["plot_mrp_group"]
+__all__ = ["mrp_group_figure", "plot_mrp_group"]
 
 
-def plot_mrp_group(items: Sequence[tuple[dict, dict]], path: Path, title: str) -> Path:
+def mrp_group_figure(items: Sequence[tuple[dict, dict]], title: str) -> Figure:
     """Three panels for the runs of one experiment (one line per controller).
 
     Parameters
@@ -19,17 +25,19 @@ def plot_mrp_group(items: Sequence[tuple[dict, dict]], path: Path, title: str) -
     items : sequence of (record, trace)
         Traces hold ``t``, ``u_applied``, ``d``, ``error_angle_deg`` and, for the controllers
         with an estimator, ``torque_estimate``.
-    path : Path
-        The PNG to write.
     title : str
         The figure's title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three panels sharing the time axis: the error angle (log axis) and ``max_i |u_i|``, one
+        line per run; the disturbance torque, one dashed line per estimating run and the three
+        axes of the true torque.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax_e, ax_u, ax_d) = plt.subplots(3, 1, figsize=(9.0, 9.0), sharex=True)
+    fig = Figure(figsize=(9.0, 9.0))
+    FigureCanvasAgg(fig)
+    ax_e, ax_u, ax_d = fig.subplots(3, 1, sharex=True)
     for rec, trace in items:
         t = np.asarray(trace["t"])
         name = rec["controller"]
@@ -54,6 +62,20 @@ def plot_mrp_group(items: Sequence[tuple[dict, dict]], path: Path, title: str) -
         ax.legend(fontsize=7, loc="upper right")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig
+
+
+def plot_mrp_group(items: Sequence[tuple[dict, dict]], path: Path, title: str) -> Path:
+    """Write :func:`mrp_group_figure` as a PNG at ``path`` (90 dpi) and return ``path``.
+
+    Parameters
+    ----------
+    items : sequence of (record, trace)
+        As for :func:`mrp_group_figure`.
+    path : Path
+        The PNG to write.
+    title : str
+        The figure's title.
+    """
+    mrp_group_figure(items, title).savefig(path, dpi=90)
     return path

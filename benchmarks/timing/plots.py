@@ -2,7 +2,9 @@
 
 Box plots on a log axis (the paths span microseconds to seconds): the box is the interquartile
 range, the line the median, the whiskers reach the 5th and 95th percentiles, and the dots beyond
-them are single steps. Drawn with matplotlib's Agg canvas directly, so no global backend is set.
+them are single steps. Drawn with matplotlib's Agg canvas directly, so no global backend is set:
+:func:`distributions_figure` returns the :class:`matplotlib.figure.Figure`, :func:`plot_distributions`
+writes it as a PNG.
 """
 
 from __future__ import annotations
@@ -11,8 +13,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 
-__all__ = ["plot_distributions"]
+__all__ = ["distributions_figure", "plot_distributions"]
 
 _PROBLEMS = ("RMPC", "OfflineRMPC", "GIPC")
 
@@ -26,10 +29,24 @@ def _label(rec: dict[str, Any]) -> str:
     return f"{rec['backend']} / {rec['formulation']} / {rec['vertices']}v"
 
 
-def plot_distributions(report: dict[str, Any], samples: dict[str, np.ndarray], path: Path) -> Path:
-    """Write a PNG of the per-step times of every record of ``report`` (``samples`` by record key)."""
+def distributions_figure(report: dict[str, Any], samples: dict[str, np.ndarray]) -> Figure:
+    """The per-step times of every record of ``report`` (``samples`` by record key), as a Figure.
+
+    Parameters
+    ----------
+    report : dict
+        The timing report: ``records`` (each with ``problem``, ``backend``, ``formulation`` and
+        ``vertices``) and ``machine``.
+    samples : dict of str to ndarray
+        The per-step times (s) by record key ``"problem|backend|formulation|vertices"``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per problem with samples (RMPC, OfflineRMPC, GIPC), one box per record on a
+        log time axis; a single "no timing samples" panel when there is none.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
 
     groups = []
     for problem in _PROBLEMS:
@@ -70,5 +87,10 @@ def plot_distributions(report: dict[str, Any], samples: dict[str, np.ndarray], p
         f"{m.get('platform', '')}, {m.get('cpu_count', '?')} CPUs, load {m.get('load_average_start')} "
         f"-> {m.get('load_average_end')}", fontsize=8,
     )
-    fig.savefig(path, dpi=110)
+    return fig
+
+
+def plot_distributions(report: dict[str, Any], samples: dict[str, np.ndarray], path: Path) -> Path:
+    """Write :func:`distributions_figure` as a PNG at ``path`` (110 dpi) and return ``path``."""
+    distributions_figure(report, samples).savefig(path, dpi=110)
     return Path(path)

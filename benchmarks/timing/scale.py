@@ -28,12 +28,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from benchmarks.core.machine import percentiles
 from benchmarks.reports.sections import statuses
 from benchmarks.timing.common import SCS_OPTIONS
 
-__all__ = ["SCALE_SIZES", "SCALE_VERTICES", "plot_scale", "scale_problem", "time_scale"]
+__all__ = ["SCALE_SIZES", "SCALE_VERTICES", "plot_scale", "scale_figure", "scale_problem", "time_scale"]
 
 SCALE_SIZES: tuple[int, ...] = (6, 10, 14, 20)
 SCALE_VERTICES: tuple[int, ...] = (2, 8)
@@ -203,10 +204,21 @@ def format_scale_markdown(records: Sequence[dict[str, Any]], plot_name: str | No
     return lines
 
 
-def plot_scale(records: Sequence[dict[str, Any]], path: Path) -> Path:
-    """p50 (markers and lines) and p95 (bars) of each path against the state dimension, log axis."""
+def scale_figure(records: Sequence[dict[str, Any]]) -> Figure:
+    """p50 (markers and lines) and p95 (bars) of each path against the state dimension, log axis.
+
+    Parameters
+    ----------
+    records : sequence of dict
+        The scale records: ``backend``, ``formulation``, ``vertices``, ``n_states``, ``p50_s``
+        and ``p95_s``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel, one error-bar line per (backend, formulation, vertex count) that has records.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
 
     fig = Figure(figsize=(7.0, 4.2), layout="constrained")
     FigureCanvasAgg(fig)
@@ -230,5 +242,10 @@ def plot_scale(records: Sequence[dict[str, Any]], path: Path) -> Path:
     ax.set_ylabel("time per solve (s): p50, bar to p95")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
-    fig.savefig(path, dpi=110)
+    return fig
+
+
+def plot_scale(records: Sequence[dict[str, Any]], path: Path) -> Path:
+    """Write :func:`scale_figure` as a PNG at ``path`` (110 dpi) and return ``path``."""
+    scale_figure(records).savefig(path, dpi=110)
     return Path(path)
