@@ -125,6 +125,14 @@ FOUND_WORDS: dict[str, tuple[str, ...]] = {
 """Per kind of bad value, the words one of which a clear message uses to say what it found."""
 
 
+def _found_words(label: str, value: Any) -> tuple[str, ...]:
+    """What a clear message says it found: the kind's words, and a string's value in quotes."""
+    words = FOUND_WORDS.get(label, ())
+    if isinstance(value, str):
+        words = (*words, repr(value))
+    return words
+
+
 # --- the grid of targets x arguments x values ------------------------------------------------------
 
 
@@ -150,7 +158,7 @@ def _grid(
                     id=f"{target}.{argument}:{label}",
                     group="api",
                     names=(argument,),
-                    found=FOUND_WORDS.get(label, ()),
+                    found=_found_words(label, value),
                     call=call,
                     kind=label,
                 )
@@ -303,6 +311,8 @@ def _simulate(**kw: Any) -> Any:
         "x0": np.array([1.0, 0.0]),
         "duration": 1.0,
     }
+    if "n_steps" in kw:
+        del args["duration"]
     args.update(kw)
     return simulate(**args)
 
