@@ -234,7 +234,10 @@ class SampledPlant:
 
 
 def _check_dt(dt: float | None, plant_dt: float) -> None:
-    if dt is not None and abs(dt - plant_dt) > 1e-12 * plant_dt:
+    if dt is None:
+        return
+    dt = check_positive(dt, "dt")
+    if abs(dt - plant_dt) > 1e-12 * plant_dt:
         raise InvalidArgumentError("dt", f"None or the plant's dt = {plant_dt:g}", repr(dt))
 
 
