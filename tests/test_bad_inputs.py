@@ -19,7 +19,7 @@ from models import (
     kinematics_matrix,
     zoh,
 )
-from rmpc import LQR, SineDisturbance, StepDisturbance, simulate
+from rmpc import GIPC, LQR, SineDisturbance, StepDisturbance, simulate
 from toolkit_common.errors import SingularityError, ToolkitError
 
 NAN, INF = float("nan"), float("inf")
@@ -189,6 +189,7 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("simulate-limiter-nan-linear", _sim(limiter=lambda u: np.full(3, NAN)), "limiter"),
     ("simulate-limiter-length", _sim(limiter=lambda u: np.zeros(2)), "limiter"),
     ("simulate-sensor-nan", _sim(sensor=lambda t, x: np.full(6, NAN)), "sensor"),
+    ("gipc-backend-unknown", lambda: GIPC(POLY, Np=20, Nc=2, backend="nonsense"), "backend"),
     ("Q-complex", lambda: LQR(POLY, Q6 * (1 + 1j), R3), "Q"),
     ("Q-None", lambda: LQR(POLY, None, R3), "Q"),
     # --- disturbances and actuators -----------------------------------------------------

@@ -235,7 +235,7 @@ class GIPC:
                 )
             self.backend = backend
         elif isinstance(backend, str):
-            self.backend = make_backend(backend, **dict(solver_options or {}))
+            self.backend = make_backend(backend, argument="backend", **dict(solver_options or {}))
         else:
             raise ArgumentTypeError(
                 "backend", "a back-end name or a rmpc.qp.QPBackend", type(backend).__name__
