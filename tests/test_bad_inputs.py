@@ -190,6 +190,11 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("simulate-limiter-length", _sim(limiter=lambda u: np.zeros(2)), "limiter"),
     ("simulate-sensor-nan", _sim(sensor=lambda t, x: np.full(6, NAN)), "sensor"),
     ("gipc-backend-unknown", lambda: GIPC(POLY, Np=20, Nc=2, backend="nonsense"), "backend"),
+    ("lqr-vertex-negative", lambda: LQR(POLY, Q6, R3, vertex=-1), "vertex"),
+    ("vertex-index-negative", lambda: PLANT2.vertex(-1), "index"),
+    ("vertices-zero-states",
+     lambda: PolytopicModel([(np.zeros((0, 0)), np.zeros((0, 1)))], dt=0.1), "vertices"),
+    ("vertices-zero-inputs", lambda: PolytopicModel([(A2, np.zeros((2, 0)))], dt=0.1), "vertices"),
     ("Q-complex", lambda: LQR(POLY, Q6 * (1 + 1j), R3), "Q"),
     ("Q-None", lambda: LQR(POLY, None, R3), "Q"),
     # --- disturbances and actuators -----------------------------------------------------
