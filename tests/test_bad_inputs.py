@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from models import (
+    FlexibleSatellite,
     PolytopicModel,
     ReactionWheelActuator,
     RigidSatellite,
@@ -195,6 +196,8 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("vertices-zero-states",
      lambda: PolytopicModel([(np.zeros((0, 0)), np.zeros((0, 1)))], dt=0.1), "vertices"),
     ("vertices-zero-inputs", lambda: PolytopicModel([(A2, np.zeros((2, 0)))], dt=0.1), "vertices"),
+    ("flexible-zero-quaternion",
+     lambda: FlexibleSatellite.di_gennaro().dynamics(np.zeros(15), np.zeros(3)), "x"),
     ("Q-complex", lambda: LQR(POLY, Q6 * (1 + 1j), R3), "Q"),
     ("Q-None", lambda: LQR(POLY, None, R3), "Q"),
     # --- disturbances and actuators -----------------------------------------------------
