@@ -1,0 +1,180 @@
+"""A damaged, foreign or locked sweep store, or another sweep's folder: exit 2, one line, nothing lost.
+
+Each case used to end in a traceback (sqlite3 and json errors), or silently mixed two sweeps'
+results in one folder.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from benchmarks.cli import main
+from benchmarks.core.store import CaseStore
+from toolkit_common.errors import StoreError
+
+TINY = """name = "tiny"
+description = "one short case"
+[base]
+plant = "linear"
+controller = "LQR"
+saturation = "limiter"
+duration = 0.2
+"""
+
+
+def _store_with_rows(path: Path, n: int = 20) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with CaseStore(path) as store:
+        run = store.begin_run("test")
+        for k in range(n):
+            store.put_done(f"case{k:02d}", k, {"plant": "linear"}, {"metrics": {"x": k}}, run)
+
+
+def _random_bytes(path: Path) -> None:
+    path.write_bytes(np.random.default_rng(0).bytes(8192))
+
+
+def _truncated(path: Path) -> None:
+    _store_with_rows(path)
+    size = path.stat().st_size
+    with open(path, "r+b") as handle:
+        handle.truncate(size // 2)
+
+
+def _foreign_schema(path: Path) -> None:
+    with sqlite3.connect(path) as connection:
+        connection.execute("CREATE TABLE cases (id INTEGER, payload BLOB)")
+
+
+def _folder(path: Path) -> None:
+    path.mkdir()
+
+
+DAMAGE = {"random bytes": _random_bytes, "truncated": _truncated, "foreign schema": _foreign_schema,
+          "folder": _folder}
+
+
+@pytest.mark.parametrize("kind", list(DAMAGE))
+def test_a_damaged_store_is_refused_naming_the_file_and_what_to_do(tmp_path, kind):
+    path = tmp_path / "sweep.sqlite"
+    DAMAGE[kind](path)
+    with pytest.raises(StoreError) as info:
+        CaseStore(path)
+    message = str(info.value)
+    assert str(path) in message and "--out" in message
+
+
+@pytest.mark.parametrize("kind", list(DAMAGE))
+def test_the_cli_reports_a_damaged_store_in_one_line_with_exit_2(tmp_path, capsys, kind):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    out = tmp_path / "out"
+    out.mkdir()
+    DAMAGE[kind](out / "sweep.sqlite")
+    code = main(["bench", "sweep", "--config", str(config), "--out", str(out), "--workers", "0",
+                 "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "sweep.sqlite" in err
+
+
+def test_a_record_that_is_not_json_names_the_case(tmp_path):
+    path = tmp_path / "sweep.sqlite"
+    _store_with_rows(path)
+    with sqlite3.connect(path) as connection:
+        connection.execute("UPDATE cases SET record = '{not json' WHERE case_id = 'case03'")
+    with CaseStore(path) as store, pytest.raises(StoreError, match="case03"):
+        store.rows()
+
+
+def test_a_locked_store_is_reported_as_locked(tmp_path):
+    path = tmp_path / "sweep.sqlite"
+    _store_with_rows(path, 1)
+    holder = sqlite3.connect(path)
+    holder.execute("BEGIN EXCLUSIVE")
+    try:
+        with CaseStore(path, timeout=0.1) as store, pytest.raises(StoreError, match="locked"):
+            store.begin_run("second writer")
+    finally:
+        holder.rollback()
+        holder.close()
+
+
+def test_another_sweeps_folder_is_refused_then_replaced_with_overwrite(tmp_path, capsys):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    other = tmp_path / "other.toml"
+    other.write_text(TINY.replace('name = "tiny"', 'name = "other"'))
+    out = tmp_path / "out"
+    args = ["bench", "sweep", "--out", str(out), "--workers", "0", "--no-progress"]
+    assert main([*args, "--config", str(other)]) == 0
+    before = (out / "results.json").read_text()
+    capsys.readouterr()
+    assert main([*args, "--config", str(config)]) == 2
+    err = capsys.readouterr().err
+    assert "'other'" in err and "--overwrite" in err and len(err.strip().splitlines()) == 1
+    assert (out / "results.json").read_text() == before  # nothing overwritten
+    assert main([*args, "--config", str(config), "--overwrite"]) == 0
+    with CaseStore(out / "sweep.sqlite") as store:
+        assert store.sweep_name() == "tiny"
+        assert len(store.rows()) == 1
+
+
+def test_a_suites_results_folder_is_refused_for_a_sweep(tmp_path, capsys):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.json").write_text(json.dumps([{"experiment": "E1"}]))
+    assert main(["bench", "sweep", "--config", str(config), "--out", str(out), "--workers", "0"]) == 2
+    assert "results.json without a sweep store" in capsys.readouterr().err
+
+
+def test_the_same_sweep_resumes_in_its_own_folder(tmp_path):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    args = ["bench", "sweep", "--config", str(config), "--out", str(tmp_path / "out"), "--workers", "0",
+            "--no-progress"]
+    assert main(args) == 0
+    assert main(args) == 0
+
+
+@pytest.mark.parametrize(
+    ("argv", "word"),
+    [
+        (["bench", "paper", "--out", "", "--workers", "0"], "--out"),
+        (["bench", "paper", "--out", "X", "--experiments", ""], "--experiments"),
+        (["bench", "paper", "--out", "X", "--experiments", "E1,,E2"], "--experiments"),
+        (["bench", "paper", "--out", "X", "--workers", "100000"], "--workers"),
+        (["bench", "paper", "--out", "X", "--duration-scale", "1e12"], "--duration-scale"),
+        (["bench", "paper", "--out", "X", "--duration-scale", "nan"], "--duration-scale"),
+    ],
+)
+def test_bad_options_are_refused_before_anything_runs(tmp_path, capsys, monkeypatch, argv, word):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 2
+    assert word in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_out_that_is_a_file_is_refused(tmp_path, capsys):
+    target = tmp_path / "file.txt"
+    target.write_text("x")
+    with pytest.raises(SystemExit) as info:
+        main(["bench", "paper", "--out", str(target)])
+    assert info.value.code == 2 and "--out" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["-1", "nan", "1e13"])
+def test_demo_duration_out_of_range_is_one_line_naming_the_option(capsys, value):
+    assert main(["demo", "--duration", value]) == 2
+    err = capsys.readouterr().err
+    assert "--duration" in err and len(err.strip().splitlines()) == 1
