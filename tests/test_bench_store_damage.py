@@ -15,7 +15,7 @@ import pytest
 
 from benchmarks.cli import main
 from benchmarks.core.store import CaseStore
-from toolkit_common.errors import StoreError
+from toolkit_common.errors import ConfigError, StoreError
 
 TINY = """name = "tiny"
 description = "one short case"
@@ -178,3 +178,53 @@ def test_demo_duration_out_of_range_is_one_line_naming_the_option(capsys, value)
     assert main(["demo", "--duration", value]) == 2
     err = capsys.readouterr().err
     assert "--duration" in err and len(err.strip().splitlines()) == 1
+
+
+TEN_VALUES = "[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]"
+TEN_FIELDS = ("u_max", "ic_scale", "duration", "disturbance", "disturbance_start")
+GRID_OF_A_MILLION = "[grid]\n" + "".join(f"{field} = {TEN_VALUES}\n" for field in TEN_FIELDS) + (
+    "spread = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]\n"
+)
+
+
+def _write_sweep(tmp_path: Path, body: str) -> Path:
+    config = tmp_path / "sweep.toml"
+    config.write_text(body)
+    return config
+
+
+@pytest.mark.parametrize(
+    ("extra", "where"),
+    [
+        (GRID_OF_A_MILLION, "grid"),
+        ("[montecarlo]\nn = 10000000000000\nseed = 1\n", "montecarlo.n"),
+    ],
+    ids=["grid 10^6", "draws 10^13"],
+)
+def test_a_sweep_beyond_max_cases_is_refused_before_expanding(tmp_path, extra, where):
+    from benchmarks.core.sweep_spec import load_sweep
+
+    body = TINY.replace('plant = "linear"', 'plant = "nonlinear"') if "montecarlo" in extra else TINY
+    with pytest.raises(ConfigError) as info:
+        load_sweep(_write_sweep(tmp_path, body + extra))
+    assert info.value.argument == where and "max_cases" in str(info.value)
+
+
+def test_max_cases_lifts_the_bound(tmp_path):
+    from benchmarks.core.sweep_spec import expand, load_sweep
+
+    body = TINY + "[grid]\nduration = [0.1, 0.2, 0.3]\n"
+    with pytest.raises(ConfigError, match="max_cases = 2 cases"):
+        load_sweep(_write_sweep(tmp_path, "max_cases = 2\n" + body))
+    assert len(expand(load_sweep(_write_sweep(tmp_path, "max_cases = 3\n" + body)))) == 3
+
+
+def test_a_deeply_nested_or_oversized_sweep_file_is_refused(tmp_path):
+    from benchmarks.core.sweep_spec import load_sweep
+
+    deep = 'name = "deep"\n[base]\nsettings = ' + "[" * 5000 + "1" + "]" * 5000 + "\n"
+    with pytest.raises(ConfigError, match="nested too deep"):
+        load_sweep(_write_sweep(tmp_path, deep))
+    big = 'name = "big"\ndescription = "' + "x" * (2**20 + 1) + '"\n'
+    with pytest.raises(ConfigError, match="at most 1048576 bytes"):
+        load_sweep(_write_sweep(tmp_path, big))
