@@ -153,8 +153,8 @@ def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSp
             raise ConfigError(str(key), "a sweep table (" + ", ".join(_TOP_LEVEL) + ")", "an unknown field")
     name = data.get("name", default_name)
     description = data.get("description", "")
-    if not isinstance(name, str) or not name:
-        raise ConfigError("name", "a non-empty string", repr(name))
+    if not isinstance(name, str) or not name.strip() or not name.isprintable():
+        raise ConfigError("name", "a non-empty one-line string of printable characters", repr(name))
     if not isinstance(description, str):
         raise ConfigError("description", "a string", repr(description))
     base = data.get("base", {})
