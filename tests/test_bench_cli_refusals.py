@@ -1,4 +1,4 @@
-"""A damaged, foreign or locked sweep store, or another sweep's folder: exit 2, one line, nothing lost.
+"""What rmpc refuses: damaged or foreign stores, another sweep's folder, oversized sweeps, bad options.
 
 Each case used to end in a traceback (sqlite3 and json errors), or silently mixed two sweeps'
 results in one folder.
@@ -228,3 +228,12 @@ def test_a_deeply_nested_or_oversized_sweep_file_is_refused(tmp_path):
     big = 'name = "big"\ndescription = "' + "x" * (2**20 + 1) + '"\n'
     with pytest.raises(ConfigError, match="at most 1048576 bytes"):
         load_sweep(_write_sweep(tmp_path, big))
+
+
+@pytest.mark.parametrize("name", ["a\\n# b", "", "  ", "tab\\there"])
+def test_a_sweep_name_must_be_one_printable_line(tmp_path, name):
+    from benchmarks.core.sweep_spec import load_sweep
+
+    with pytest.raises(ConfigError) as info:
+        load_sweep(_write_sweep(tmp_path, TINY.replace('name = "tiny"', f'name = "{name}"')))
+    assert info.value.argument == "name"
