@@ -20,7 +20,7 @@ from models import (
     kinematics_matrix,
     zoh,
 )
-from rmpc import GIPC, LQR, SineDisturbance, StepDisturbance, simulate
+from rmpc import GIPC, LQR, OfflineRMPC, SineDisturbance, StepDisturbance, simulate
 from toolkit_common.errors import SingularityError, ToolkitError
 
 NAN, INF = float("nan"), float("inf")
@@ -198,6 +198,13 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("vertices-zero-inputs", lambda: PolytopicModel([(A2, np.zeros((2, 0)))], dt=0.1), "vertices"),
     ("flexible-zero-quaternion",
      lambda: FlexibleSatellite.di_gennaro().dynamics(np.zeros(15), np.zeros(3)), "x"),
+    ("gipc-Np-beyond-max_horizon", lambda: GIPC(POLY, Np=10**6), "Np"),
+    ("gipc-Np-beyond-lifted-max_horizon", lambda: GIPC(POLY, Np=11, Nc=2, max_horizon=10), "Np"),
+    ("gipc-max_horizon-zero", lambda: GIPC(POLY, max_horizon=0), "max_horizon"),
+    ("offline-n_ellipsoids-beyond-shrink", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=10**7),
+     "n_ellipsoids"),
+    ("offline-n_ellipsoids-41-at-half", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=41),
+     "n_ellipsoids"),
     ("Q-complex", lambda: LQR(POLY, Q6 * (1 + 1j), R3), "Q"),
     ("Q-None", lambda: LQR(POLY, None, R3), "Q"),
     # --- disturbances and actuators -----------------------------------------------------
