@@ -54,7 +54,7 @@ def _describe_shape(arr: np.ndarray) -> str:
 
 
 def _to_float_array(
-    value: Any, name: str, expected: str = "a numeric array", *, copy: bool = False, allow_bool: bool = True
+    value: Any, name: str, expected: str = "a numeric array", *, copy: bool = False, allow_bool: bool = False
 ) -> np.ndarray:
     """``value`` as a float array (a new one with ``copy``).
 
@@ -223,9 +223,14 @@ def check_positive(value: Any, name: str, allow_zero: bool = False) -> float:
 
 
 def check_choice(value: Any, name: str, choices: Iterable[Any]) -> Any:
-    """Check that ``value`` is one of ``choices`` and return it."""
+    """Check that ``value`` is one of ``choices`` and return it (an array or any value that cannot
+    be compared is not one of them)."""
     options = list(choices)
-    if value not in options:
+    try:
+        known = not isinstance(value, np.ndarray) and any(bool(value == option) for option in options)
+    except (TypeError, ValueError):
+        known = False
+    if not known:
         listed = ", ".join(repr(c) for c in options)
         raise InvalidArgumentError(name, f"one of {listed}", repr(value))
     return value
