@@ -77,6 +77,9 @@ def _bounded_positive(limit: float) -> Any:
 MAX_DEMO_DURATION = 3600.0
 """Bound on ``rmpc demo --duration`` (s): an hour of simulated time at 10 ms."""
 
+MAX_CASE_TIME_LIMIT = 7 * 24 * 3600.0
+"""Bound on ``--case-time-limit`` (s): a week."""
+
 MAX_DURATION_SCALE = 100.0
 """Bound on ``--duration-scale``: paper P's 30 s runs become 50 min of simulated time."""
 
@@ -213,6 +216,7 @@ def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
         progress=None if not args.no_progress else False,
         argv=argv,
         overwrite=args.overwrite,
+        case_time_limit=args.case_time_limit,
     )
     ex = outcome.execution
     print(
@@ -315,6 +319,13 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         help="a Dask scheduler (tcp://host:port) to run the cases on instead of local workers",
     )
     sweep.add_argument("--retry-errors", action="store_true", help="run again the cases stored with an error")
+    sweep.add_argument(
+        "--case-time-limit",
+        type=_bounded_positive(MAX_CASE_TIME_LIMIT),
+        default=None,
+        metavar="S",
+        help="stop a case after S seconds of wall time and store it as a time_limit error (not on Dask)",
+    )
     sweep.add_argument(
         "--overwrite",
         action="store_true",

@@ -237,3 +237,18 @@ def test_a_sweep_name_must_be_one_printable_line(tmp_path, name):
     with pytest.raises(ConfigError) as info:
         load_sweep(_write_sweep(tmp_path, TINY.replace('name = "tiny"', f'name = "{name}"')))
     assert info.value.argument == "name"
+
+
+def test_a_case_past_its_time_limit_is_stored_as_time_limit_and_the_rest_runs(tmp_path):
+    """Two RMPC cases on the linear plant: 0.2 s (20 solves, well under a second) is done; 120 s
+    (12000 solves, a minute or more) is stopped by a 5 s limit and stored as a time_limit error."""
+    body = TINY.replace('controller = "LQR"', 'controller = "RMPC"') + "[grid]\nduration = [0.2, 120.0]\n"
+    config = _write_sweep(tmp_path, body)
+    out = tmp_path / "out"
+    args = ["--out", str(out), "--workers", "0", "--no-progress", "--case-time-limit", "5"]
+    assert main(["bench", "sweep", "--config", str(config), *args]) == 1  # a case failed
+    with CaseStore(out / "sweep.sqlite") as store:
+        rows = {row["scenario"]["duration"]: row for row in store.rows()}
+    stopped = rows[120.0]
+    assert stopped["status"] == "error" and stopped["error"].startswith("time_limit: "), stopped["error"]
+    assert rows[0.2]["status"] == "done"

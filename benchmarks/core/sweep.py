@@ -34,6 +34,7 @@ from benchmarks.core.sweep_spec import (
 )
 from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
 from toolkit_common.errors import StoreError
+from toolkit_common.validation import check_positive
 
 __all__ = [
     "SHIPPED",
@@ -72,6 +73,7 @@ def run_sweep(
     progress: bool | None = None,
     argv: Sequence[str] | None = None,
     overwrite: bool = False,
+    case_time_limit: float | None = None,
 ) -> SweepOutcome:
     """Run the cases of ``config`` not yet in ``out``'s store, then write the reports from the store.
 
@@ -95,7 +97,13 @@ def run_sweep(
         Replace what ``out`` holds when it belongs to another sweep or another run (by default
         such a folder is refused with :class:`~toolkit_common.errors.StoreError`, so one sweep
         never overwrites another's results).
+    case_time_limit : float, optional
+        Wall-clock seconds a case may run; a case that runs longer is stopped and stored as an
+        error whose message starts with ``time_limit`` (the rest runs on). Enforced in local
+        worker processes and with ``workers=0``; Dask runs cases in threads, where it is not.
     """
+    if case_time_limit is not None:
+        case_time_limit = check_positive(case_time_limit, "case_time_limit")
     spec = load_sweep(config)
     cases = expand(spec)
     _refuse_other_results(Path(out), spec.name, overwrite)
@@ -118,7 +126,13 @@ def run_sweep(
         if todo:
             run = store.begin_run(shlex.join(["rmpc", *(argv or sys.argv[1:])]))
             by_id = {sc.case_id: sc for sc in todo}
-            tasks = [Task(sc.case_id, {"scenario": sc.to_dict(), "experiment": sc.case_id}) for sc in todo]
+            tasks = [
+                Task(
+                    sc.case_id,
+                    {"scenario": sc.to_dict(), "experiment": sc.case_id, "time_limit": case_time_limit},
+                )
+                for sc in todo
+            ]
             with CaseProgress(len(tasks), f"sweep {spec.name}", progress) as bar:
 
                 def on_result(task: Task, result: dict[str, Any]) -> None:
