@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from toolkit_common.errors import ToolkitError
+from toolkit_common.errors import InvalidArgumentError, ToolkitError
 
 __all__ = ["main"]
 
@@ -18,6 +18,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from models import PAPER_P_SAMPLE_TIME, RigidSatellite, TorqueLimiter
     from rmpc import LQR, simulate
 
+    if not 0 < args.duration <= MAX_DEMO_DURATION:  # NaN fails too
+        expected = f"a number of seconds in (0, {MAX_DEMO_DURATION:g}]"
+        raise InvalidArgumentError("--duration", expected, repr(args.duration))
     sat = RigidSatellite.paper_p()
     x0 = sat.initial_state()
     plant = sat.linear_model(x0, PAPER_P_SAMPLE_TIME)
@@ -36,28 +39,67 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0 if np.all(err < 1e-2) else 1
 
 
+def max_workers() -> int:
+    """The most local worker processes ``--workers`` accepts: 4 per CPU, at least 64."""
+    from benchmarks.core.executors import default_workers
+
+    return max(64, 4 * default_workers())
+
+
 def _workers(text: str) -> int:
+    limit = max_workers()
+    expected = f"expected an integer in [0, {limit}] (4 per CPU; --scheduler runs on more machines)"
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, found {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, found {text!r}")
+        raise argparse.ArgumentTypeError(f"{expected}, found {text!r}") from None
+    if not 0 <= value <= limit:
+        raise argparse.ArgumentTypeError(f"{expected}, found {text!r}")
     return value
 
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, found {text!r}") from None
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, found {text!r}")
-    return value
+def _bounded_positive(limit: float) -> Any:
+    """An argparse type: a finite number in ``(0, limit]``."""
+
+    def parse(text: str) -> float:
+        expected = f"expected a number in (0, {limit:g}]"
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{expected}, found {text!r}") from None
+        if not 0 < value <= limit:
+            raise argparse.ArgumentTypeError(f"{expected}, found {text!r}")
+        return value
+
+    return parse
+
+
+MAX_DEMO_DURATION = 3600.0
+"""Bound on ``rmpc demo --duration`` (s): an hour of simulated time at 10 ms."""
+
+MAX_CASE_TIME_LIMIT = 7 * 24 * 3600.0
+"""Bound on ``--case-time-limit`` (s): a week."""
+
+MAX_DURATION_SCALE = 100.0
+"""Bound on ``--duration-scale``: paper P's 30 s runs become 50 min of simulated time."""
 
 
 def _experiments(text: str) -> list[str]:
-    return [part.strip() for part in text.split(",") if part.strip()]
+    parts = [part.strip() for part in text.split(",")]
+    if not text.strip() or any(not part for part in parts):
+        raise argparse.ArgumentTypeError(f"expected experiment names separated by commas, found {text!r}")
+    return parts
+
+
+def _out_dir(text: str) -> str:
+    """An argparse type for ``--out``: a folder name, not empty, not an existing file."""
+    import os
+
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a folder name, found {text!r}")
+    if os.path.exists(text) and not os.path.isdir(text):
+        raise argparse.ArgumentTypeError(f"expected a folder, found the file {text!r}")
+    return text
 
 
 def _cmd_bench_paper(args: argparse.Namespace) -> int:
@@ -151,7 +193,7 @@ def _add_suite(bsub: Any, name: str, workers_help: str) -> None:
     module, runner, help_text, description, short_help, metavar = _SUITES[name]
     status = "Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted."
     parser = bsub.add_parser(name, help=help_text, description=f"{description} {status}")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    parser.add_argument("--out", required=True, type=_out_dir, metavar="DIR", help="output directory")
     parser.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS", help="a Dask scheduler instead")
     parser.add_argument("--short", action="store_true", help=short_help)
@@ -173,6 +215,8 @@ def _cmd_bench_sweep(args: argparse.Namespace, argv: Sequence[str]) -> int:
         retry_errors=args.retry_errors,
         progress=None if not args.no_progress else False,
         argv=argv,
+        overwrite=args.overwrite,
+        case_time_limit=args.case_time_limit,
     )
     ex = outcome.execution
     print(
@@ -220,13 +264,13 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         "results_table.json, run.json, figures/*.png and traces/*.npz into DIR. Exit status: 0 all done, "
         "1 some cases failed, 2 bad input, 130 interrupted.",
     )
-    paper.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    paper.add_argument("--out", required=True, type=_out_dir, metavar="DIR", help="output directory")
     paper.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
     paper.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run on a Dask scheduler instead")
     length = paper.add_mutually_exclusive_group()
     length.add_argument(
         "--duration-scale",
-        type=_positive,
+        type=_bounded_positive(MAX_DURATION_SCALE),
         default=1.0,
         metavar="F",
         help="multiply every duration and the disturbance time by F (default 1)",
@@ -264,7 +308,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         metavar="FILE",
         help="the sweep TOML file, or the name of a shipped one (smoke, uncertainty, ...)",
     )
-    sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (holds the store)")
+    sweep.add_argument(
+        "--out", required=True, type=_out_dir, metavar="DIR", help="output directory (holds the store)"
+    )
     sweep.add_argument("--workers", type=_workers, default=None, metavar="N", help=workers_help)
     sweep.add_argument(
         "--scheduler",
@@ -273,6 +319,18 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         help="a Dask scheduler (tcp://host:port) to run the cases on instead of local workers",
     )
     sweep.add_argument("--retry-errors", action="store_true", help="run again the cases stored with an error")
+    sweep.add_argument(
+        "--case-time-limit",
+        type=_bounded_positive(MAX_CASE_TIME_LIMIT),
+        default=None,
+        metavar="S",
+        help="stop a case after S seconds of wall time and store it as a time_limit error (not on Dask)",
+    )
+    sweep.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace what DIR holds when it belongs to another sweep or run (refused by default)",
+    )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     sweep.set_defaults(func=_cmd_bench_sweep)
 

@@ -361,7 +361,7 @@ class NestedKothareProblem:
     def design_ray(self, x0: Any, n_ellipsoids: int, shrink: float = 0.5) -> OfflineTable:
         """Design states geometrically spaced along the ray of ``x0``: ``x_i = shrink^(i-1) x0``."""
         x0 = as_vector(x0, "x0", self.data.n)
-        count = _check_count(n_ellipsoids)
+        count = check_ellipsoid_count(n_ellipsoids, shrink)
         shrink = _check_shrink(shrink)
         return self.design(np.array([x0 * shrink**i for i in range(count)]))
 
@@ -377,7 +377,7 @@ class NestedKothareProblem:
         """
         d = self.data
         x = as_vector(x0, "x0", d.n)
-        count = _check_count(n_ellipsoids)
+        count = check_ellipsoid_count(n_ellipsoids, shrink)
         level_next = _check_shrink(shrink) ** 2
         a_sim = d.A.mean(axis=0) if A is None else as_matrix(A, "A", (d.n, d.n))
         b_sim = d.B.mean(axis=0) if B is None else as_matrix(B, "B", (d.n, d.m))
@@ -405,9 +405,38 @@ class NestedKothareProblem:
                 steps += 1
 
 
-def _check_count(n_ellipsoids: Any) -> int:
+SMALLEST_SCALE = 1e-12
+"""The smallest design state, relative to the first, the nested design goes down to."""
+
+
+def check_ellipsoid_count(n_ellipsoids: Any, shrink: Any) -> int:
+    """``n_ellipsoids`` as an int, at most what ``shrink`` allows.
+
+    Ellipsoid ``k`` is designed at a state ``shrink^k`` times the first (on the ray, or at least
+    that much smaller along a trajectory), so beyond ``1 + log(1e-12) / log(shrink)`` ellipsoids
+    (40 at the default 0.5) the design states fall below 1e-12 of the first and the SDPs
+    degenerate; a count above that is refused, naming the ``shrink`` that would allow it. (A count
+    of 10 million was accepted and designed ellipsoid by ellipsoid.)
+
+    Examples
+    --------
+    >>> check_ellipsoid_count(15, 0.5)
+    15
+    >>> try:
+    ...     check_ellipsoid_count(41, 0.5)
+    ... except ValueError as err:
+    ...     print(err.found, "|", err.expected)
+    41 | at most 40 for shrink = 0.5 (a shrink nearer 1 allows more)
+    """
     if isinstance(n_ellipsoids, bool) or not isinstance(n_ellipsoids, int | np.integer) or n_ellipsoids < 1:
         raise InvalidArgumentError("n_ellipsoids", "a positive integer", repr(n_ellipsoids))
+    factor = _check_shrink(shrink)
+    most = 1 + int(np.floor(np.log(SMALLEST_SCALE) / np.log(factor)))
+    if n_ellipsoids > most:
+        raise InvalidArgumentError(
+            "n_ellipsoids", f"at most {most} for shrink = {factor:g} (a shrink nearer 1 allows more)",
+            repr(int(n_ellipsoids)),
+        )
     return int(n_ellipsoids)
 
 

@@ -199,10 +199,14 @@ class PolytopicModel:
             a = as_matrix(pair[0], f"vertices[{j}] A")
             if n is None:
                 n = a.shape[0]
+                if n == 0:
+                    raise InvalidArgumentError(f"vertices[{j}] A", "at least one state", "shape (0, 0)")
             a = as_matrix(a, f"vertices[{j}] A", (n, n))
             b = as_matrix(pair[1], f"vertices[{j}] B", (n, m))
             if m is None:
                 m = b.shape[1]
+                if m == 0:
+                    raise InvalidArgumentError(f"vertices[{j}] B", "at least one input", f"shape {b.shape}")
             a_list.append(a)
             b_list.append(b)
         assert n is not None and m is not None
@@ -325,7 +329,8 @@ class PolytopicModel:
 
     def vertex(self, index: int) -> tuple[np.ndarray, np.ndarray]:
         """Return vertex ``index`` as an ``(A, B)`` pair."""
-        if not isinstance(index, int | np.integer) or not -self.n_vertices <= index < self.n_vertices:
+        n_vertices = self.n_vertices
+        if isinstance(index, bool) or not isinstance(index, int | np.integer) or not 0 <= index < n_vertices:
             raise InvalidArgumentError(
                 "index", f"an integer in [0, {self.n_vertices - 1}]", repr(index)
             )

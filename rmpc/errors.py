@@ -11,6 +11,7 @@ from toolkit_common.errors import (
     InvalidArgumentError,
     SingularityError,
     SolverError,
+    StoreError,
     ToolkitError,
 )
 
@@ -20,5 +21,6 @@ __all__ = [
     "InvalidArgumentError",
     "SingularityError",
     "SolverError",
+    "StoreError",
     "ToolkitError",
 ]

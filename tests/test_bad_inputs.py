@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from models import (
+    FlexibleSatellite,
     PolytopicModel,
     ReactionWheelActuator,
     RigidSatellite,
@@ -19,7 +20,7 @@ from models import (
     kinematics_matrix,
     zoh,
 )
-from rmpc import LQR, SineDisturbance, StepDisturbance, simulate
+from rmpc import GIPC, LQR, OfflineRMPC, SineDisturbance, StepDisturbance, simulate
 from toolkit_common.errors import SingularityError, ToolkitError
 
 NAN, INF = float("nan"), float("inf")
@@ -175,6 +176,37 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("simulate-disturbance-type", _sim(disturbance=0.1), "disturbance"),
     ("simulate-actuator-axes", _sim(actuator=ReactionWheelActuator(n_axes=2)), "actuator"),
     ("simulate-limiter", _sim(limiter=1.0), "limiter"),
+    ("simulate-dt-nan", _sim(dt=NAN), "dt"),
+    ("simulate-dt-string", _sim(dt="0.01"), "dt"),
+    ("simulate-duration-below-dt", _sim(duration=0.004), "duration"),
+    ("simulate-duration-beyond-max_steps", _sim(duration=1e12), "duration"),
+    ("simulate-n_steps-beyond-max_steps", _sim(duration=None, n_steps=11, max_steps=10), "n_steps"),
+    ("simulate-max_steps-zero", _sim(max_steps=0), "max_steps"),
+    ("simulate-disturbance-nan-rigid", _sim(plant=SAT, dt=0.01, disturbance=lambda t: np.full(3, NAN)),
+     "disturbance"),
+    ("simulate-disturbance-nan-later", _sim(disturbance=lambda t: np.full(3, NAN if t > 0.02 else 0.0)),
+     "disturbance"),
+    ("simulate-limiter-nan-rigid", _sim(plant=SAT, dt=0.01, limiter=lambda u: np.full(3, NAN)), "limiter"),
+    ("simulate-limiter-nan-linear", _sim(limiter=lambda u: np.full(3, NAN)), "limiter"),
+    ("simulate-limiter-length", _sim(limiter=lambda u: np.zeros(2)), "limiter"),
+    ("simulate-sensor-nan", _sim(sensor=lambda t, x: np.full(6, NAN)), "sensor"),
+    ("gipc-backend-unknown", lambda: GIPC(POLY, Np=20, Nc=2, backend="nonsense"), "backend"),
+    ("lqr-vertex-negative", lambda: LQR(POLY, Q6, R3, vertex=-1), "vertex"),
+    ("vertex-index-negative", lambda: PLANT2.vertex(-1), "index"),
+    ("vertices-zero-states",
+     lambda: PolytopicModel([(np.zeros((0, 0)), np.zeros((0, 1)))], dt=0.1), "vertices"),
+    ("vertices-zero-inputs", lambda: PolytopicModel([(A2, np.zeros((2, 0)))], dt=0.1), "vertices"),
+    ("flexible-zero-quaternion",
+     lambda: FlexibleSatellite.di_gennaro().dynamics(np.zeros(15), np.zeros(3)), "x"),
+    ("gipc-Np-beyond-max_horizon", lambda: GIPC(POLY, Np=10**6), "Np"),
+    ("gipc-Np-beyond-lifted-max_horizon", lambda: GIPC(POLY, Np=11, Nc=2, max_horizon=10), "Np"),
+    ("gipc-max_horizon-zero", lambda: GIPC(POLY, max_horizon=0), "max_horizon"),
+    ("offline-n_ellipsoids-beyond-shrink", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=10**7),
+     "n_ellipsoids"),
+    ("offline-n_ellipsoids-41-at-half", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=41),
+     "n_ellipsoids"),
+    ("Q-complex", lambda: LQR(POLY, Q6 * (1 + 1j), R3), "Q"),
+    ("Q-None", lambda: LQR(POLY, None, R3), "Q"),
     # --- disturbances and actuators -----------------------------------------------------
     ("step-magnitude-nan", lambda: StepDisturbance([NAN, 0.0, 0.0]), "magnitude"),
     ("step-t_start-negative", lambda: StepDisturbance([0.1, 0.0, 0.0], t_start=-1.0), "t_start"),

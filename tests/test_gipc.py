@@ -220,7 +220,7 @@ def test_solver_failure_holds_the_previous_input(
         ({"C": np.eye(5)}, "C"),
         ({"x_ref": np.zeros(5)}, "x_ref"),
         ({"u0": [2.0, 0.0, 0.0]}, "u0"),                          # outside u_max
-        ({"backend": "gurobi"}, "name"),
+        ({"backend": "gurobi"}, "backend"),
         ({"solver_options": {"eps": 1.0}}, "settings 'eps'"),
         ({"backend": ProxQPBackend(), "solver_options": {"eps_abs": 1e-6}}, "solver_options"),
     ],

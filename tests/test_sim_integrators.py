@@ -110,20 +110,21 @@ def _deadline(seconds: int) -> Iterator[None]:
         signal.signal(signal.SIGALRM, previous)
 
 
-def test_a_nan_right_hand_side_stops_dop853_with_the_time(sat: RigidSatellite) -> None:
-    """A NaN at the start of a DOP853 piece would make ``solve_ivp`` shrink its step forever."""
+def test_a_nan_disturbance_stops_dop853_with_the_time(sat: RigidSatellite) -> None:
+    """A NaN in a DOP853 piece would make ``solve_ivp`` shrink its step forever; the disturbance is named."""
     x0 = np.array([0.1, 0.0, 0.0, 0.1, 0.2, 0.0])
-    with _deadline(60), pytest.raises(InvalidArgumentError, match="plant") as err:
+    with _deadline(60), pytest.raises(InvalidArgumentError, match=r"^disturbance: ") as err:
         simulate(_Zero(), sat, x0, duration=1.0, dt=0.1, disturbance=_NaNAfter(0.3))
-    assert "x'" in str(err.value) and "t = 0.3 s" in str(err.value)
+    assert "t = 0.3 s" in str(err.value)
 
 
-def test_a_nan_right_hand_side_stops_rk4_with_the_time(sat: RigidSatellite) -> None:
+def test_a_nan_disturbance_stops_rk4_with_the_time(sat: RigidSatellite) -> None:
+    """RK4 evaluates the disturbance at its substeps: the first one at or after 0.35 s is named."""
     x0 = np.array([0.1, 0.0, 0.0, 0.1, 0.2, 0.0])
     plant = SampledPlant(sat, 0.1, integrator="RK4", substep=0.01)
-    with pytest.raises(InvalidArgumentError, match="plant") as err:
+    with pytest.raises(InvalidArgumentError, match=r"^disturbance: ") as err:
         simulate(_Zero(), plant, x0, duration=1.0, disturbance=_NaNAfter(0.35))
-    assert "t = 0.4 s" in str(err.value) and "RK4 from t = 0.3 s" in str(err.value)
+    assert "t = 0.35 s" in str(err.value)
 
 
 class _NaNStage:
@@ -136,3 +137,28 @@ def test_a_nan_input_stage_is_named_with_the_time(sat: RigidSatellite) -> None:
     with pytest.raises(InvalidArgumentError, match="input_stage") as err:
         simulate(_Zero(), plant, np.zeros(6), duration=1.0)
     assert "t = 0.2 s" in str(err.value)
+
+
+class _NaNBeyond:
+    """A user's plant: the rigid satellite whose own right-hand side turns NaN once roll passes 0.25 rad."""
+
+    def __init__(self, sat: RigidSatellite) -> None:
+        self.sat = sat
+        self.n_states, self.n_inputs = sat.n_states, sat.n_inputs
+
+    def dynamics(self, x: np.ndarray, u: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+        out = self.sat.dynamics(x, u, d)
+        return np.full_like(out, np.nan) if x[0] > 0.25 else out
+
+
+@pytest.mark.parametrize("integrator", ["DOP853", "RK4"])
+def test_a_nan_plant_right_hand_side_stops_with_the_time(sat: RigidSatellite, integrator: str) -> None:
+    """The plant's own NaN (no callback to blame) stops the integrator with the plant named and the time."""
+    x0 = np.array([0.1, 0.0, 0.0, 0.1, 0.0, 0.0])  # roll rate 0.1 rad/s: roll passes 0.25 rad near 1.5 s
+    plant = SampledPlant(_NaNBeyond(sat), 0.1, integrator=integrator, substep=0.01)
+    with _deadline(60), pytest.raises(InvalidArgumentError, match=r"^plant: ") as err:
+        simulate(_Zero(), plant, x0, duration=3.0)
+    message = str(err.value)
+    assert "x'" in message and "nan" in message
+    t_reported = float(message.split("at t = ")[1].split(" s")[0])
+    assert 1.3 <= t_reported <= 1.7, message

@@ -7,11 +7,15 @@ import pytest
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import (
+    as_array,
     as_inertia,
+    as_matrix,
     as_optional_limits,
     as_positive_values,
     as_square_matrix,
+    as_vector,
     check_bool,
+    check_positive,
     renamed_arguments,
 )
 
@@ -111,3 +115,30 @@ def test_renamed_arguments_name_the_new_argument() -> None:
         polytope(0.1, inertia_spread=0.2)
     with pytest.raises(ArgumentTypeError, match="'factor'"):
         polytope(0.1, scale=2.0)
+
+
+@pytest.mark.parametrize(
+    "check",
+    [
+        lambda: as_vector([1.0, 2.0 + 1.0j], "x"),
+        lambda: as_matrix(np.diag([1.0, 1.0 + 1.0j]), "Q"),
+        lambda: as_array([[1.0j]], "M"),
+    ],
+)
+def test_complex_values_are_refused_not_cast(check) -> None:
+    """numpy would drop the imaginary part with only a ComplexWarning; the checks refuse it and say where."""
+    with pytest.raises(ArgumentTypeError, match=r"expected real values, but found complex .*1j\)? at index"):
+        check()
+
+
+def test_complex_with_zero_imaginary_parts_is_its_real_part() -> None:
+    values = np.linalg.eigvals(np.diag([1.0, 2.0])).astype(complex)
+    np.testing.assert_array_equal(as_vector(values, "x"), [1.0, 2.0])
+
+
+@pytest.mark.parametrize("check", [lambda: as_vector(None, "x"), lambda: as_matrix(None, "Q"),
+                                   lambda: check_positive(None, "dt")])
+def test_none_is_named_as_none(check) -> None:
+    """``None`` used to become NaN or a 1 x 1 matrix and was reported as 'shape (1, 1)'."""
+    with pytest.raises(ArgumentTypeError, match=r"but found None$"):
+        check()

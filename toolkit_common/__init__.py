@@ -13,6 +13,7 @@ from toolkit_common.errors import (
     InvalidArgumentError,
     SingularityError,
     SolverError,
+    StoreError,
     ToolkitError,
 )
 
@@ -22,5 +23,6 @@ __all__ = [
     "InvalidArgumentError",
     "SingularityError",
     "SolverError",
+    "StoreError",
     "ToolkitError",
 ]

@@ -60,6 +60,14 @@ class ConfigError(InvalidArgumentError):
     """
 
 
+class StoreError(InvalidArgumentError):
+    """A sweep's store (``DIR/sweep.sqlite``) is damaged, foreign, locked or holds another sweep.
+
+    ``argument`` is the store's path (or ``--out``); the message says what was found and what to
+    do about it.
+    """
+
+
 class SingularityError(ToolkitError, ArithmeticError):
     """A model was evaluated where it is singular (3-2-1 Euler angles at pitch = +-90 deg)."""
 

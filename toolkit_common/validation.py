@@ -54,14 +54,33 @@ def _describe_shape(arr: np.ndarray) -> str:
 
 
 def _to_float_array(
-    value: Any, name: str, expected: str = "a numeric array", *, copy: bool = False, allow_bool: bool = True
+    value: Any, name: str, expected: str = "a numeric array", *, copy: bool = False, allow_bool: bool = False
 ) -> np.ndarray:
-    """``value`` as a float array (a new one with ``copy``); a string or a non-numeric value is an error."""
+    """``value`` as a float array (a new one with ``copy``).
+
+    A string, ``None``, a non-numeric value or a complex value with a nonzero imaginary part is an
+    error that says what was found (a complex array whose imaginary parts are all zero, as
+    eigenvalue routines return, is taken as its real part).
+    """
     rejected = str | bytes if allow_bool else str | bytes | bool | np.bool_
+    if value is None:
+        raise ArgumentTypeError(name, expected, "None")
     if isinstance(value, rejected):
         raise ArgumentTypeError(name, expected, f"{type(value).__name__} {value!r}")
     try:
-        return np.array(value, dtype=float) if copy else np.asarray(value, dtype=float)
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as err:
+        raise ArgumentTypeError(name, expected, f"{type(value).__name__} ({err})") from None
+    if np.iscomplexobj(raw):
+        imaginary = np.abs(np.imag(raw))
+        if raw.size and float(np.nanmax(imaginary, initial=0.0)) > 0.0:
+            where = tuple(int(i) for i in np.argwhere(imaginary > 0)[0])
+            raise ArgumentTypeError(
+                name, "real values", f"complex {raw[where] if where else raw[()]} at index {where}"
+            )
+        raw = np.real(raw)
+    try:
+        return np.array(raw, dtype=float) if copy else np.asarray(raw, dtype=float)
     except (TypeError, ValueError) as err:
         raise ArgumentTypeError(name, expected, f"{type(value).__name__} ({err})") from None
 
@@ -186,7 +205,8 @@ def check_pd(mat: np.ndarray, name: str) -> np.ndarray:
 def check_real(value: Any, name: str) -> float:
     """Return ``value`` as a finite float."""
     if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
-        raise ArgumentTypeError(name, "a real number", f"{type(value).__name__} {value!r}")
+        found = "None" if value is None else f"{type(value).__name__} {value!r}"
+        raise ArgumentTypeError(name, "a real number", found)
     out = float(value)
     if not np.isfinite(out):
         raise InvalidArgumentError(name, "a finite number", repr(out))
@@ -203,9 +223,14 @@ def check_positive(value: Any, name: str, allow_zero: bool = False) -> float:
 
 
 def check_choice(value: Any, name: str, choices: Iterable[Any]) -> Any:
-    """Check that ``value`` is one of ``choices`` and return it."""
+    """Check that ``value`` is one of ``choices`` and return it (an array or any value that cannot
+    be compared is not one of them)."""
     options = list(choices)
-    if value not in options:
+    try:
+        known = not isinstance(value, np.ndarray) and any(bool(value == option) for option in options)
+    except (TypeError, ValueError):
+        known = False
+    if not known:
         listed = ", ".join(repr(c) for c in options)
         raise InvalidArgumentError(name, f"one of {listed}", repr(value))
     return value

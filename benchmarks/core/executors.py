@@ -247,15 +247,42 @@ class DaskExecutor:
         self._client.close()
 
 
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss")
+"""Address schemes ``--scheduler`` accepts (every one runs over TCP, so it can be probed first)."""
+
+
+def scheduler_host_port(address: str) -> tuple[str, str, int]:
+    """``(scheme, host, port)`` of a scheduler address, or :class:`ConfigError` naming ``--scheduler``.
+
+    ``host:port`` without a scheme means ``tcp://host:port`` (as in Dask).
+
+    Examples
+    --------
+    >>> scheduler_host_port("tcp://10.0.0.5:8786")
+    ('tcp', '10.0.0.5', 8786)
+    >>> scheduler_host_port("[::1]:8786")
+    ('tcp', '::1', 8786)
+    """
+    expected = f"an address scheme://host:port with scheme among {', '.join(SCHEDULER_SCHEMES)}"
+    text = address.strip()
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    if scheme not in SCHEDULER_SCHEMES:
+        raise ConfigError("--scheduler", expected, repr(address))
+    host, _, port = rest.rstrip("/").rpartition(":")
+    host = host.strip("[]")
+    if not host or any(c.isspace() for c in host) or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ConfigError("--scheduler", expected, repr(address))
+    return scheme, host, int(port)
+
+
 def _probe(address: str, timeout: float) -> None:
-    """Fail at once (not after the client's timeout) when a ``tcp://`` address refuses connections."""
-    if not address.startswith("tcp://"):
-        return
-    host, _, port = address[len("tcp://") :].rstrip("/").rpartition(":")
-    if not host or not port.isdigit():
-        raise ConfigError("--scheduler", "an address tcp://host:port", repr(address))
+    """Check the address's form, then fail at once (not after the client's timeout) when nothing
+    listens there."""
+    _, host, port = scheduler_host_port(address)
     try:
-        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout).close()
+        socket.create_connection((host, port), timeout=timeout).close()
     except OSError as err:
         raise ConfigError(
             "--scheduler", "the address of a reachable Dask scheduler", f"{address!r} ({err.strerror or err})"

@@ -8,8 +8,12 @@ runner uses :mod:`benchmarks.core.scenario`, which does not import it back.
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 import time
 import traceback
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -71,18 +75,58 @@ def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str,
     return record
 
 
-def run_case(payload: dict[str, Any]) -> dict[str, Any]:
-    """Worker entry point: ``payload = {"scenario": dict, "experiment": str|None, "trace": bool}``.
+class CaseTimeLimit(Exception):
+    """A case ran longer than its wall-clock limit (raised inside the case by a timer)."""
 
-    Returns ``{"ok": True, "record": ..., "trace": ...}`` or, when the case raised,
-    ``{"ok": False, "error": "<type>: <message>", "traceback": ...}``.
+
+@contextlib.contextmanager
+def _time_limit(seconds: float | None) -> Iterator[bool]:
+    """Raise :class:`CaseTimeLimit` in this thread after ``seconds`` of wall time; yield whether armed.
+
+    A POSIX interval timer (``SIGALRM``) needs the main thread of a process: local worker
+    processes and ``--workers 0`` have it; a Dask worker runs cases in threads, where the limit
+    cannot be armed (the case then runs unbounded). The
+    timer is checked between Python bytecodes, so one long call into compiled code (a QP solve)
+    finishes before the case stops.
+    """
+    usable = (
+        seconds is not None
+        and hasattr(signal, "setitimer")
+        and threading.current_thread() is threading.main_thread()
+    )
+    if not usable:
+        yield False
+        return
+
+    def expire(signum: int, frame: Any) -> None:
+        raise CaseTimeLimit(f"the case ran longer than its limit of {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, float(seconds))
+    try:
+        yield True
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def run_case(payload: dict[str, Any]) -> dict[str, Any]:
+    """Worker entry point: ``payload = {"scenario": dict, "experiment": str|None, "trace": bool,
+    "time_limit": seconds|None}``.
+
+    Returns ``{"ok": True, "record": ..., "trace": ...}`` or, when the case raised or ran past
+    ``time_limit``, ``{"ok": False, "error": "<type>: <message>", "traceback": ...}`` (the type
+    ``time_limit`` for a case stopped by its limit).
     """
     try:
         scenario = Scenario.from_dict(payload["scenario"])
-        record, trace = simulate_scenario(
-            scenario, experiment=payload.get("experiment"), keep_trace=bool(payload.get("trace"))
-        )
+        with _time_limit(payload.get("time_limit")):
+            record, trace = simulate_scenario(
+                scenario, experiment=payload.get("experiment"), keep_trace=bool(payload.get("trace"))
+            )
         return {"ok": True, "record": record, "trace": trace}
+    except CaseTimeLimit as err:
+        return {"ok": False, "error": f"time_limit: {err}", "traceback": traceback.format_exc()}
     except Exception as err:  # a failing case is data, not a crash of the sweep
         return {
             "ok": False,

@@ -5,6 +5,7 @@ Schema (``DIR/sweep.sqlite``, WAL journal so a reader never blocks the writer)::
     runs(run INTEGER PRIMARY KEY, started_at REAL, command TEXT)
     cases(case_id TEXT PRIMARY KEY, position INTEGER, scenario TEXT, status TEXT,
           record TEXT, error TEXT, run INTEGER, finished_at REAL)
+    meta(key TEXT PRIMARY KEY, value TEXT)      -- key 'sweep': the sweep's name
 
 ``status`` is ``"done"`` (``record`` holds the JSON record) or ``"error"`` (``error`` holds
 the one-line error, ``record`` the traceback and scenario). A case id is the primary key, so
@@ -31,6 +32,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from toolkit_common.errors import StoreError
+
 __all__ = ["STORE_NAME", "CaseStore"]
 
 #: File name of the store inside a sweep's output directory.
@@ -52,7 +55,31 @@ CREATE TABLE IF NOT EXISTS cases (
     run INTEGER NOT NULL,
     finished_at REAL NOT NULL
 );
+CREATE TABLE IF NOT EXISTS meta (
+    key TEXT PRIMARY KEY,
+    value TEXT NOT NULL
+);
 """
+
+_COLUMNS = {
+    "runs": ("run", "started_at", "command"),
+    "cases": ("case_id", "position", "scenario", "status", "record", "error", "run", "finished_at"),
+    "meta": ("key", "value"),
+}
+_EXPECTED = "the SQLite store of a sweep"
+_REMEDY = "move it away or choose another --out"
+
+
+def _found(err: sqlite3.Error) -> str:
+    """What an SQLite error says about the file, and what to do."""
+    text = str(err)
+    if "locked" in text:
+        return f"a store locked by another process ({text}); wait for the other sweep or choose another --out"
+    if "not a database" in text:
+        return f"a file that is not an SQLite database ({text}); {_REMEDY}"
+    if "malformed" in text:
+        return f"a damaged SQLite file ({text}); {_REMEDY}"
+    return f"a file SQLite cannot use ({text}); {_REMEDY}"
 
 
 class CaseStore:
@@ -64,12 +91,66 @@ class CaseStore:
         The database file.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, timeout: float = 30.0) -> None:
         self.path = Path(path)
-        self._db = sqlite3.connect(self.path, timeout=30.0)
-        self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("PRAGMA synchronous=NORMAL")
-        self._db.executescript(_SCHEMA)
+        if self.path.is_dir():
+            raise StoreError(str(self.path), _EXPECTED, f"a folder; {_REMEDY}")
+        try:
+            self._db = sqlite3.connect(self.path, timeout=timeout)
+        except sqlite3.Error as err:
+            raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
+        try:
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=NORMAL")
+            self._db.executescript(_SCHEMA)
+            self._db.commit()
+            self._check_schema()
+        except sqlite3.Error as err:
+            self._db.close()
+            raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
+        except StoreError:
+            self._db.close()
+            raise
+
+    def _check_schema(self) -> None:
+        """A table of this name made by another program (other columns) is refused."""
+        for table, columns in _COLUMNS.items():
+            found = tuple(row[1] for row in self._db.execute(f"PRAGMA table_info({table})"))
+            if found != columns:
+                raise StoreError(
+                    str(self.path), _EXPECTED,
+                    f"a table {table!r} with the columns {', '.join(found)} (another program's file); "
+                    + _REMEDY,
+                )
+
+    def sweep_name(self) -> str | None:
+        """The name of the sweep this store belongs to (None for a new store or one written before
+        stores recorded it)."""
+        row = self._db.execute("SELECT value FROM meta WHERE key = 'sweep'").fetchone()
+        return None if row is None else str(row[0])
+
+    def claim(self, name: str, case_ids: set[str], *, overwrite: bool = False) -> None:
+        """Make this the store of the sweep ``name`` whose cases are ``case_ids``.
+
+        A store of another sweep (its recorded name differs, or it records none and holds no case
+        of this sweep) is refused with :class:`StoreError`, unless ``overwrite``: then its cases
+        and runs are deleted first.
+        """
+        owner = self.sweep_name()
+        stored = self.finished_ids()
+        unrelated = owner is None and bool(stored) and not stored & case_ids
+        foreign = (owner is not None and owner != name) or unrelated
+        if foreign and not overwrite:
+            found = f"the store of the sweep {owner!r}" if owner is not None else (
+                f"a store of {len(stored)} cases none of which is in this sweep"
+            )
+            raise StoreError(
+                "--out", f"a new folder or one of the sweep {name!r} (--overwrite replaces it)", found
+            )
+        if foreign:
+            self._db.execute("DELETE FROM cases")
+            self._db.execute("DELETE FROM runs")
+        self._db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES ('sweep', ?)", (name,))
         self._db.commit()
 
     def __enter__(self) -> CaseStore:
@@ -86,11 +167,31 @@ class CaseStore:
 
     def begin_run(self, command: str) -> int:
         """Register an invocation of the sweep; return its run number (1, 2, ...)."""
-        cur = self._db.execute("INSERT INTO runs (started_at, command) VALUES (?, ?)", (time.time(), command))
-        self._db.commit()
+        try:
+            cur = self._db.execute(
+                "INSERT INTO runs (started_at, command) VALUES (?, ?)", (time.time(), command)
+            )
+            self._db.commit()
+        except sqlite3.Error as err:
+            raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
         return int(cur.lastrowid)
 
     def _put(
+        self,
+        case_id: str,
+        position: int,
+        scenario: dict[str, Any],
+        status: str,
+        record: Any,
+        error: str | None,
+        run: int,
+    ) -> None:
+        try:
+            self._write_case(case_id, position, scenario, status, record, error, run)
+        except sqlite3.Error as err:
+            raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
+
+    def _write_case(
         self,
         case_id: str,
         position: int,
@@ -143,13 +244,22 @@ class CaseStore:
         )
         out = []
         for cid, pos, scen, status, record, error, run, fin in cur:
+            try:
+                scenario = json.loads(scen)
+                decoded = None if record is None else json.loads(record)
+            except (TypeError, json.JSONDecodeError) as err:
+                raise StoreError(
+                    str(self.path), "cases stored as JSON",
+                    f"case {cid!r} holding text that is not JSON ({err}); the store is damaged: move it away "
+                    "or choose another --out to run the sweep afresh",
+                ) from None
             out.append(
                 {
                     "case_id": cid,
                     "position": pos,
-                    "scenario": json.loads(scen),
+                    "scenario": scenario,
                     "status": status,
-                    "record": None if record is None else json.loads(record),
+                    "record": decoded,
                     "error": error,
                     "run": run,
                     "finished_at": fin,

@@ -74,6 +74,8 @@ def chosen_experiments(known: Collection[str], experiments: Sequence[str] | None
     (['E1', 'E2'], ['E2'])
     """
     chosen = list(known) if experiments is None else list(experiments)
+    if not chosen:
+        raise ConfigError("--experiments", "one or more names among " + ", ".join(known), "none")
     for name in chosen:
         if name not in known:
             raise ConfigError("--experiments", "names among " + ", ".join(known), repr(name))

@@ -33,6 +33,8 @@ from benchmarks.core.sweep_spec import (
     resolve_config,
 )
 from benchmarks.reports.tables import metric_table, to_markdown, varying_fields, write_tables
+from toolkit_common.errors import StoreError
+from toolkit_common.validation import check_positive
 
 __all__ = [
     "SHIPPED",
@@ -70,6 +72,8 @@ def run_sweep(
     retry_errors: bool = False,
     progress: bool | None = None,
     argv: Sequence[str] | None = None,
+    overwrite: bool = False,
+    case_time_limit: float | None = None,
 ) -> SweepOutcome:
     """Run the cases of ``config`` not yet in ``out``'s store, then write the reports from the store.
 
@@ -89,20 +93,46 @@ def run_sweep(
         Force the progress bar on or off (default: on when stderr is a terminal).
     argv : sequence of str, optional
         The command line, recorded in the store's ``runs`` table.
+    overwrite : bool
+        Replace what ``out`` holds when it belongs to another sweep or another run (by default
+        such a folder is refused with :class:`~toolkit_common.errors.StoreError`, so one sweep
+        never overwrites another's results).
+    case_time_limit : float, optional
+        Wall-clock seconds a case may run; a case that runs longer is stopped and stored as an
+        error whose message starts with ``time_limit`` (the rest runs on). Enforced in local
+        worker processes and with ``workers=0``; Dask runs cases in threads, where it is not.
     """
+    if case_time_limit is not None:
+        case_time_limit = check_positive(case_time_limit, "case_time_limit")
     spec = load_sweep(config)
     cases = expand(spec)
+    _refuse_other_results(Path(out), spec.name, overwrite)
     executor, out = make_executor_and_out(workers, scheduler, out)  # a bad --scheduler fails first
     start = time.perf_counter()
     position = {sc.case_id: i for i, sc in enumerate(cases)}
-    with CaseStore(out / STORE_NAME) as store:
+    store: CaseStore | None = None
+    try:
+        store = CaseStore(out / STORE_NAME)
+        store.claim(spec.name, set(position), overwrite=overwrite)
+    except BaseException:
+        executor.close()
+        if store is not None:
+            store.close()
+        raise
+    with store:
         finished = store.finished_ids(include_errors=not retry_errors)
         todo = [sc for sc in cases if sc.case_id not in finished]
         outcome = SweepOutcome(name=spec.name, total=len(cases), skipped=len(cases) - len(todo))
         if todo:
             run = store.begin_run(shlex.join(["rmpc", *(argv or sys.argv[1:])]))
             by_id = {sc.case_id: sc for sc in todo}
-            tasks = [Task(sc.case_id, {"scenario": sc.to_dict(), "experiment": sc.case_id}) for sc in todo]
+            tasks = [
+                Task(
+                    sc.case_id,
+                    {"scenario": sc.to_dict(), "experiment": sc.case_id, "time_limit": case_time_limit},
+                )
+                for sc in todo
+            ]
             with CaseProgress(len(tasks), f"sweep {spec.name}", progress) as bar:
 
                 def on_result(task: Task, result: dict[str, Any]) -> None:
@@ -132,6 +162,17 @@ def run_sweep(
     where = executor.description if todo else "nothing to run"
     outcome.files = _write(out, spec, cases, rows, extra, outcome, where)
     return outcome
+
+
+def _refuse_other_results(out: Path, name: str, overwrite: bool) -> None:
+    """Refuse a folder holding another run's results without a sweep store (a suite's, say)."""
+    if overwrite or (out / STORE_NAME).exists() or not (out / "results.json").exists():
+        return
+    raise StoreError(
+        "--out",
+        f"a new folder or one of the sweep {name!r} (--overwrite replaces it)",
+        f"the results of another run in {str(out)!r} (results.json without a sweep store)",
+    )
 
 
 def _write(

@@ -1,9 +1,10 @@
 """A sweep file: read, checked, and expanded into its scenarios (:mod:`benchmarks.core.sweep` runs them).
 
-A sweep file has up to five top-level entries, all optional::
+A sweep file has up to six top-level entries, all optional::
 
     name = "smoke"                      # used in reports
     description = "what it is for"
+    max_cases = 200000                  # lifts the bound on cases (default 100000)
 
     [base]                              # scenario fields (benchmarks.core.scenario.Scenario)
     controller = "GIPC"
@@ -33,6 +34,7 @@ are left out and listed in ``results.md``.
 from __future__ import annotations
 
 import itertools
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -56,7 +58,14 @@ __all__ = [
     "resolve_config",
 ]
 
-_TOP_LEVEL = ("name", "description", "base", "grid", "montecarlo")
+_TOP_LEVEL = ("name", "description", "max_cases", "base", "grid", "montecarlo")
+
+MAX_CASES = 100_000
+"""Default bound on a sweep's cases (grid points x draws); ``max_cases = N`` at the top of the
+file lifts it (a grid of 10^6 cases used to expand silently)."""
+
+MAX_FILE_BYTES = 2**20
+"""Largest sweep file read (1 MiB; the shipped ones are under 2 KiB)."""
 _MONTECARLO = ("n", "seed")
 
 
@@ -90,6 +99,9 @@ def load_sweep(path: str | Path) -> SweepSpec:
     """
     path = resolve_config(path)
     try:
+        size = path.stat().st_size
+        if path.is_file() and size > MAX_FILE_BYTES:
+            raise ConfigError("--config", f"a sweep file of at most {MAX_FILE_BYTES} bytes", f"{size} bytes")
         text = path.read_text(encoding="utf-8")
     except OSError as err:
         raise ConfigError("--config", "a readable TOML file", f"{str(path)!r} ({err.strerror})") from None
@@ -99,6 +111,9 @@ def load_sweep(path: str | Path) -> SweepSpec:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(str(path), "valid TOML", str(err).replace("\n", " ")) from None
+    except RecursionError:
+        found = "arrays or tables nested too deep to read"
+        raise ConfigError(str(path), "TOML nested a few levels deep", found) from None
     return parse_sweep(data, default_name=path.stem)
 
 
@@ -138,8 +153,8 @@ def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSp
             raise ConfigError(str(key), "a sweep table (" + ", ".join(_TOP_LEVEL) + ")", "an unknown field")
     name = data.get("name", default_name)
     description = data.get("description", "")
-    if not isinstance(name, str) or not name:
-        raise ConfigError("name", "a non-empty string", repr(name))
+    if not isinstance(name, str) or not name.strip() or not name.isprintable():
+        raise ConfigError("name", "a non-empty one-line string of printable characters", repr(name))
     if not isinstance(description, str):
         raise ConfigError("description", "a string", repr(description))
     base = data.get("base", {})
@@ -177,10 +192,26 @@ def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSp
     mc = data.get("montecarlo")
     if mc is not None:
         mc = _check_montecarlo(mc, base, grid, family)
+    _check_case_count(data.get("max_cases", MAX_CASES), grid, mc)
     spec = SweepSpec(name=name, description=description, base=dict(base), grid=grid, montecarlo=mc)
     _check_settings_used(spec)
     _grid_points(spec)  # the combinations: raises on one that is impossible
     return spec
+
+
+def _check_case_count(limit: Any, grid: Mapping[str, list[Any]], mc: Mapping[str, int] | None) -> None:
+    """Refuse a sweep of more than ``limit`` cases before any is expanded."""
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise ConfigError("max_cases", "a positive integer", repr(limit))
+    points = math.prod(len(values) for values in grid.values())
+    count = points * (mc["n"] if mc else 1)
+    if count > limit:
+        where = "montecarlo.n" if mc and mc["n"] > limit // max(points, 1) else "grid"
+        raise ConfigError(
+            where,
+            f"at most max_cases = {limit} cases (a line max_cases = N at the top of the file lifts it)",
+            f"{points} grid points x {mc['n'] if mc else 1} draws = {count} cases",
+        )
 
 
 def _family(spec: SweepSpec) -> PlantFamily:

@@ -68,16 +68,22 @@ class TimingConfig:
         return max(CHEAP_FACTOR * self.steps, 2)
 
 
-def _int_option(value: Any, option: str, minimum: int) -> int:
+MAX_STEPS_OPTION = 100_000
+"""Bound on every ``--*-steps`` option: the report times each step, and a count above this runs
+for many hours (``--steps 1e9`` used to end in a MemoryError); time in parts above it."""
+
+
+def _int_option(value: Any, option: str, minimum: int, maximum: int = MAX_STEPS_OPTION) -> int:
+    expected = f"an integer in [{minimum}, {maximum}] (the bound keeps a run within hours; time in parts)"
     if isinstance(value, bool):
-        raise InvalidArgumentError(option, f"an integer >= {minimum}", repr(value))
+        raise InvalidArgumentError(option, expected, repr(value))
     try:
         number = int(value)
         exact = float(value) == number if not isinstance(value, str) else True
     except (TypeError, ValueError):
-        raise InvalidArgumentError(option, f"an integer >= {minimum}", repr(value)) from None
-    if not exact or number < minimum:
-        raise InvalidArgumentError(option, f"an integer >= {minimum}", repr(value))
+        raise InvalidArgumentError(option, expected, repr(value)) from None
+    if not exact or not minimum <= number <= maximum:
+        raise InvalidArgumentError(option, expected, repr(value))
     return number
 
 

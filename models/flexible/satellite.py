@@ -376,6 +376,11 @@ class FlexibleSatellite:
             Hub disturbance torque (3), optionally followed by the panel forces ``d_f`` (N).
         """
         x = as_vector(x, "x", self.n_states)
+        q_norm = float(np.linalg.norm(x[:4]))
+        if q_norm < 1e-6:
+            raise InvalidArgumentError(
+                "x", "a quaternion x[0:4] of norm near 1", f"norm {q_norm:.3g} ({x[:4].tolist()})"
+            )
         return hybrid_rhs(self._p, x, *split_inputs(self._p, u, d))
 
     def angular_momentum(self, x: Any) -> np.ndarray:

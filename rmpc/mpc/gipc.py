@@ -54,7 +54,7 @@ from toolkit_common.validation import (
     as_vector,
 )
 
-__all__ = ["GIPC", "prediction_matrices", "velocity_form"]
+__all__ = ["GIPC", "MAX_HORIZON", "prediction_matrices", "velocity_form"]
 
 
 def velocity_form(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -100,11 +100,20 @@ def prediction_matrices(
     return f, phi
 
 
-def _horizon(value: Any, name: str, upper: int | None = None) -> int:
+MAX_HORIZON = 20_000
+"""Default bound on ``Np``: the prediction matrices grow as ``Np`` squared in time and ``Np x Nc`` in
+memory (paper P uses 400); ``GIPC(..., max_horizon=N)`` lifts it."""
+
+
+def _horizon(value: Any, name: str, upper: int | None = None, limit: int | None = None) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
         raise InvalidArgumentError(name, "a positive integer", repr(value))
     if upper is not None and value > upper:
         raise InvalidArgumentError(name, f"an integer <= Np = {upper}", repr(value))
+    if limit is not None and value > limit:
+        raise InvalidArgumentError(
+            name, f"at most max_horizon = {limit} samples (pass a larger max_horizon to lift it)", repr(value)
+        )
     return int(value)
 
 
@@ -139,6 +148,9 @@ class GIPC:
         Reference state; the output reference is ``C x_ref`` (default the origin).
     u0 : (m,) array_like, optional
         The input assumed applied before the first step (default zero).
+    max_horizon : int
+        The largest ``Np`` accepted (default :data:`MAX_HORIZON`, 20000); a larger ``Np`` is
+        refused with an error naming this limit (``Np = 10**6`` ended in a MemoryError).
 
     Attributes
     ----------
@@ -203,11 +215,13 @@ class GIPC:
         solver_options: Mapping[str, Any] | None = None,
         x_ref: Any = None,
         u0: Any = None,
+        max_horizon: int = MAX_HORIZON,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
         n, m = plant.n_states, plant.n_inputs
-        self.Np = _horizon(Np, "Np")
+        limit = _horizon(max_horizon, "max_horizon")
+        self.Np = _horizon(Np, "Np", limit=limit)
         self.Nc = _horizon(Nc, "Nc", self.Np)
         if C is None:
             c = np.eye(n)[:3] if n == 6 else np.eye(n)
@@ -235,7 +249,7 @@ class GIPC:
                 )
             self.backend = backend
         elif isinstance(backend, str):
-            self.backend = make_backend(backend, **dict(solver_options or {}))
+            self.backend = make_backend(backend, argument="backend", **dict(solver_options or {}))
         else:
             raise ArgumentTypeError(
                 "backend", "a back-end name or a rmpc.qp.QPBackend", type(backend).__name__

@@ -73,7 +73,7 @@ class LQR:
         if vertex is not None and (
             isinstance(vertex, bool)
             or not isinstance(vertex, int | np.integer)
-            or not -plant.n_vertices <= vertex < plant.n_vertices
+            or not 0 <= vertex < plant.n_vertices
         ):
             raise InvalidArgumentError(
                 "vertex", f"None or an integer in [0, {plant.n_vertices - 1}]", repr(vertex)

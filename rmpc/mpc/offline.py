@@ -130,11 +130,11 @@ class OfflineRMPC:
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
         if input_constraint == "auto":
             input_constraint = None if u_max is None else "ellipsoid"
-        count_ok = isinstance(n_ellipsoids, int | np.integer) and not isinstance(n_ellipsoids, bool)
-        if not count_ok or n_ellipsoids < 1:
-            raise InvalidArgumentError("n_ellipsoids", "a positive integer", repr(n_ellipsoids))
         if not check_positive(shrink, "shrink") < 1.0:
             raise InvalidArgumentError("shrink", "a number in (0, 1)", repr(shrink))
+        from lmi.offline import check_ellipsoid_count
+
+        check_ellipsoid_count(n_ellipsoids, shrink)
         check_bool(interpolate, "interpolate")
         self.path = check_choice(path, "path", ("ray", "trajectory"))
         self.plant = plant

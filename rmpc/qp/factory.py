@@ -22,13 +22,16 @@ BACKENDS: dict[str, type[QPBackend]] = {
 }
 
 
-def make_backend(name: str, **settings: Any) -> QPBackend:
+def make_backend(name: str, *, argument: str = "name", **settings: Any) -> QPBackend:
     """Build the back-end called ``name`` with ``settings`` (unknown settings raise).
 
     Parameters
     ----------
     name : {"osqp", "proxqp", "clarabel", "cvxpy"}
         The back-end.
+    argument : str
+        The name the caller's user gave ``name`` under (``"backend"`` for a controller), used in
+        the error message of an unknown back-end.
     **settings
         Settings of that back-end (see its settings class).
 
@@ -44,8 +47,8 @@ def make_backend(name: str, **settings: Any) -> QPBackend:
     settings 'eps' | the unknown setting 'eps'
     """
     if not isinstance(name, str):
-        raise ArgumentTypeError("name", "a back-end name (str)", type(name).__name__)
+        raise ArgumentTypeError(argument, "a back-end name (str)", type(name).__name__)
     key = name.lower()
     if key not in BACKENDS:
-        raise InvalidArgumentError("name", f"one of {', '.join(repr(k) for k in BACKENDS)}", repr(name))
+        raise InvalidArgumentError(argument, f"one of {', '.join(repr(k) for k in BACKENDS)}", repr(name))
     return BACKENDS[key](**settings)

@@ -118,7 +118,18 @@ def as_disturbance(value: Any, size: int, x0: Any = None) -> Callable[..., np.nd
 
 
 def disturbance_at(disturbance: DisturbanceFn, t: float, x: np.ndarray) -> np.ndarray:
-    """``d(t, x)`` for a state-dependent disturbance (``state_dependent = True``), else ``d(t)``."""
+    """``d(t, x)`` for a state-dependent disturbance (``state_dependent = True``), else ``d(t)``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``disturbance`` and the time when a value is NaN or infinite (an integrator fed
+        one would shrink its step without end or carry the NaN into the state).
+    """
     if getattr(disturbance, "state_dependent", False):
-        return disturbance(t, x)
-    return disturbance(t)
+        value = np.asarray(disturbance(t, x), dtype=float)
+    else:
+        value = np.asarray(disturbance(t), dtype=float)
+    if not np.all(np.isfinite(value)):
+        raise InvalidArgumentError("disturbance", "finite values d(t)", f"{value.tolist()} at t = {t:.9g} s")
+    return value

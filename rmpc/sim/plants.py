@@ -29,7 +29,7 @@ import numpy as np
 
 from models import PolytopicModel
 from rmpc.sim.disturbances import DisturbanceFn, disturbance_at
-from rmpc.sim.integrators import Derivative, Integrator, make_integrator
+from rmpc.sim.integrators import Derivative, Integrator, check_finite_derivative, make_integrator
 from rmpc.sim.rhs import model_dynamics, plant_derivative
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, check_positive
@@ -197,15 +197,21 @@ class SampledPlant:
         return out
 
     def derivative(self, u: np.ndarray, disturbance: DisturbanceFn | None) -> Derivative:
-        """``f(t, x) = x'`` for the command ``u`` held: the input stage, the disturbance, the model."""
+        """``f(t, x) = x'`` for the command ``u`` held: the input stage, the disturbance, the model.
+
+        Every evaluation is checked: a NaN or infinite ``x'`` raises at once, naming the plant and
+        the time, before an integrator can carry it into a state (or shrink its step without end).
+        """
         dynamics, stage = self._dynamics, self.input_stage
         if stage is None:
             def f(t: float, x: np.ndarray) -> np.ndarray:
-                return np.asarray(plant_derivative(dynamics, t, x, u, disturbance), dtype=float)
+                dx = np.asarray(plant_derivative(dynamics, t, x, u, disturbance), dtype=float)
+                return check_finite_derivative(dx, t)
         else:
             def f(t: float, x: np.ndarray) -> np.ndarray:
                 applied = np.asarray(stage(t, x, u), dtype=float)
-                return np.asarray(plant_derivative(dynamics, t, x, applied, disturbance), dtype=float)
+                dx = np.asarray(plant_derivative(dynamics, t, x, applied, disturbance), dtype=float)
+                return check_finite_derivative(dx, t)
         return f
 
     def advance(
@@ -234,7 +240,10 @@ class SampledPlant:
 
 
 def _check_dt(dt: float | None, plant_dt: float) -> None:
-    if dt is not None and abs(dt - plant_dt) > 1e-12 * plant_dt:
+    if dt is None:
+        return
+    dt = check_positive(dt, "dt")
+    if abs(dt - plant_dt) > 1e-12 * plant_dt:
         raise InvalidArgumentError("dt", f"None or the plant's dt = {plant_dt:g}", repr(dt))
 
 

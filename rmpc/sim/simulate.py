@@ -14,7 +14,11 @@ from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["simulate"]
+__all__ = ["MAX_STEPS", "simulate"]
+
+
+MAX_STEPS = 10_000_000
+"""Default bound on a run's samples (10 million samples of 14 states: about 1.1 GB of states)."""
 
 
 def simulate(
@@ -34,6 +38,7 @@ def simulate(
     reset: bool = True,
     progress: Any = None,
     sensor: Any = None,
+    max_steps: int = MAX_STEPS,
 ) -> Trajectory:
     """Run ``controller`` in closed loop on ``plant`` from ``x0``.
 
@@ -83,6 +88,10 @@ def simulate(
         ``sensor(t, x) -> y``: what the controller measures (sensor noise, say); the
         trajectory keeps the true state. Its ``reset()`` is called before the run when present.
         Default: the controller sees the true state.
+    max_steps : int
+        The largest number of samples a run may have (default :data:`MAX_STEPS`, 10 million:
+        the trajectory's arrays are allocated up front); a longer run is refused with an error
+        naming this limit. Pass a larger value to lift it.
 
     Returns
     -------
@@ -115,8 +124,21 @@ def simulate(
     if duration is not None:
         duration = check_positive(duration, "duration")
         n_steps = round(duration / step_dt)
-    if not isinstance(n_steps, int | np.integer) or n_steps < 1:
+        if n_steps < 1:
+            raise InvalidArgumentError(
+                "duration", f"at least half a sample time (dt = {step_dt:g} s)", f"{duration:g} s"
+            )
+    if isinstance(n_steps, bool) or not isinstance(n_steps, int | np.integer) or n_steps < 1:
         raise InvalidArgumentError("n_steps", "a positive integer", repr(n_steps))
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or max_steps < 1:
+        raise InvalidArgumentError("max_steps", "a positive integer", repr(max_steps))
+    if n_steps > max_steps:
+        asked = f"duration {duration:g} s / dt {step_dt:g} s = " if duration is not None else ""
+        raise InvalidArgumentError(
+            "duration" if duration is not None else "n_steps",
+            f"at most max_steps = {max_steps} samples (pass a larger max_steps to lift the limit)",
+            f"{asked}{n_steps} samples",
+        )
     n_d = int(getattr(sim_plant, "n_disturbances", m))
     d_fn = as_disturbance(disturbance, n_d, x)
     stage = getattr(sim_plant, "input_stage", None)
@@ -152,7 +174,7 @@ def simulate(
     xs[0] = x
     for k in range(n_steps):
         t = k * step_dt
-        measured = x if sensor is None else np.asarray(sensor(t, x), dtype=float)
+        measured = x if sensor is None else _finite_output(sensor(t, x), "sensor", "sensor(t, x)", t, None)
         start = time.perf_counter()
         u = np.asarray(controller.step(measured), dtype=float).reshape(-1)
         step_time[k] = time.perf_counter() - start
@@ -168,9 +190,9 @@ def simulate(
             gamma[k] = float(g)
         info.append(last)
         u_cmd[k] = u
-        applied = limiter(u) if limiter is not None else u
+        applied = _finite_output(limiter(u), "limiter", "limiter(u)", t, m) if limiter is not None else u
         if actuator is not None:
-            applied = actuator.step(applied)
+            applied = _finite_output(actuator.step(applied), "actuator", "actuator.step(u)", t, m)
         if callable(begin_sample):
             stage_rows.append(dict(begin_sample(t, x, applied) or {}))
         u_app[k] = applied if stage is None else sim_plant.applied(t, x, applied)
@@ -189,6 +211,18 @@ def simulate(
         status=status, solve_time=solve_time, step_time=step_time, gamma=gamma, info=info,
         plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows), attitude_euler=attitude,
     )
+
+
+def _finite_output(value: Any, name: str, call: str, t: float, size: int | None) -> np.ndarray:
+    """A callback's output as finite floats (``size`` of them if given), else an error naming it and ``t``."""
+    out = np.asarray(value, dtype=float)
+    if size is not None:
+        out = out.reshape(-1)
+    if (size is not None and out.shape != (size,)) or not np.all(np.isfinite(out)):
+        count = f"{size} " if size is not None else ""
+        expected = f"{call} returning {count}finite values"
+        raise InvalidArgumentError(name, expected, f"{out.tolist()} at t = {t:.9g} s")
+    return out
 
 
 def _stack_rows(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:
