@@ -75,36 +75,52 @@ def run_scenario(scenario: Scenario, experiment: str | None = None) -> dict[str,
     return record
 
 
-class CaseTimeLimit(Exception):
-    """A case ran longer than its wall-clock limit (raised inside the case by a timer)."""
+class CaseTimeLimit(BaseException):
+    """A case ran longer than its wall-clock limit (raised inside the case by a timer).
+
+    A ``BaseException``, like ``KeyboardInterrupt``, so that a fallback that catches a failing
+    solver's ``Exception`` does not swallow it and run on.
+    """
+
+
+class _Timer:
+    """Whether the case's time limit was armed and whether it has expired."""
+
+    def __init__(self) -> None:
+        self.armed = False
+        self.expired = False
 
 
 @contextlib.contextmanager
-def _time_limit(seconds: float | None) -> Iterator[bool]:
-    """Raise :class:`CaseTimeLimit` in this thread after ``seconds`` of wall time; yield whether armed.
+def _time_limit(seconds: float | None) -> Iterator[_Timer]:
+    """Raise :class:`CaseTimeLimit` in this thread after ``seconds`` of wall time.
 
     A POSIX interval timer (``SIGALRM``) needs the main thread of a process: local worker
     processes and ``--workers 0`` have it; a Dask worker runs cases in threads, where the limit
-    cannot be armed (the case then runs unbounded). The
-    timer is checked between Python bytecodes, so one long call into compiled code (a QP solve)
-    finishes before the case stops.
+    cannot be armed (the case then runs unbounded). The timer is checked between Python
+    bytecodes, so one long call into compiled code (a QP solve) finishes before the case stops;
+    raised inside a compiled function the error may reach the caller wrapped (a numba kernel
+    turns it into ``SystemError``), so the yielded timer says whether the limit expired.
     """
+    timer = _Timer()
     usable = (
         seconds is not None
         and hasattr(signal, "setitimer")
         and threading.current_thread() is threading.main_thread()
     )
     if not usable:
-        yield False
+        yield timer
         return
 
     def expire(signum: int, frame: Any) -> None:
+        timer.expired = True
         raise CaseTimeLimit(f"the case ran longer than its limit of {seconds:g} s")
 
     previous = signal.signal(signal.SIGALRM, expire)
     signal.setitimer(signal.ITIMER_REAL, float(seconds))
+    timer.armed = True
     try:
-        yield True
+        yield timer
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         signal.signal(signal.SIGALRM, previous)
@@ -118,9 +134,11 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     ``time_limit``, ``{"ok": False, "error": "<type>: <message>", "traceback": ...}`` (the type
     ``time_limit`` for a case stopped by its limit).
     """
+    limit = payload.get("time_limit")
+    timer = _Timer()
     try:
         scenario = Scenario.from_dict(payload["scenario"])
-        with _time_limit(payload.get("time_limit")):
+        with _time_limit(limit) as timer:
             record, trace = simulate_scenario(
                 scenario, experiment=payload.get("experiment"), keep_trace=bool(payload.get("trace"))
             )
@@ -128,6 +146,9 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     except CaseTimeLimit as err:
         return {"ok": False, "error": f"time_limit: {err}", "traceback": traceback.format_exc()}
     except Exception as err:  # a failing case is data, not a crash of the sweep
+        if timer.expired:  # the limit's error, wrapped by compiled code it passed through
+            message = f"the case ran longer than its limit of {limit:g} s"
+            return {"ok": False, "error": f"time_limit: {message}", "traceback": traceback.format_exc()}
         return {
             "ok": False,
             "error": f"{type(err).__name__}: {err}".replace("\n", " "),
