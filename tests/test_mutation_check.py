@@ -66,6 +66,10 @@ TESTS = textwrap.dedent(
 
     def test_count_up():
         assert count_up(3) == 3
+
+
+    def test_broken_whatever_the_code():
+        assert clamp(1, 0, 3) == 99  # fails on the original: never used to judge a mutant
     """
 ).lstrip()
 
@@ -105,7 +109,8 @@ def test_operators_change_one_node_and_leave_docstrings_annotations_and_type_che
 
 def test_the_sample_is_seeded_and_sized(project: Path) -> None:
     mutants = list_mutants(project, ["fakepkg"])
-    config = CheckConfig(root=project, modules=["fakepkg"], tests=["tests"], out=project / "out", max_mutants=4)
+    config = CheckConfig(root=project, modules=["fakepkg"], tests=["tests"], out=project / "out",
+                         max_mutants=4)
     first = sample_mutants(mutants, config)
     assert len(first) == 4 and first == sample_mutants(mutants, config)
     others = [sample_mutants(mutants, CheckConfig(**{**config.__dict__, "seed": s})) for s in range(1, 6)]
@@ -114,7 +119,9 @@ def test_the_sample_is_seeded_and_sized(project: Path) -> None:
     assert sample_mutants(mutants, named) == [mutants[2]]
 
 
-def test_a_mutant_in_the_sandbox_is_undone_on_interrupt_and_never_reaches_the_working_file(project: Path) -> None:
+def test_a_mutant_in_the_sandbox_is_undone_on_interrupt_and_never_reaches_the_working_file(
+    project: Path,
+) -> None:
     mutant = find_mutants(CALC, "fakepkg.calc", "fakepkg/calc.py")[0]
     with Sandbox(project) as box:
         copy = box.tree / "fakepkg" / "calc.py"
@@ -135,7 +142,7 @@ def test_caught_survived_untested_and_timed_out_mutants_are_told_apart(project: 
 
     chosen = {
         pick("if x < lo:", "compare"): ("caught", "tests/test_calc.py::test_"),
-        pick("LIMIT = 10", "constant"): ("survived", ""),  # no test reads LIMIT
+        pick("LIMIT = 10", "constant"): ("survived", ""),  # no passing test reads LIMIT
         pick("return hi", "return"): ("survived", "no test runs it"),
         pick("i += 1", "statement"): ("timeout", ""),  # the loop never ends
     }
@@ -148,7 +155,8 @@ def test_caught_survived_untested_and_timed_out_mutants_are_told_apart(project: 
         assert got[mutant_id][0] == status, (mutant_id, got[mutant_id])
         assert got[mutant_id][1].startswith(detail), (mutant_id, got[mutant_id])
     assert summary["counts"] == {"caught": 1, "survived": 2, "timeout": 1, "error": 0, "not run": 0}
-    assert summary["map"]["tests_passed"] == 3 and summary["working_files_untouched"]
+    assert summary["map"]["tests"] == 4 and summary["map"]["tests_passed"] == 3
+    assert summary["working_files_untouched"]
     assert (project / "fakepkg" / "calc.py").read_text() == CALC
     report = (out / "report.md").read_text()
     assert "1 caught, 2 survived (1 run by no test), 1 timed out" in report
