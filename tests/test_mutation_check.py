@@ -162,3 +162,34 @@ def test_caught_survived_untested_and_timed_out_mutants_are_told_apart(project: 
     assert "1 caught, 2 survived (1 run by no test), 1 timed out" in report
     assert json.loads((out / "results.json").read_text())["tried"] == 4
     assert len((out / "mutants.jsonl").read_text().splitlines()) == 4
+
+
+KERNEL = textwrap.dedent(
+    '''
+    """A module with a "compiled" kernel (the decorator's name is what marks it)."""
+
+
+    def njit(func):
+        return func
+
+
+    @njit
+    def double(x):
+        return 2 * x
+    '''
+).lstrip()
+
+
+def test_a_compiled_kernel_is_judged_by_the_tests_that_import_it(project: Path) -> None:
+    (project / "fakepkg" / "kern.py").write_text(KERNEL)
+    (project / "tests" / "test_kern.py").write_text(
+        "from fakepkg.kern import double\n\n\ndef test_double():\n    assert double(3) == 6\n"
+    )
+    mutant = next(m for m in list_mutants(project, ["fakepkg.kern"]) if m.operator == "arith")
+    assert mutant.scope == "compiled"  # a tracer never sees its lines: no module of fakepkg imports it
+    config = CheckConfig(root=project, modules=["fakepkg"], tests=["tests"], out=project.parent / "out",
+                         mutant_ids=[mutant.id], python=sys.executable)
+    summary = run_check(config, log=lambda _: None)
+    (record,) = summary["mutants"]
+    assert (record["status"], record["detail"]) == ("caught", "tests/test_kern.py::test_double")
+    assert (record["tests_covering"], record["tests_run"]) == (1, 1)

@@ -7,7 +7,8 @@ The tests of a mutant (the rule the report states):
 - a line that runs on import (a module constant, a default value, a class body): the tests that
   ran any line inside a function of that module;
 - a line inside a numba-compiled function (which a line tracer never sees): the tests that ran
-  any line inside a function of the modules that import its module or its package.
+  any line inside a function of the modules that import its module or its package, and the
+  tests in test files that import its module or its package (they may call the kernel directly).
 
 Only tests that passed in the map run are used. They run fastest first, with ``-x``, and the list
 is cut where the map run's durations add up to ``max_test_seconds`` (the report gives, for each
@@ -147,6 +148,12 @@ def _imported_names(source: str) -> set[str]:
     return names
 
 
+def _wanted_names(module: str) -> set[str]:
+    """``module`` and its package (not a top-level package): the imports that reach it."""
+    parts = module.split(".")
+    return {".".join(parts[:i]) for i in range(max(2, len(parts) - 1), len(parts) + 1)}
+
+
 class LineMap:
     """Which tests ran which lines, read from the map run's output.
 
@@ -187,8 +194,7 @@ class LineMap:
         if not self._importers:
             for name, rel in self.files.items():
                 self._importers[name] = _imported_names((root / rel).read_text(encoding="utf-8"))
-        parts = module.split(".")
-        wanted = {".".join(parts[:i]) for i in range(max(2, len(parts) - 1), len(parts) + 1)}
+        wanted = _wanted_names(module)
         return {self.files[name] for name, names in self._importers.items()
                 if names & wanted and name != module}
 
@@ -204,7 +210,24 @@ class LineMap:
             found = set()
             for path in self._importers_of(root, mutant.module):
                 found |= self._module_tests(root, path)
+            found |= self._importing_tests(root, mutant.module)
         return sorted(found, key=lambda k: (self.tests[k]["duration"], k))
+
+    def _importing_tests(self, root: Path, module: str) -> set[int]:
+        """The tests in test files that import ``module`` or its package (they may call a compiled
+        kernel directly, running no traced line)."""
+        wanted = _wanted_names(module)
+        files: dict[str, bool] = {}
+        found: set[int] = set()
+        for k, test in enumerate(self.tests):
+            file = test["nodeid"].split("::")[0]
+            if file not in files:
+                path = root / file
+                files[file] = path.is_file() and bool(
+                    _imported_names(path.read_text(encoding="utf-8")) & wanted)
+            if files[file]:
+                found.add(k)
+        return found
 
 
 #: Changes when the map's contents change meaning (a cached map of another format is not reused).
