@@ -14,13 +14,14 @@ if TYPE_CHECKING:
     from benchmarks.mutation.operators import Mutant
     from benchmarks.mutation.runner import CheckConfig, MutantResult
 
-__all__ = ["STATUSES", "render_markdown", "summarize", "write_report"]
+__all__ = ["STATUSES", "project_commit", "render_markdown", "summarize", "write_report"]
 
 #: The outcomes, in the order the report counts them.
 STATUSES = ("caught", "survived", "timeout", "error", "not run")
 
 
-def _commit(root: Path) -> str:
+def project_commit(root: Path) -> str:
+    """The short commit of ``root``, with a note when tracked files have uncommitted changes."""
     try:
         head = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True,
                               text=True, check=True).stdout.strip()
@@ -32,14 +33,16 @@ def _commit(root: Path) -> str:
 
 
 def summarize(config: CheckConfig, every: Sequence[Mutant], results: Sequence[MutantResult],
-              map_info: dict[str, Any], seconds: float, interrupted: bool, untouched: bool) -> dict[str, Any]:
-    """Everything ``results.json`` holds."""
+              map_info: dict[str, Any], seconds: float, interrupted: bool, untouched: bool,
+              commit: str | None = None) -> dict[str, Any]:
+    """Everything ``results.json`` holds; ``commit`` is the project's commit when the run started
+    (read now if not given)."""
     counts = Counter(r.status for r in results)
     settings = {k: (str(v) if isinstance(v, Path) else v) for k, v in asdict(config).items()}
     settings["operators"] = list(config.operators)
     return {
         "settings": settings,
-        "commit": _commit(config.root),
+        "commit": commit if commit is not None else project_commit(config.root),
         "mutants_in_modules": len(every),
         "mutants_by_module": dict(Counter(m.module for m in every)),
         "map": map_info,

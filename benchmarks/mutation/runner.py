@@ -312,10 +312,11 @@ def run_check(config: CheckConfig, log: Callable[[str], None] = print) -> dict[s
         What ``results.json`` holds: the settings, the map run, the counts and every mutant's record.
         If interrupted, the mutants finished so far are written before ``KeyboardInterrupt`` propagates.
     """
-    from benchmarks.mutation.report import summarize, write_report
+    from benchmarks.mutation.report import project_commit, summarize, write_report
 
     start = time.perf_counter()
     root = config.root.resolve()
+    commit = project_commit(root)  # the tree the sandbox copies, not the one at the end
     config.out.mkdir(parents=True, exist_ok=True)
     files = module_files(root, config.modules)
     before = _hash_files(root, files)
@@ -348,7 +349,7 @@ def run_check(config: CheckConfig, log: Callable[[str], None] = print) -> dict[s
     finally:
         untouched = _hash_files(root, files) == before
         summary = summarize(config, every, results, map_info, time.perf_counter() - start,
-                            interrupted=interrupted, untouched=untouched)
+                            interrupted=interrupted, untouched=untouched, commit=commit)
         write_report(config.out, summary)
     return summary
 
