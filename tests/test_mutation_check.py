@@ -162,6 +162,11 @@ def test_caught_survived_untested_and_timed_out_mutants_are_told_apart(project: 
     assert "1 caught, 2 survived (1 run by no test), 1 timed out" in report
     assert json.loads((out / "results.json").read_text())["tried"] == 4
     assert len((out / "mutants.jsonl").read_text().splitlines()) == 4
+    assert "of which the map run" in report and "reused" not in report
+    # a second run on the same tree reuses the map, and says so
+    again = run_check(CheckConfig(**{**config.__dict__, "mutant_ids": list(chosen)[:1]}), log=lambda _: None)
+    assert again["map"]["reused"] and again["counts"]["caught"] == 1
+    assert "the map was reused from an earlier run" in (out / "report.md").read_text()
 
 
 KERNEL = textwrap.dedent(

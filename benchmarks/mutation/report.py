@@ -73,6 +73,14 @@ def _code(text: str) -> str:
     return "`" + text.replace("`", "'").replace("|", "\\|") + "`"
 
 
+def _map_note(info: dict[str, Any]) -> str:
+    if not info:
+        return ""
+    if info.get("reused"):
+        return f"; the map was reused from an earlier run (which took {info['seconds']:.0f} s)"
+    return f", of which the map run {info['seconds']:.0f} s"
+
+
 def render_markdown(summary: dict[str, Any]) -> str:
     """``report.md``: the settings, the counts, and every mutant that was not caught."""
     s = summary["settings"]
@@ -84,7 +92,7 @@ def render_markdown(summary: dict[str, Any]) -> str:
         f"Commit {summary['commit']}; modules {', '.join(s['modules'])}; tests {', '.join(s['tests'])}.",
         f"Sample of {summary['tried']} of {summary['mutants_in_modules']} mutants (seed {s['seed']}, "
         f"operators {', '.join(s['operators'])}); wall time {summary['wall_seconds']:.0f} s"
-        + (f", of which the map run {summary['map']['seconds']:.0f} s" if summary["map"] else "") + ".",
+        + _map_note(summary["map"]) + ".",
         "",
         f"**{c['caught']} caught, {c['survived']} survived ({summary['no_test']} run by no test), "
         f"{c['timeout']} timed out, {c['error']} errors, {c['not run']} not run.**",

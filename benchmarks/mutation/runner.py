@@ -249,7 +249,7 @@ def _build_map(config: CheckConfig, box: Sandbox, files: dict[str, str], log: Ca
         data = json.loads(cached.read_text(encoding="utf-8"))
         if data.get("key") == key:
             log(f"map: reusing {cached} ({len(data['tests'])} tests)")
-            return data
+            return {**data, "reused": True}
     targets = box.path / "targets.json"
     targets.write_text(json.dumps([str(box.tree / rel) for rel in files.values()]), encoding="utf-8")
     trace = box.path / "trace.json"
@@ -331,8 +331,9 @@ def run_check(config: CheckConfig, log: Callable[[str], None] = print) -> dict[s
         with Sandbox(root, exclude=[config.out], keep=config.keep_sandbox) as box:
             data = _build_map(config, box, files, log)
             line_map = LineMap(data, files)
-            map_info = {"seconds": data["seconds"], "tests": len(data["tests"]),
-                        "tests_passed": len(line_map.tests), "summary": data.get("summary", [])}
+            map_info = {"seconds": data["seconds"], "reused": bool(data.get("reused")),
+                        "tests": len(data["tests"]), "tests_passed": len(line_map.tests),
+                        "summary": data.get("summary", [])}
             for i, mutant in enumerate(chosen):
                 elapsed = time.perf_counter() - start
                 if config.budget_minutes is not None and elapsed > 60.0 * config.budget_minutes:
