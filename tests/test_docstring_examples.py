@@ -18,6 +18,7 @@ PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common")
 #: The modules whose docstrings hold examples (``>>>``), by their import name.
 MODULES_WITH_EXAMPLES = (
     "benchmarks.compare",
+    "benchmarks.core.executors",
     "benchmarks.core.family",
     "benchmarks.core.jsonable",
     "benchmarks.core.metrics",
@@ -29,6 +30,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.families.flexible.controllers",
     "benchmarks.families.flexible.metrics",
     "benchmarks.families.wheel.plant",
+    "benchmarks.mutation.operators",
     "benchmarks.reports.sections",
     "benchmarks.reports.tables",
     "benchmarks.suites.faults",
