@@ -15,16 +15,10 @@ import pytest
 
 from benchmarks.cli import main
 from benchmarks.core.store import CaseStore
+from benchmarks.robustness.cli_cases import TINY_SWEEP
 from toolkit_common.errors import ConfigError, StoreError
 
-TINY = """name = "tiny"
-description = "one short case"
-[base]
-plant = "linear"
-controller = "LQR"
-saturation = "limiter"
-duration = 0.2
-"""
+TINY = TINY_SWEEP  # one short case of LQR on the linear plant
 
 
 def _store_with_rows(path: Path, n: int = 20) -> None:

@@ -25,9 +25,11 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sqlite3
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -167,14 +169,20 @@ class CaseStore:
 
     def begin_run(self, command: str) -> int:
         """Register an invocation of the sweep; return its run number (1, 2, ...)."""
-        try:
+        with self._sqlite_errors():
             cur = self._db.execute(
                 "INSERT INTO runs (started_at, command) VALUES (?, ?)", (time.time(), command)
             )
             self._db.commit()
+        return int(cur.lastrowid)
+
+    @contextlib.contextmanager
+    def _sqlite_errors(self) -> Iterator[None]:
+        """An SQLite error inside (a lock held too long, a damaged page) as a :class:`StoreError`."""
+        try:
+            yield
         except sqlite3.Error as err:
             raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
-        return int(cur.lastrowid)
 
     def _put(
         self,
@@ -186,37 +194,23 @@ class CaseStore:
         error: str | None,
         run: int,
     ) -> None:
-        try:
-            self._write_case(case_id, position, scenario, status, record, error, run)
-        except sqlite3.Error as err:
-            raise StoreError(str(self.path), _EXPECTED, _found(err)) from None
-
-    def _write_case(
-        self,
-        case_id: str,
-        position: int,
-        scenario: dict[str, Any],
-        status: str,
-        record: Any,
-        error: str | None,
-        run: int,
-    ) -> None:
-        self._db.execute(
-            "INSERT OR REPLACE INTO cases"
-            " (case_id, position, scenario, status, record, error, run, finished_at)"
-            " VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-            (
-                case_id,
-                position,
-                json.dumps(scenario, sort_keys=True),
-                status,
-                None if record is None else json.dumps(record, allow_nan=False),
-                error,
-                run,
-                time.time(),
-            ),
-        )
-        self._db.commit()
+        with self._sqlite_errors():
+            self._db.execute(
+                "INSERT OR REPLACE INTO cases"
+                " (case_id, position, scenario, status, record, error, run, finished_at)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                (
+                    case_id,
+                    position,
+                    json.dumps(scenario, sort_keys=True),
+                    status,
+                    None if record is None else json.dumps(record, allow_nan=False),
+                    error,
+                    run,
+                    time.time(),
+                ),
+            )
+            self._db.commit()
 
     def put_done(
         self, case_id: str, position: int, scenario: dict[str, Any], record: dict[str, Any], run: int

@@ -22,6 +22,20 @@ duration = 0.2
 """A valid sweep of one case of 0.2 s (the damaged stores sit next to it)."""
 
 
+SWEEP_ARGV = (
+    "bench",
+    "sweep",
+    "--config",
+    "{tmp}/sweep.toml",
+    "--out",
+    "{tmp}/out",
+    "--workers",
+    "0",
+    "--no-progress",
+)
+"""``rmpc`` arguments of a sweep of ``{tmp}/sweep.toml`` into ``{tmp}/out``, run in-process."""
+
+
 def _write(name: str, text: str | bytes) -> Callable[[str], None]:
     def setup(tmp: str) -> None:
         path = os.path.join(tmp, name)
@@ -107,17 +121,7 @@ def _sweep(name: str, body: str, names: tuple[str, ...], kind: str = "sweep file
         f"cli:sweep {name}",
         "cli",
         names,
-        argv=(
-            "bench",
-            "sweep",
-            "--config",
-            "{tmp}/sweep.toml",
-            "--out",
-            "{tmp}/out",
-            "--workers",
-            "0",
-            "--no-progress",
-        ),
+        argv=SWEEP_ARGV,
         setup=_sweep_file(body),
         kind=kind,
     )
@@ -128,17 +132,7 @@ def _store(kind: str) -> Probe:
         f"cli:store {kind}",
         "cli",
         ("sweep.sqlite", "store"),
-        argv=(
-            "bench",
-            "sweep",
-            "--config",
-            "{tmp}/sweep.toml",
-            "--out",
-            "{tmp}/out",
-            "--workers",
-            "0",
-            "--no-progress",
-        ),
+        argv=SWEEP_ARGV,
         setup=_damaged_store(kind),
         kind="store",
         expect="either" if kind == "empty file" else "error",  # SQLite takes an empty file as a new store
@@ -363,17 +357,7 @@ def cli_probes() -> list[Probe]:
             "cli:sweep --out holds another sweep's results",
             "cli",
             ("--out", "results"),
-            argv=(
-                "bench",
-                "sweep",
-                "--config",
-                "{tmp}/sweep.toml",
-                "--out",
-                "{tmp}/out",
-                "--workers",
-                "0",
-                "--no-progress",
-            ),
+            argv=SWEEP_ARGV,
             setup=_another_sweep_results,
             kind="overwrite",
         ),
@@ -381,16 +365,7 @@ def cli_probes() -> list[Probe]:
             "cli:sweep --scheduler not an address",
             "cli",
             ("--scheduler",),
-            argv=(
-                "bench",
-                "sweep",
-                "--config",
-                "{tmp}/sweep.toml",
-                "--out",
-                "{tmp}/out",
-                "--scheduler",
-                "not an address",
-            ),
+            argv=(*SWEEP_ARGV[:6], "--scheduler", "not an address"),
             setup=_sweep_file(base),
             kind="scheduler",
         ),
@@ -398,16 +373,7 @@ def cli_probes() -> list[Probe]:
             "cli:sweep --scheduler tls://",
             "cli",
             ("--scheduler",),
-            argv=(
-                "bench",
-                "sweep",
-                "--config",
-                "{tmp}/sweep.toml",
-                "--out",
-                "{tmp}/out",
-                "--scheduler",
-                "tls://",
-            ),
+            argv=(*SWEEP_ARGV[:6], "--scheduler", "tls://"),
             setup=_sweep_file(base),
             kind="scheduler",
         ),
@@ -421,17 +387,7 @@ def cli_probes() -> list[Probe]:
             "cli:sweep store from another sweep",
             "cli",
             ("sweep.sqlite", "store", "another"),
-            argv=(
-                "bench",
-                "sweep",
-                "--config",
-                "{tmp}/sweep.toml",
-                "--out",
-                "{tmp}/out",
-                "--workers",
-                "0",
-                "--no-progress",
-            ),
+            argv=SWEEP_ARGV,
             setup=_both(_sweep_file(base), _store_with_rows),
             kind="store",
         )
