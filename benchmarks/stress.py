@@ -15,7 +15,9 @@ peak or ellipsoid input bound and a state ``x``. Two kinds:
 ``"infeasible"``
     The vertex-mean plant has a real eigenvalue ``lam`` in ``[1.1, 1.5]`` with left
     eigenvector ``w`` (the other vertices are perturbations of it) and ``x`` is drawn so that
-    ``|w'x| (lam - 1)`` is twice the largest ``|w' B_0 u|`` the input bound allows. On the
+    ``|w'x| (lam - 1)`` is ``distance`` (2 unless given) times the largest ``|w' B_0 u|`` the
+    input bound allows: the state is ``distance`` times as far along ``w`` as the edge of the
+    slab ``|w'x| (lam - 1) <= max |w' B_0 u|`` that holds every state the input can keep. On the
     constant plant ``(A_0, B_0)``, which is in the polytope, ``|w'x(k)|`` then grows for every
     admissible input sequence (``|w'x(k+1)| >= lam |w'x(k)| - |w'B_0 u(k)|``), so no
     controller keeps the cost finite and the Kothare LMIs have no solution. Here ``A_0`` is
@@ -159,7 +161,8 @@ def _feasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: 
     return a, b, q1, r, u_max, x, (gamma, q, y)
 
 
-def _infeasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: str):
+def _infeasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: str,
+                distance: float = 2.0):
     """One draw of an infeasible problem (see the module docstring)."""
     lam = rng.uniform(1.1, 1.5)
     rest = rng.normal(size=(n - 1, n - 1)) / np.sqrt(n - 1)
@@ -184,13 +187,17 @@ def _infeasible(rng: np.random.Generator, n: int, m: int, count: int, constraint
         u_max = float(rng.uniform(0.5, 2.0))
         reach = float(np.linalg.norm(wb)) * u_max
     x = rng.normal(size=n)
-    x *= 2.0 * reach / ((lam - 1.0) * abs(float(w @ x)))
+    x *= distance * reach / ((lam - 1.0) * abs(float(w @ x)))
     return a, b, q1, r, u_max, x, None
 
 
 def make_problem(n: int, m: int, n_vertices: int, kind: Kind, seed: int,
-                 input_constraint: str = "peak") -> StressProblem:
+                 input_constraint: str = "peak", distance: float = 2.0) -> StressProblem:
     """One stress problem (deterministic in its arguments).
+
+    ``distance`` (infeasible problems only, > 1) places the state that many times beyond the
+    slab of states the input can hold (see the module docstring); the data do not depend on it,
+    only the state's length.
 
     Raises
     ------
@@ -207,11 +214,15 @@ def make_problem(n: int, m: int, n_vertices: int, kind: Kind, seed: int,
         raise InvalidArgumentError("kind", "'feasible' or 'infeasible'", repr(kind))
     if input_constraint not in ("peak", "ellipsoid"):
         raise InvalidArgumentError("input_constraint", "'peak' or 'ellipsoid'", repr(input_constraint))
+    if isinstance(distance, bool) or not (isinstance(distance, int | float) and 1.0 < distance < np.inf):
+        raise InvalidArgumentError("distance", "a finite number > 1", repr(distance))
     rng = np.random.default_rng([seed, n, m, n_vertices, kind == "feasible",
                                  input_constraint == "peak"])
-    draw = _feasible if kind == "feasible" else _infeasible
     for _ in range(MAX_DRAWS):
-        out = draw(rng, n, m, n_vertices, input_constraint)
+        if kind == "feasible":
+            out = _feasible(rng, n, m, n_vertices, input_constraint)
+        else:
+            out = _infeasible(rng, n, m, n_vertices, input_constraint, float(distance))
         if out is not None:
             a, b, q1, r, u_max, x, witness = out
             for arr in (a, b, q1, r, x):

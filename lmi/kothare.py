@@ -118,9 +118,10 @@ class KothareProblem:
         Output constraints ``|(C x(k+i))_r| <= y_max_r`` for ``i >= 1`` (Kothare 1996, sec. 3.2).
     backend : str
         ``"ipm"`` (default: the toolkit's own structure-exploiting interior-point method
-        :mod:`lmi.ipm`, data built once, warm-started; a failed solve runs phase one, which
-        either proves the problem infeasible (status ``"infeasible"`` with
-        ``LMISolution.infeasibility``) or hands the state to Clarabel; :mod:`lmi.backends.ipm`),
+        :mod:`lmi.ipm`, data built once, warm-started; an infeasible problem is proved so by
+        the run's own dual iterates or, after a failed solve, by phase one (status
+        ``"infeasible"`` with ``LMISolution.infeasibility``), and what neither settles goes to
+        Clarabel; :mod:`lmi.backends.ipm`),
         ``"clarabel"`` (Clarabel's own API, data built once) or
         ``"cvxpy"`` with ``solver`` naming any installed
         cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).

@@ -1,9 +1,12 @@
-"""Infeasibility as a status: the IPM's phase one and the independently checked Farkas certificate.
+"""Infeasibility as a status: the IPM's Farkas ray, its phase one and the independently checked
+certificate.
 
 * The closed-form infeasible problem of ``test_lmi_failures`` (``x1(k+1) = 1.5 x1(k) + u``,
   ``|u| <= 0.01``, ``x1 = 10``: ``|x1|`` grows for every admissible input) comes back
-  ``"infeasible"`` from the IPM itself (no Clarabel fallback) with a certificate that
-  :func:`lmi.infeasibility.check_farkas` accepts; cvxpy + Clarabel at 1e-9 says infeasible too.
+  ``"infeasible"`` from the IPM's main run itself (no phase one, no Clarabel fallback) with a
+  certificate that :func:`lmi.infeasibility.check_farkas` accepts; with the ray test off
+  (``infeasibility_radius = inf``) phase one proves it; cvxpy + Clarabel at 1e-9 says
+  infeasible too.
 * A certificate tampered with (sign flipped, a block made indefinite, checked against another
   state inside the region) fails the check.
 * Infeasible stress problems (infeasible by construction, :mod:`benchmarks.stress`) are proved
@@ -36,11 +39,16 @@ def _problem(constraint: str, **kw) -> KothareProblem:
 def test_closed_form_infeasible_state_is_proved_by_the_ipm(constraint):
     sol = _problem(constraint).solve(FAR)
     assert sol.status == "infeasible", sol.solver_status
-    assert sol.solver_status.endswith("phase one infeasible") and "clarabel" not in sol.solver_status
+    assert sol.solver_status == "ipm infeasible"  # the main run's ray: no phase one, no fallback
     cert = sol.infeasibility
     assert cert is not None and cert.ok
     assert cert.objective < 0.0 and cert.radius >= MIN_RADIUS and cert.min_eigenvalue >= 0.0
     assert np.isnan(sol.gamma) and sol.Q is None
+    # the ray test off: phase one proves it
+    slow = _problem(constraint, solver_options={"infeasibility_radius": np.inf}).solve(FAR)
+    assert slow.status == "infeasible" and slow.infeasibility.ok
+    assert slow.solver_status.endswith("phase one infeasible") and "clarabel" not in slow.solver_status
+    assert slow.iterations > sol.iterations
     ref = _problem(constraint, backend="cvxpy", solver="CLARABEL",
                    solver_options={"tol_feas": 1e-9, "tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9}).solve(FAR)
     assert ref.status == "infeasible"
@@ -119,5 +127,37 @@ def test_stress_problems_are_classified_as_known(n, vertices, seed):
 def test_phase_one_setting_is_checked():
     with pytest.raises(InvalidArgumentError, match="phase_one"):
         _problem("peak", solver_options={"phase_one": 1})
-    off = _problem("peak", solver_options={"phase_one": False}).solve(FAR)
+    off = _problem("peak", solver_options={"phase_one": False, "infeasibility_radius": np.inf}).solve(FAR)
     assert off.status == "infeasible" and "clarabel" in off.solver_status and off.infeasibility is None
+    # phase one off, the ray on: the main run proves it by itself
+    ray = _problem("peak", solver_options={"phase_one": False}).solve(FAR)
+    assert ray.solver_status == "ipm infeasible" and ray.infeasibility.ok
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, np.nan, True, "1e8"])
+def test_infeasibility_radius_setting_is_checked(bad):
+    with pytest.raises(InvalidArgumentError, match="infeasibility_radius"):
+        _problem("peak", solver_options={"infeasibility_radius": bad})
+
+
+def test_a_radius_beyond_reach_leaves_the_proof_to_phase_one():
+    """A ray must prove the radius asked for: at 1e300 the main run cannot, phase one does (its
+    check asks :data:`~lmi.infeasibility.MIN_RADIUS`)."""
+    sol = _problem("peak", solver_options={"infeasibility_radius": 1e300}).solve(FAR)
+    assert sol.status == "infeasible" and sol.solver_status.endswith("phase one infeasible")
+
+
+def test_a_ray_that_fails_the_independent_check_is_not_called_infeasible(monkeypatch):
+    """The main run's proof is checked on the conic data; a check that fails (here: made against
+    a bound ten times larger, on which the multipliers prove nothing) leaves the solve failed."""
+    prob = _problem("peak", solver_options={"phase_one": False})
+    backend = prob._backend
+    check = backend.farkas_check
+
+    def wrong_data(z_blocks, xs, u_max, y_max):
+        return check(z_blocks, xs, 10.0 * u_max, y_max)
+
+    monkeypatch.setattr(backend, "farkas_check", wrong_data)
+    sol = prob.solve(FAR)
+    assert sol.solver_status.startswith("ipm infeasible (unchecked); clarabel"), sol.solver_status
+    assert sol.infeasibility is None

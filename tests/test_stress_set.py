@@ -70,7 +70,8 @@ def test_stress_set_is_deterministic_and_covers_its_grid():
 
 @pytest.mark.parametrize(("kwargs", "name"), [
     ({"n": 1}, "n"), ({"m": 0}, "m"), ({"n_vertices": 0}, "n_vertices"), ({"kind": "maybe"}, "kind"),
-    ({"input_constraint": "box"}, "input_constraint"),
+    ({"input_constraint": "box"}, "input_constraint"), ({"distance": 1.0}, "distance"),
+    ({"distance": np.inf}, "distance"), ({"distance": True}, "distance"),
 ])
 def test_bad_arguments_name_the_argument(kwargs, name):
     args = {"n": 4, "m": 2, "n_vertices": 2, "kind": "feasible", "seed": 0, **kwargs}
@@ -92,3 +93,12 @@ def test_stress_benchmark_answers_never_contradict_the_construction():
     assert records[0]["rel_diff_gamma_ipm"] < 1e-6
     assert records[1]["ipm"]["status"] != "optimal"
     assert "n4-v2-infeasible-s0" in format_stress(records)
+
+
+def test_distance_moves_only_the_state_and_scales_it():
+    """``distance`` changes neither the data nor the state's direction, only its length (in
+    proportion: the state is placed on ``|w'x| (lam - 1) = distance * max |w' B_0 u|``)."""
+    base = make_problem(4, 2, 2, "infeasible", 1, "ellipsoid")
+    far = make_problem(4, 2, 2, "infeasible", 1, "ellipsoid", distance=2e3)
+    assert np.array_equal(base.A, far.A) and np.array_equal(base.B, far.B) and base.u_max == far.u_max
+    assert np.allclose(far.x, 1e3 * base.x, rtol=1e-14, atol=0.0)

@@ -25,6 +25,7 @@ from lmi.backends.conic import KothareConic
 from lmi.data import KothareData
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
+from lmi.ipm.solver import INFEASIBILITY_RADIUS
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
 from lmi.status import INACCURATE, INFEASIBLE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
@@ -66,6 +67,10 @@ REBALANCE_MAX_RESIDUAL = 1e-3
 #: "inaccurate" or "insufficient_progress" after 35-48 iterations. Rebalanced, they ended
 #: "optimal" in 48-69 iterations in all (0.4-1.4 s at load 1-2), gamma within 7e-10 of cvxpy +
 #: Clarabel at 1e-10 on the delta form at 14 deg.
+#: ``infeasibility_radius``: a run ends ``"infeasible"`` when its dual iterate proves that no
+#: solution of norm below this exists (:meth:`lmi.ipm.BlockLMISolver.solve`; ``inf`` switches the
+#: test off and leaves infeasible problems to phase one); the proof is checked again on the conic
+#: data (:meth:`IPMKothare.solve`).
 DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "tol_feas": 1e-8,
     "tol_gap_abs": 1e-12,
@@ -77,6 +82,7 @@ DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "state_scaling": True,
     "phase_one": True,
     "rebalance": True,
+    "infeasibility_radius": INFEASIBILITY_RADIUS,
 }
 _STATUS = {
     "optimal": OPTIMAL,
@@ -99,6 +105,10 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, float | int) and value > 0):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(value))
+    radius = merged["infeasibility_radius"]
+    if isinstance(radius, bool) or not (isinstance(radius, float | int) and radius > 0):
+        raise InvalidArgumentError("solver_options['infeasibility_radius']", "a number > 0 (inf: no test)",
+                                   repr(radius))
     for key in ("max_iter", "warm_max_iter"):
         value = merged[key]
         if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
@@ -221,7 +231,12 @@ class IPMKothare(KothareBackend):
         """Solve with the IPM; a failure goes to phase one, then (unless proved infeasible) to
         Clarabel.
 
-        A solve that does not end ``"optimal"`` runs phase one
+        A solve that ends ``"infeasible"`` (its dual iterate a Farkas ray, see
+        :meth:`lmi.ipm.BlockLMISolver.solve`) is checked by :func:`lmi.infeasibility.check_farkas`
+        on the conic data of the fallback; checked, the answer is ``"infeasible"`` with that
+        certificate and ``solver_status`` ``"ipm infeasible"``; unchecked, the solve counts as
+        failed (``"infeasible (unchecked)"``) and goes on as below. Any other solve that does
+        not end ``"optimal"`` runs phase one
         (:meth:`lmi.ipm.BlockLMISolver.phase_one`). If it proves the problem infeasible and
         the proof passes :func:`lmi.infeasibility.check_farkas` on the conic data of the
         fallback (independent of the IPM's own packing, equilibration and factored forms), the
@@ -244,6 +259,8 @@ class IPMKothare(KothareBackend):
         raw = self._solve_ipm(xs, us, ys)
         if raw.status == OPTIMAL:
             return self._unscale(raw, norm)
+        if raw.status == INFEASIBLE:
+            return dataclasses.replace(raw, solver_status=f"ipm {raw.solver_status}")
         t_new = self._rebalanced_scaling(raw) if self._rebalance else None
         if t_new is not None:
             start = time.perf_counter()
@@ -363,6 +380,13 @@ class IPMKothare(KothareBackend):
                              time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
+        if res.status == "infeasible":
+            cert = self.farkas_check(res.Z, x, u_max, y_max)
+            if cert.ok:
+                return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
+                                 infeasibility=cert)
+            return RawResult(NUMERICAL_ERROR, "infeasible (unchecked)", np.nan, None, None, res.iterations,
+                             elapsed)
         q_mat, y_mat = self.conic.variables(res.x)
         return RawResult(
             _STATUS.get(res.status, NUMERICAL_ERROR), res.status, self.gamma(res.x[0]), q_mat, y_mat,

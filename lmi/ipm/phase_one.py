@@ -131,7 +131,8 @@ def phase_one_solver(slv: BlockLMISolver) -> BlockLMISolver:
         cvec[n] = 1.0
         aux = slv._phase_one_solver = type(slv)(
             cvec, blocks, tol_feas=PHASE_ONE_TOL, tol_gap_abs=PHASE_ONE_TOL,
-            tol_gap_rel=PHASE_ONE_TOL, max_iter=PHASE_ONE_MAX_ITER, factors=factors)
+            tol_gap_rel=PHASE_ONE_TOL, max_iter=PHASE_ONE_MAX_ITER, infeasibility_radius=np.inf,
+            factors=factors)
     return aux
 
 
