@@ -95,6 +95,13 @@ INFEASIBILITY_RADIUS = MIN_RADIUS
 #: 60 far states of :mod:`benchmarks.far_states`: ``||G'z|| / ||z||`` of 2e-12..3e-10 (see
 #: :meth:`BlockLMISolver.solve`).
 RAY_TOL = 1e-6
+#: A run that stalls (:data:`STALL_WINDOW`) while its Farkas radius keeps growing (halved
+#: inverse over the window) goes on for at most this many iterations, for a proof only: if none
+#: comes (nor ``"optimal"``), it ends ``"insufficient_progress"`` with the iterate of the stall,
+#: as without the extension. On the far states of :mod:`benchmarks.far_states` the proof came
+#: 3-10 iterations after the stall; problems close to the edge of feasibility (phase one then
+#: says "feasible") also have growing duals and spend the extension for nothing.
+RAY_EXTENSION = 15
 
 
 @dataclass
@@ -233,8 +240,9 @@ class BlockLMISolver(BlockData):
         ||(sum_j <A_ij, Z_j>)_i||``: a solution ``x`` would give ``0 <= sum_j <S_j, Z_j> =
         sum_j <C_j, Z_j> - sum_i x_i sum_j <A_ij, Z_j> <= -r ||a|| + ||x|| ||a||`` (``a`` the
         vector of the ``sum_j <A_ij, Z_j>``), so none exists with ``||x|| < r``. The run ends
-        ``"infeasible"`` once ``r >= infeasibility_radius``; it is not ended for a stall while
-        ``r`` keeps growing. A feasible problem can reach that radius only if all its solutions
+        ``"infeasible"`` once ``r >= infeasibility_radius``; a run that stalls while ``r`` keeps
+        growing goes on for at most :data:`RAY_EXTENSION` iterations for that proof, and without
+        one ends as at the stall. A feasible problem can reach that radius only if all its solutions
         are at least that large. On random open-loop-unstable Kothare problems of 2-6 states at
         1e3 times the largest feasible state, the proof came after 21-35 iterations.
         """
@@ -324,6 +332,8 @@ class BlockLMISolver(BlockData):
         merits: list[float] = []
         ray_merits: list[float] = []
         radius = np.nan
+        stall_point: tuple | None = None  # the iterate where the run stalled, while a ray grows
+        extension_end = -1
         if not _kernels.cholesky_blocks(s, orders, s_chol):
             max_iter, status = -1, "numerical_error"
         debug = _LOG.isEnabledFor(logging.DEBUG)
@@ -341,7 +351,7 @@ class BlockLMISolver(BlockData):
             ):
                 status = "optimal"
                 break
-            if max(pres, dres) <= REDUCED_TOL and min(gap, rel_gap) <= REDUCED_TOL:
+            if stall_point is None and max(pres, dres) <= REDUCED_TOL and min(gap, rel_gap) <= REDUCED_TOL:
                 best = (x, s, z, pres, dres, gap)
             if monitor is not None and (word := monitor(x, s, z)) is not None:
                 status, best = word, None
@@ -355,12 +365,18 @@ class BlockLMISolver(BlockData):
                 break
             merits.append(max(pres, dres, min(gap, rel_gap)))
             ray_merits.append(1.0 / radius if radius > 0.0 else np.inf)
-            if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW] and not (
-                    ray_merits[-1] <= STALL_FACTOR * ray_merits[-1 - STALL_WINDOW]):
-                status = "insufficient_progress"
+            ray_grows = it >= STALL_WINDOW and ray_merits[-1] <= STALL_FACTOR * ray_merits[-1 - STALL_WINDOW]
+            if stall_point is None:
+                if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW]:
+                    if not ray_grows:
+                        status = "insufficient_progress"
+                        break
+                    # stalled, but the dual iterate grows along a ray: go on for a proof only
+                    stall_point, extension_end = (x, s, z, pres, dres, gap), it + RAY_EXTENSION
+            elif not ray_grows or it >= extension_end:
                 break
-            if (0.1 * self.warm_gap <= rel_gap <= self.warm_gap
-                    and max(pres, dres) <= self.warm_feas):
+            if stall_point is None and (0.1 * self.warm_gap <= rel_gap <= self.warm_gap
+                                        and max(pres, dres) <= self.warm_feas):
                 warm_next = (x * dscale, s, z)
             if it == max_iter:
                 break
@@ -393,6 +409,10 @@ class BlockLMISolver(BlockData):
                 status = "numerical_error"
                 break
             x, s, z, s_chol = x_new, s_new, z_new, chol_new
+        if stall_point is not None and status not in ("optimal", "infeasible"):
+            # no proof came: the run ends as it would have at the stall, with that iterate
+            status = "insufficient_progress"
+            x, s, z, pres, dres, gap = stall_point
         if status == "optimal" and warm_next is not None:
             self._warm = warm_next
         if status != "optimal" and best is not None:
