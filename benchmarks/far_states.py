@@ -100,7 +100,8 @@ def run_far(problems: Sequence[tuple[float, StressProblem]], repeats: int = 5) -
             in_times.append(t_in)
         t_far, t_in = statistics.median(far_times), statistics.median(in_times)
         records.append({
-            "label": f"{prob.label}-d{distance:g}", "distance": distance, "n_states": prob.n_states, "vertices": prob.n_vertices,
+            "label": f"{prob.label}-d{distance:g}", "distance": distance, "n_states": prob.n_states,
+            "vertices": prob.n_vertices,
             "input_constraint": prob.input_constraint, "length": length,
             "feasible_radius": radius, "beyond": length / radius if radius > 0.0 else float("inf"),
             "status": str(sol.status), "solver_status": sol.solver_status, "iterations": sol.iterations,
@@ -121,7 +122,8 @@ def format_far(records: Sequence[dict]) -> str:
     for r in records:
         proof = "n/a" if r["certificate_radius"] is None else f"{r['certificate_radius']:.1e}"
         lines.append(
-            f"| {r['label']} | {r['beyond']:.3g} | {r['status']}{'' if r['certificate_ok'] else ' (unchecked)'} "
+            f"| {r['label']} | {r['beyond']:.3g} | {r['status']}"
+            f"{'' if r['certificate_ok'] else ' (unchecked)'} "
             f"| {r['solver_status']} | {proof} | {r['far_iterations']} / {r['feasible_iterations']} "
             f"| {1e3 * r['far_time_s']:.1f} / {1e3 * r['feasible_time_s']:.1f} | {r['time_ratio']:.2f} |")
     proved = sum(r["status"] == "infeasible" and r["certificate_ok"] for r in records)
@@ -138,7 +140,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     import json
     import os
 
-    parser = argparse.ArgumentParser(description="states far outside the region: the IPM's infeasibility proofs")
+    parser = argparse.ArgumentParser(
+        description="states far outside the region: the IPM's infeasibility proofs")
     parser.add_argument("--sizes", nargs="+", type=int, default=[2, 3, 4, 5, 6])
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3])
     parser.add_argument("--distances", nargs="+", type=float, default=list(FAR_DISTANCES))
