@@ -330,6 +330,7 @@ class BlockLMISolver(BlockData):
         ray_merits: list[float] = []
         radius = np.nan
         stall_point: tuple | None = None  # the iterate where the run stalled, while a ray grows
+        ray_test = bool(np.isfinite(self.infeasibility_radius))  # inf: the test is off
         if not _kernels.cholesky_blocks(s, orders, s_chol):
             max_iter, status = -1, "numerical_error"
         debug = _LOG.isEnabledFor(logging.DEBUG)
@@ -355,13 +356,14 @@ class BlockLMISolver(BlockData):
             # the dual iterate as a Farkas ray: sum_j <A_ij, Z_j> = (G'z)_i / dscale_i
             gtz = rd - cvec
             radius = dcost / max(float(np.linalg.norm(gtz / dscale)), 1e-300) if dcost > 0.0 else 0.0
-            if radius >= self.infeasibility_radius and n_gtz <= RAY_TOL * float(np.linalg.norm(
+            if ray_test and radius >= self.infeasibility_radius and n_gtz <= RAY_TOL * float(np.linalg.norm(
                     _kernels.pack(z, *packing))):
                 status, best = "infeasible", None
                 break
             merits.append(max(pres, dres, min(gap, rel_gap)))
             ray_merits.append(1.0 / radius if radius > 0.0 else np.inf)
-            ray_grows = it >= STALL_WINDOW and ray_merits[-1] <= STALL_FACTOR * ray_merits[-1 - STALL_WINDOW]
+            ray_grows = ray_test and it >= STALL_WINDOW and (
+                ray_merits[-1] <= STALL_FACTOR * ray_merits[-1 - STALL_WINDOW])
             if stall_point is None:
                 if it >= STALL_WINDOW and merits[-1] > STALL_FACTOR * merits[-1 - STALL_WINDOW]:
                     if not ray_grows:
