@@ -123,7 +123,9 @@ class CaseResult:
     ----------
     settings : dict
         What the record's ``settings`` adds to the scenario's fields (initial state, the model
-        the controller used, ...).
+        the controller used, ...). The shipped families write ``duration_used``, the time that
+        ran (``n_steps dt`` of the trajectory; the scenario's ``duration`` is what was asked for,
+        which :func:`rmpc.sim.simulate` rounds to whole samples).
     metrics : dict
         The record's ``metrics``.
     trace : dict of ndarray

@@ -294,7 +294,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     table = getattr(inner, "table", None)
     extra = {
         "controller_name": controller_name(scenario),
-        "duration_used": case.duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "angle_deg_used": case.angle_deg,
         "n_vertices": None if poly is None else poly.n_vertices,
         "n_ellipsoids": None if table is None else table.n_ellipsoids,

@@ -166,7 +166,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         late = traj.t[:-1] >= lo
         metrics["td_est_err_max"] = float(np.abs(est[late] - traj.d[late]).max()) if late.any() else None
     extra = {
-        "duration_used": case.duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "steady_window": [lo, hi],
         "inertia_scale_used": case.inertia_scale,
         "disk": case.disk,

@@ -250,7 +250,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     metrics["faults"] = faults
     extra = {
         "x0": x0.tolist(),
-        "duration_used": duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "inertia_scale_used": scale,
         "polytope_inertia_spread": spread,
         "n_vertices": poly.n_vertices,
