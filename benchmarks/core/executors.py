@@ -189,7 +189,8 @@ class DaskExecutor:
     address : str
         The scheduler address.
     timeout : float
-        Seconds to wait for the connection.
+        Seconds to wait for the connection, and for the scheduler's answer to a first question
+        (the peer must say it is a scheduler before Dask's client is built).
     """
 
     def __init__(self, address: str, timeout: float = 20.0) -> None:
