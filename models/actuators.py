@@ -9,7 +9,20 @@ import numpy as np
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_positive_values, as_vector, check_choice, check_positive, check_real
 
-__all__ = ["ReactionWheelActuator", "TorqueLimiter"]
+__all__ = ["MAX_AXES", "ReactionWheelActuator", "TorqueLimiter"]
+
+MAX_AXES = 1_000
+"""Default bound on ``ReactionWheelActuator(n_axes=...)``: a spacecraft has 3 to 6 wheels, and the
+states are allocated at once (``n_axes = 10**9`` ended in a MemoryError);
+``ReactionWheelActuator(..., max_axes=N)`` lifts it."""
+
+
+def _gain(value: Any, name: str, which: str) -> float:
+    out = check_real(value, name)
+    if not out > 0.0:
+        expected = f"an {which} gain > 0 (a DC gain c b / (1 - a) > 0: the torque follows the command)"
+        raise InvalidArgumentError(name, expected, repr(out))
+    return out
 
 
 class ReactionWheelActuator:
@@ -20,12 +33,23 @@ class ReactionWheelActuator:
     ``c b / (1 - a) ~= 0.949``. Paper P states no sample time for it; it is run at the
     controller's sample time.
 
+    Each axis is a first-order lag sampled at ``dt``: ``a = exp(-dt / tau)`` lies in ``[0, 1)``
+    (``a = 0``: a lag much shorter than the sample, the torque follows one sample late), and the
+    wheel turns the way it is commanded: ``b > 0`` and ``c > 0``, so the DC gain is positive. A
+    pole ``a < 0`` (a sign flip every sample, which no sampled lag gives), ``|a| >= 1`` (no
+    decay) and a zero or negative gain are refused.
+
     Parameters
     ----------
     n_axes : int
-        Number of independent axes (3 for the satellite).
-    a, b, c : float
-        Pole, input gain and output gain; ``|a| < 1``.
+        Number of independent axes (3 for the satellite), at most ``max_axes``.
+    a : float
+        Pole, ``0 <= a < 1``.
+    b, c : float
+        Input gain and output gain, both ``> 0``.
+    max_axes : int
+        The largest ``n_axes`` accepted (default :data:`~models.actuators.MAX_AXES`, 1000); a
+        larger ``n_axes`` is refused with an error naming this limit. Pass a larger value to lift it.
 
     Examples
     --------
@@ -35,15 +59,29 @@ class ReactionWheelActuator:
     0.9486
     """
 
-    def __init__(self, n_axes: int = 3, a: float = 0.86, b: float = 0.0093, c: float = 14.28):
-        if not isinstance(n_axes, int) or n_axes < 1:
+    def __init__(
+        self,
+        n_axes: int = 3,
+        a: float = 0.86,
+        b: float = 0.0093,
+        c: float = 14.28,
+        *,
+        max_axes: int = MAX_AXES,
+    ) -> None:
+        if isinstance(max_axes, bool) or not isinstance(max_axes, int | np.integer) or max_axes < 1:
+            raise InvalidArgumentError("max_axes", "a positive integer", repr(max_axes))
+        if isinstance(n_axes, bool) or not isinstance(n_axes, int | np.integer) or n_axes < 1:
             raise InvalidArgumentError("n_axes", "a positive integer", repr(n_axes))
+        if n_axes > max_axes:
+            expected = f"at most max_axes = {max_axes} axes (pass a larger max_axes to lift it)"
+            raise InvalidArgumentError("n_axes", expected, repr(n_axes))
         self.a = check_real(a, "a")
-        if abs(self.a) >= 1.0:
-            raise InvalidArgumentError("a", "a stable pole, |a| < 1", repr(self.a))
-        self.b = check_real(b, "b")
-        self.c = check_real(c, "c")
-        self.n_axes = n_axes
+        if not 0.0 <= self.a < 1.0:
+            expected = "a decaying first-order pole, 0 <= a < 1 (a = exp(-dt / tau))"
+            raise InvalidArgumentError("a", expected, repr(self.a))
+        self.b = _gain(b, "b", "input")
+        self.c = _gain(c, "c", "output")
+        self.n_axes = int(n_axes)
         self._state = np.zeros(n_axes)
 
     @property

@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 from models import (
+    FaultSchedule,
     FlexibleSatellite,
     PolytopicModel,
     ReactionWheelActuator,
     RigidSatellite,
     TorqueLimiter,
+    WheelDisturbance,
     kinematics_matrix,
     zoh,
 )
@@ -215,7 +217,21 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("limiter-u_max-negative-axis", lambda: TorqueLimiter([1.0, -1.0, 1.0]), "u_max"),
     ("limiter-kind", lambda: TorqueLimiter(1.0, kind="soft"), "kind"),
     ("wheel-unstable-pole", lambda: ReactionWheelActuator(a=1.0), "a"),
+    ("wheel-pole-negative", lambda: ReactionWheelActuator(a=-0.5), "a"),  # |a| < 1 but a sign flip per sample
+    ("wheel-b-zero", lambda: ReactionWheelActuator(b=0.0), "b"),
+    ("wheel-b-negative", lambda: ReactionWheelActuator(b=-0.0093), "b"),
+    ("wheel-c-zero", lambda: ReactionWheelActuator(c=0.0), "c"),
+    ("wheel-c-negative", lambda: ReactionWheelActuator(c=-14.28), "c"),
+    ("wheel-b-and-c-negative", lambda: ReactionWheelActuator(b=-0.0093, c=-14.28), "b"),  # DC gain > 0 still
     ("wheel-n_axes", lambda: ReactionWheelActuator(n_axes=0), "n_axes"),
+    ("wheel-n_axes-bool", lambda: ReactionWheelActuator(n_axes=True), "n_axes"),
+    ("wheel-n_axes-beyond-max_axes", lambda: ReactionWheelActuator(n_axes=10**9), "n_axes"),
+    ("wheel-n_axes-beyond-lifted-max_axes", lambda: ReactionWheelActuator(n_axes=11, max_axes=10), "n_axes"),
+    ("wheel-max_axes-zero", lambda: ReactionWheelActuator(max_axes=0), "max_axes"),
+    ("wheel-disturbance-n_wheels-beyond-max_wheels", lambda: WheelDisturbance(10**12), "n_wheels"),
+    ("wheel-disturbance-max_wheels-zero", lambda: WheelDisturbance(4, max_wheels=0), "max_wheels"),
+    ("fault-schedule-n_wheels-beyond-max_wheels", lambda: FaultSchedule([], 10**12), "n_wheels"),
+    ("fault-schedule-n_wheels-beyond-lifted", lambda: FaultSchedule([], 5, max_wheels=4), "n_wheels"),
     ("wheel-command-length", lambda: ReactionWheelActuator().step([1.0, 2.0]), "command"),
 ]
 

@@ -246,3 +246,83 @@ def test_a_case_past_its_time_limit_is_stored_as_time_limit_and_the_rest_runs(tm
     stopped = rows[120.0]
     assert stopped["status"] == "error" and stopped["error"].startswith("time_limit: "), stopped["error"]
     assert rows[0.2]["status"] == "done"
+
+
+# --- sizes that a case would refuse after the sweep started are refused when the file is read -----
+
+WHEEL = 'name = "w"\n[base]\nfamily = "wheel"\ncontroller = "ABFTC"\nsaturation = "limiter"\n'
+MRP = 'name = "m"\n[base]\nfamily = "mrp"\ncontroller = "BS"\n'
+FLEXIBLE = 'name = "f"\n[base]\nfamily = "flexible"\ncontroller = "MTSMC"\n'
+GIPC_TINY = TINY.replace('controller = "LQR"', 'controller = "GIPC"')
+OFFLINE_TINY = TINY.replace('controller = "LQR"', 'controller = "OfflineRMPC"')
+
+STEPS, HORIZON, ELLIPSOIDS = "MAX_STEPS = 10000000", "MAX_HORIZON = 20000", "at most 40 for shrink = 0.5"
+READ_TIME_SIZES = {
+    # name: (sweep file, the key the error names, the limit it states)
+    "duration 1e12": (TINY.replace("duration = 0.2", "duration = 1e12"), "base.duration", STEPS),
+    "grid duration 1e12": (TINY + "[grid]\nduration = [0.2, 1e12]\n", "grid.duration", STEPS),
+    "wheel dt 1e-9": (WHEEL + "dt = 1e-9\n", "base.dt", STEPS),
+    "wheel dt past the run": (WHEEL + "dt = 1000.0\n", "base.dt", "at least one sample"),
+    "mrp dt 1e-9": (MRP + "dt = 1e-9\nplant_step = 1e-9\n", "base.dt", STEPS),
+    "flexible dt 1e-9": (FLEXIBLE + "dt = 1e-9\n", "base.dt", STEPS),
+    "GIPC Np 10^6": (GIPC_TINY + "[base.settings]\nNp = 1000000\n", "base.settings.Np", HORIZON),
+    "GIPC grid Np": (GIPC_TINY + "[grid]\nsettings.Np = [400, 20001]\n", "grid.settings.Np", HORIZON),
+    "wheel GIPC Np": (
+        WHEEL.replace('"ABFTC"', '"GIPC"') + "[base.settings]\nNp = 1000000\n", "base.settings.Np", HORIZON
+    ),
+    "OfflineRMPC 41 ellipsoids": (
+        OFFLINE_TINY + "[base.settings]\nn_ellipsoids = 41\n", "base.settings.n_ellipsoids", ELLIPSOIDS
+    ),
+    "flexible OfflineRMPC 41 ellipsoids": (
+        FLEXIBLE.replace('"MTSMC"', '"OfflineRMPC"') + "[base.settings]\nn_ellipsoids = 41\n",
+        "base.settings.n_ellipsoids",
+        ELLIPSOIDS,
+    ),
+}
+
+
+@pytest.mark.parametrize(("body", "where", "limit"), READ_TIME_SIZES.values(), ids=list(READ_TIME_SIZES))
+def test_a_size_beyond_what_a_case_runs_is_refused_when_the_sweep_is_read(tmp_path, body, where, limit):
+    """Each of these ran and then failed in every case (exit 1 after running); now the reader names
+    the key, the limit and what to do."""
+    from benchmarks.core.sweep_spec import load_sweep
+
+    with pytest.raises(ConfigError) as info:
+        load_sweep(_write_sweep(tmp_path, body))
+    assert info.value.argument == where, str(info.value)
+    assert limit in info.value.expected, str(info.value)
+    if "MAX_" in limit:
+        assert "lifts it" in info.value.expected
+
+
+@pytest.mark.parametrize("name", ["duration 1e12", "GIPC Np 10^6"])
+def test_the_cli_refuses_such_a_sweep_with_one_line_before_running(tmp_path, capsys, name):
+    body, where, _ = READ_TIME_SIZES[name]
+    config, out = _write_sweep(tmp_path, body), tmp_path / "out"
+    assert main(["bench", "sweep", "--config", str(config), "--out", str(out), "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"rmpc: error: {where}: ") and err.count("\n") == 1, err
+    assert not out.exists()  # refused before the folder (or any case) was made
+
+
+def test_the_read_time_bound_on_samples_is_the_simulators(monkeypatch):
+    """``check_run_length`` takes exactly what ``simulate`` takes by default: round(duration / dt) up to
+    ``rmpc.sim.simulate.MAX_STEPS`` samples, and at least one."""
+    import importlib
+    import inspect
+
+    from benchmarks.core.family import check_run_length
+
+    sim = importlib.import_module("rmpc.sim.simulate")  # the module (rmpc.sim.simulate is also the function)
+
+    assert inspect.signature(sim.simulate).parameters["max_steps"].default == sim.MAX_STEPS
+    assert check_run_length(float(sim.MAX_STEPS), 1.0, "duration") == sim.MAX_STEPS
+    assert check_run_length(sim.MAX_STEPS + 0.4, 1.0, "duration") == sim.MAX_STEPS  # rounds like simulate
+    with pytest.raises(ConfigError, match="MAX_STEPS"):
+        check_run_length(sim.MAX_STEPS + 0.6, 1.0, "duration")
+    assert check_run_length(0.6, 1.0, "dt") == 1
+    with pytest.raises(ConfigError, match="at least one sample"):
+        check_run_length(0.4, 1.0, "dt")
+    monkeypatch.setattr(sim, "MAX_STEPS", 10)  # the bound is read from the simulator, not copied
+    with pytest.raises(ConfigError, match="MAX_STEPS = 10 "):
+        check_run_length(0.11, 0.01, "duration")

@@ -1,4 +1,5 @@
-"""The torque limiter's two kinds and its saturation test, against values worked out by hand.
+"""The torque limiter's two kinds and its saturation test, against values worked out by hand; the
+reaction-wheel actuator's admissible parameters and the bounds on axis and wheel counts.
 
 ``kind="box"`` clips each axis (paper P's limiter); ``kind="norm"`` scales the whole vector down
 to ``||u||_2 = u_max`` and keeps its direction. The expected vectors below are computed by hand
@@ -11,7 +12,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from models import TorqueLimiter
+from models import (
+    FaultSchedule,
+    ReactionWheelActuator,
+    TorqueLimiter,
+    WheelArray,
+    WheelDisturbance,
+    WheelInputStage,
+)
+from models.actuators import MAX_AXES
+from models.wheels.array import MAX_WHEELS
 from toolkit_common.errors import InvalidArgumentError
 
 
@@ -90,3 +100,37 @@ def test_clipped_output_is_saturated_exactly_when_the_input_exceeded_the_bound(k
         else:
             np.testing.assert_array_equal(clipped, u)
     assert 20 <= exceeded <= 180  # both branches exercised (measured: 101 box, 134 norm of 200)
+
+
+# --- paper P's reaction-wheel actuator: what is admissible --------------------------------------
+
+
+def test_a_pole_at_zero_is_a_one_sample_delay_with_gain_c_b():
+    """``a = 0`` (a lag much shorter than the sample) is admitted: the torque is ``c b u`` one sample late."""
+    act = ReactionWheelActuator(n_axes=2, a=0.0, b=0.5, c=4.0)
+    assert act.dc_gain == 2.0
+    np.testing.assert_array_equal(act.step([1.0, -3.0]), [0.0, 0.0])
+    np.testing.assert_array_equal(act.step([0.0, 0.0]), [2.0, -6.0])
+    np.testing.assert_array_equal(act.step([0.0, 0.0]), [0.0, 0.0])
+
+
+def test_max_axes_lifts_the_bound_on_n_axes():
+    with pytest.raises(InvalidArgumentError, match="max_axes = 1000") as info:
+        ReactionWheelActuator(n_axes=MAX_AXES + 1)
+    assert info.value.argument == "n_axes" and "lift" in info.value.expected
+    act = ReactionWheelActuator(n_axes=MAX_AXES + 1, max_axes=MAX_AXES + 1)
+    assert act.n_axes == MAX_AXES + 1 and act.step(np.ones(MAX_AXES + 1)).shape == (MAX_AXES + 1,)
+
+
+def test_max_wheels_lifts_the_bound_and_an_existing_array_is_never_refused():
+    with pytest.raises(InvalidArgumentError, match="max_wheels = 1000"):
+        WheelDisturbance(MAX_WHEELS + 1)
+    more = MAX_WHEELS + 1
+    assert WheelDisturbance(more, max_wheels=more).draw().shape == (more,)
+    assert FaultSchedule([], more, max_wheels=more).effectiveness(0.0).shape == (more,)
+    # an array of more wheels than the bound: its count is the array's, never refused
+    axes = np.zeros((3, more))
+    axes[np.arange(more) % 3, np.arange(more)] = 1.0
+    wheels = WheelArray(axes)
+    assert FaultSchedule([], wheels, max_wheels=4).n_wheels == more
+    assert WheelInputStage(wheels).faults.n_wheels == more

@@ -189,7 +189,8 @@ class DaskExecutor:
     address : str
         The scheduler address.
     timeout : float
-        Seconds to wait for the connection.
+        Seconds to wait for the connection, and for the scheduler's answer to a first question
+        (the peer must say it is a scheduler before Dask's client is built).
     """
 
     def __init__(self, address: str, timeout: float = 20.0) -> None:
@@ -201,7 +202,10 @@ class DaskExecutor:
                 "dask.distributed installed (pip install 'rmpc-satellite[dask]')",
                 "it is missing",
             ) from None
+        scheme, _, _ = scheduler_host_port(address)
+        connection_args = _tls_connection_args(address, scheme)
         _probe(address, timeout)
+        _identify_scheduler(address, timeout, connection_args)
         try:
             self._client = Client(address, timeout=timeout, set_as_default=False)
         except (OSError, TimeoutError, ValueError) as err:
@@ -287,6 +291,74 @@ def _probe(address: str, timeout: float) -> None:
         raise ConfigError(
             "--scheduler", "the address of a reachable Dask scheduler", f"{address!r} ({err.strerror or err})"
         ) from None
+
+
+def _tls_connection_args(address: str, scheme: str) -> dict[str, Any]:
+    """The client's connection settings from Dask's configuration (its TLS context for ``tls://``).
+
+    A ``tls://`` or ``wss://`` address needs Dask's TLS settings (``distributed.comm.tls.ca-file``,
+    ``.client.cert`` and ``.client.key`` in the Dask configuration, or the matching
+    ``DASK_DISTRIBUTED__COMM__TLS__...`` variables); without them Dask's client raised a
+    ``TypeError`` after connecting and printed a ``Client.__del__`` traceback 40 s later, so the
+    address is refused before any connection.
+    """
+    from distributed.security import Security
+
+    args = Security().get_connection_args("client")
+    if scheme in ("tls", "wss") and args.get("ssl_context") is None:
+        raise ConfigError(
+            "--scheduler",
+            f"a {scheme}:// address with Dask's TLS settings configured (distributed.comm.tls.ca-file, "
+            ".client.cert and .client.key in the Dask configuration)",
+            f"{address!r} with no TLS settings",
+        )
+    return args
+
+
+def _identify_scheduler(address: str, timeout: float, connection_args: dict[str, Any]) -> None:
+    """Ask ``address`` who it is, within ``timeout`` s in all, before Dask's client is built.
+
+    Dask's client waits without a limit for the handshake of a peer that accepts the connection
+    and then says nothing (its ``timeout`` covers the connection only), and when its start fails
+    its ``__del__`` prints a traceback up to 40 s later; so one connection is opened here, in a
+    thread of its own with a deadline, and the peer must answer ``identity`` as a scheduler.
+    """
+    import asyncio
+    import threading
+
+    from distributed.comm import connect
+
+    answer: dict[str, Any] = {}
+
+    async def ask() -> None:
+        comm = await connect(address, timeout=timeout, **connection_args)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            answer["identity"] = await comm.read()
+        finally:
+            await comm.close()
+
+    def run() -> None:
+        try:
+            asyncio.run(asyncio.wait_for(ask(), timeout))
+        except BaseException as err:  # reported by the caller's thread
+            answer["error"] = err
+
+    thread = threading.Thread(target=run, name="rmpc-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(timeout + 5.0)
+    err = answer.get("error")
+    identity = answer.get("identity")
+    kind = identity.get("type") if isinstance(identity, dict) else None
+    if thread.is_alive() or isinstance(err, TimeoutError):
+        found = f"{address!r} (no answer from a Dask scheduler within {timeout:g} s)"
+    elif err is not None:
+        found = f"{address!r} ({type(err).__name__}: {str(err).splitlines()[0] if str(err) else 'closed'})"
+    elif kind != "Scheduler":
+        found = f"{address!r} (a Dask {kind or 'peer'} that is not a scheduler)"
+    else:
+        return
+    raise ConfigError("--scheduler", "the address of a reachable Dask scheduler", found)
 
 
 def make_executor(workers: int | None, scheduler: str | None) -> CaseExecutor:

@@ -46,8 +46,11 @@ __all__ = [
     "PlantFamily",
     "check_bool",
     "check_choice",
+    "check_ellipsoid_count",
+    "check_horizon",
     "check_number",
     "check_real",
+    "check_run_length",
     "controller_specs",
 ]
 
@@ -120,7 +123,9 @@ class CaseResult:
     ----------
     settings : dict
         What the record's ``settings`` adds to the scenario's fields (initial state, the model
-        the controller used, ...).
+        the controller used, ...). The shipped families write ``duration_used``, the time that
+        ran (``n_steps dt`` of the trajectory; the scenario's ``duration`` is what was asked for,
+        which :func:`rmpc.sim.simulate` rounds to whole samples).
     metrics : dict
         The record's ``metrics``.
     trace : dict of ndarray
@@ -337,3 +342,74 @@ def check_real(
         hi = "" if high is None else f"{'<' if high_open else '<='} {high:g}"
         raise ConfigError(where, "a number " + " and ".join(p for p in (lo, hi) if p), repr(value))
     return x
+
+
+# -- sizes, bounded where the file is read (not after a case has been started) ---------------------
+
+
+def check_run_length(duration: float, dt: float, where: str) -> int:
+    """The samples of a run, ``round(duration / dt)``, if :func:`rmpc.sim.simulate` takes that many.
+
+    A run of more than :data:`rmpc.sim.simulate.MAX_STEPS` samples (10 million), or of less than
+    one, is refused here, naming ``where``, instead of failing in each case after the sweep has
+    started. A sweep cannot lift the bound (the families call ``simulate`` with its default); a
+    longer run is a script calling ``simulate(..., max_steps=N)``.
+
+    Examples
+    --------
+    >>> check_run_length(30.0, 0.01, "duration")
+    3000
+    >>> try:
+    ...     check_run_length(1e12, 0.01, "base.duration")
+    ... except ValueError as err:
+    ...     print(err.argument, "|", err.found)
+    base.duration | 1e+12 s / dt 0.01 s = 1e+14 samples
+    """
+    from rmpc.sim.simulate import MAX_STEPS
+
+    samples = duration / dt
+    found = f"{duration:g} s / dt {dt:g} s = {samples:.3g} samples"
+    if not math.isfinite(samples) or round(samples) > MAX_STEPS:
+        expected = (
+            f"a run of at most rmpc.sim.simulate.MAX_STEPS = {MAX_STEPS} samples (a sweep cannot lift it: "
+            "shorten the run or lengthen dt; simulate(..., max_steps=N) in a script lifts it)"
+        )
+        raise ConfigError(where, expected, found)
+    if round(samples) < 1:
+        raise ConfigError(where, f"a run of at least one sample (dt = {dt:g} s)", found)
+    return round(samples)
+
+
+def check_horizon(value: int, where: str) -> int:
+    """A GIPC prediction horizon ``Np`` up to :data:`rmpc.mpc.gipc.MAX_HORIZON` (20000), named ``where``.
+
+    Examples
+    --------
+    >>> check_horizon(400, "settings.Np")
+    400
+    """
+    from rmpc.mpc.gipc import MAX_HORIZON
+
+    if value > MAX_HORIZON:
+        expected = (
+            f"at most rmpc.mpc.gipc.MAX_HORIZON = {MAX_HORIZON} samples (a sweep cannot lift it; "
+            "GIPC(..., max_horizon=N) in a script lifts it)"
+        )
+        raise ConfigError(where, expected, repr(value))
+    return value
+
+
+def check_ellipsoid_count(n_ellipsoids: int, shrink: float, where: str) -> int:
+    """An OfflineRMPC table size that ``shrink`` allows (:func:`lmi.offline.check_ellipsoid_count`).
+
+    Examples
+    --------
+    >>> check_ellipsoid_count(15, 0.5, "settings.n_ellipsoids")
+    15
+    """
+    from lmi.offline import check_ellipsoid_count as lmi_check
+
+    try:
+        return lmi_check(n_ellipsoids, shrink)
+    except ValueError as err:
+        raise ConfigError(where, getattr(err, "expected", str(err)), repr(n_ellipsoids)) from None

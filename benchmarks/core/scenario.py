@@ -26,7 +26,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
-from benchmarks.core.family import PlantFamily
+from benchmarks.core.family import PlantFamily, check_run_length
 from benchmarks.core.registry import get_family
 from toolkit_common.errors import ConfigError
 
@@ -176,10 +176,11 @@ class Scenario:
         if problem is not None:
             raise ConfigError(name("saturation"), problem, "'constraint'")
         family.check(values, controller, name)
-        if values["duration"] is not None and values["duration"] < values["dt"]:
-            raise ConfigError(
-                name("duration"), f"at least one sample (dt = {values['dt']:g} s)", repr(values["duration"])
-            )
+        if values["duration"] is not None:
+            if values["duration"] < values["dt"]:
+                expected = f"at least one sample (dt = {values['dt']:g} s)"
+                raise ConfigError(name("duration"), expected, repr(values["duration"]))
+            check_run_length(values["duration"], values["dt"], name("duration"))
         return cls(family_name, controller, settings, values)
 
     @classmethod

@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from benchmarks.robustness.probe import Probe
+from benchmarks.robustness.probe import Expect, Probe
 
 TINY_SWEEP = """name = "tiny"
 description = "one short case"
@@ -116,7 +116,9 @@ def _another_sweep_results(tmp: str) -> None:
         handle.write("# another sweep's results\n")
 
 
-def _sweep(name: str, body: str, names: tuple[str, ...], kind: str = "sweep file") -> Probe:
+def _sweep(
+    name: str, body: str, names: tuple[str, ...], kind: str = "sweep file", expect: Expect = "error"
+) -> Probe:
     return Probe(
         f"cli:sweep {name}",
         "cli",
@@ -124,6 +126,7 @@ def _sweep(name: str, body: str, names: tuple[str, ...], kind: str = "sweep file
         argv=SWEEP_ARGV,
         setup=_sweep_file(body),
         kind=kind,
+        expect=expect,
     )
 
 
@@ -272,7 +275,26 @@ def cli_probes() -> list[Probe]:
         _sweep("duration nan", base.replace("0.2", "nan"), ("duration",)),
         _sweep("duration string", base.replace("0.2", '"long"'), ("duration",)),
         _sweep("duration huge", base.replace("0.2", "1e12"), ("duration", "limit"), kind="size"),
-        _sweep("duration not a multiple of dt", base.replace("0.2", "0.25"), ("duration", "dt")),
+        # 20.49 samples: 20 run, and the record says so (duration_used = 0.2 next to duration = 0.2049)
+        _sweep(
+            "duration not a multiple of dt",
+            base.replace("0.2", "0.2049"),
+            ("duration", "dt"),
+            expect="either",
+        ),
+        _sweep("dt tiny", base + "dt = 1e-12\n", ("dt", "duration"), kind="size"),
+        _sweep(
+            "GIPC Np huge",
+            base.replace('"LQR"', '"GIPC"') + "[base.settings]\nNp = 1000000\n",
+            ("Np", "MAX_HORIZON"),
+            kind="size",
+        ),
+        _sweep(
+            "OfflineRMPC n_ellipsoids huge",
+            base.replace('"LQR"', '"OfflineRMPC"') + "[base.settings]\nn_ellipsoids = 10000000\n",
+            ("n_ellipsoids",),
+            kind="size",
+        ),
         _sweep("dt zero", base + "dt = 0.0\n", ("dt",)),
         _sweep("spread 1.5", base + "spread = 1.5\n", ("spread",)),
         _sweep("u_max negative", base + "u_max = -1.0\n", ("u_max",)),

@@ -24,6 +24,7 @@ from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_positive_values, as_vector
 
 __all__ = [
+    "MAX_WHEELS",
     "PAPER_W_MOMENTUM_MAX",
     "PAPER_W_TORQUE_MAX",
     "PAPER_W_WHEEL_INERTIA",
@@ -39,6 +40,11 @@ PAPER_W_MOMENTUM_MAX: float = 0.625
 PAPER_W_WHEEL_INERTIA: float = 0.0123
 #: Singular values below ``RANK_TOL * max(1, sigma_max)`` count as zero in rank checks.
 RANK_TOL: float = 1e-9
+
+MAX_WHEELS = 1_000
+"""Default bound on a number of wheels given as an integer (:class:`~models.WheelDisturbance`,
+:class:`~models.FaultSchedule`): a spacecraft has 3 to 6, and the per-wheel arrays are allocated
+at once (``n_wheels = 10**12`` ended in a MemoryError); ``max_wheels=N`` lifts it."""
 
 #: Tolerance on ``|D[:, j]| = 1``.
 _UNIT_TOL = 1e-9
@@ -185,6 +191,18 @@ class WheelArray:
             f"WheelArray(n_wheels={self.n_wheels}, torque_max={self._torque_max.tolist()}, "
             f"momentum_max={self._momentum_max.tolist()})"
         )
+
+
+def _wheel_count(n_wheels: Any, max_wheels: Any) -> int:
+    """``n_wheels`` as an int in ``[1, max_wheels]``, else an error naming it (or ``max_wheels``)."""
+    if isinstance(max_wheels, bool) or not isinstance(max_wheels, int | np.integer) or max_wheels < 1:
+        raise InvalidArgumentError("max_wheels", "a positive integer", repr(max_wheels))
+    if isinstance(n_wheels, bool) or not isinstance(n_wheels, int | np.integer) or n_wheels < 1:
+        raise InvalidArgumentError("n_wheels", "a positive number of wheels", repr(n_wheels))
+    if n_wheels > max_wheels:
+        expected = f"at most max_wheels = {max_wheels} wheels (pass a larger max_wheels to lift it)"
+        raise InvalidArgumentError("n_wheels", expected, repr(n_wheels))
+    return int(n_wheels)
 
 
 def _rank(mat: np.ndarray) -> int:

@@ -33,7 +33,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from models.wheels.array import WheelArray, _rank
+from models.wheels.array import MAX_WHEELS, WheelArray, _rank, _wheel_count
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_choice, check_positive, check_real
 
@@ -230,6 +230,10 @@ class FaultSchedule:
         The number of wheels (or the array): a fault on a wheel that does not exist is an error.
     duration : float, optional
         Length of the run (s): a fault whose onset is at or after the end is an error.
+    max_wheels : int
+        The largest ``n_wheels`` given as an integer (default :data:`~models.wheels.array.MAX_WHEELS`,
+        1000); a larger one is refused with an error naming this limit. Pass a larger value to
+        lift it (an array's own count is never refused).
 
     Examples
     --------
@@ -243,12 +247,17 @@ class FaultSchedule:
     """
 
     def __init__(
-        self, faults: Sequence[WheelFault], n_wheels: int | WheelArray, duration: float | None = None
+        self,
+        faults: Sequence[WheelFault],
+        n_wheels: int | WheelArray,
+        duration: float | None = None,
+        *,
+        max_wheels: int = MAX_WHEELS,
     ) -> None:
-        if isinstance(n_wheels, WheelArray):
+        if isinstance(n_wheels, WheelArray):  # an array that exists is never refused for its size
             n_wheels = n_wheels.n_wheels
-        if isinstance(n_wheels, bool) or not isinstance(n_wheels, int | np.integer) or n_wheels < 1:
-            raise InvalidArgumentError("n_wheels", "a positive number of wheels", repr(n_wheels))
+            max_wheels = _lifted(max_wheels, n_wheels)
+        n_wheels = _wheel_count(n_wheels, max_wheels)
         if isinstance(faults, WheelFault):
             faults = [faults]
         if isinstance(faults, str | bytes) or not isinstance(faults, Sequence):
@@ -376,7 +385,9 @@ def rank_deficient_windows(
         raise InvalidArgumentError(
             "wheels", "a WheelArray or a (3, m) distribution matrix", f"shape {d.shape}"
         )
-    schedule = faults if isinstance(faults, FaultSchedule) else FaultSchedule(faults, d.shape[1], duration)
+    schedule = faults if isinstance(faults, FaultSchedule) else FaultSchedule(
+        faults, d.shape[1], duration, max_wheels=_lifted(MAX_WHEELS, d.shape[1])
+    )
     if schedule.n_wheels != d.shape[1]:
         raise InvalidArgumentError(
             "wheels", f"{schedule.n_wheels} wheels as in the schedule", f"{d.shape[1]}"
@@ -401,6 +412,12 @@ def rank_deficient_windows(
     return windows
 
 
+def _lifted(max_wheels: Any, count: int) -> Any:
+    """``max_wheels`` raised to ``count`` (a valid ``max_wheels`` only: a bad one is reported as given)."""
+    ok = not isinstance(max_wheels, bool) and isinstance(max_wheels, int | np.integer)
+    return max(int(max_wheels), count) if ok else max_wheels
+
+
 def _as_schedule(faults: Any, n_wheels: int, duration: float | None = None) -> FaultSchedule:
     """Accept ``None``, a fault, a sequence of faults or a schedule."""
     if isinstance(faults, FaultSchedule):
@@ -409,4 +426,5 @@ def _as_schedule(faults: Any, n_wheels: int, duration: float | None = None) -> F
                 "faults", f"a schedule for {n_wheels} wheels", f"{faults.n_wheels} wheels"
             )
         return faults
-    return FaultSchedule([] if faults is None else faults, n_wheels, duration)
+    limit = _lifted(MAX_WHEELS, n_wheels)  # the count of an array that exists
+    return FaultSchedule([] if faults is None else faults, n_wheels, duration, max_wheels=limit)

@@ -11,7 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from models.wheels.array import MAX_WHEELS, _wheel_count
+from toolkit_common.errors import ArgumentTypeError
 from toolkit_common.validation import as_positive_values, check_positive, check_real
 
 __all__ = ["ANGLE_NOISE_SIGMA", "AttitudeNoiseSensor", "WheelDisturbance"]
@@ -49,6 +50,9 @@ class WheelDisturbance:
         Variance of ``v_j`` ((N m)^2, default 0.0052; 0 turns the noise off).
     seed : int or None
         Seed of the generator (default 0).
+    max_wheels : int
+        The largest ``n_wheels`` accepted (default :data:`~models.wheels.array.MAX_WHEELS`, 1000);
+        a larger one is refused with an error naming this limit. Pass a larger value to lift it.
 
     Examples
     --------
@@ -68,10 +72,10 @@ class WheelDisturbance:
         period: float = 800.0,
         variance: float = 0.0052,
         seed: int | None = 0,
+        *,
+        max_wheels: int = MAX_WHEELS,
     ) -> None:
-        if isinstance(n_wheels, bool) or not isinstance(n_wheels, int | np.integer) or n_wheels < 1:
-            raise InvalidArgumentError("n_wheels", "a positive number of wheels", repr(n_wheels))
-        self.n_wheels = int(n_wheels)
+        self.n_wheels = _wheel_count(n_wheels, max_wheels)
         self.bias = check_real(bias, "bias")
         self.amplitude = check_real(amplitude, "amplitude")
         self.period = check_positive(period, "period")

@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from benchmarks.core.family import BuiltController
+from benchmarks.core.family import BuiltController, check_ellipsoid_count
 from toolkit_common.errors import ConfigError
 
 __all__ = [
@@ -289,3 +289,5 @@ def settings_check(controller: str, out: dict[str, Any], where: str) -> None:
         raise ConfigError(f"{where}.resolve_threshold", "a level in (0, 1]", repr(out["resolve_threshold"]))
     if controller == "OfflineRMPC" and out["shrink"] >= 1.0:
         raise ConfigError(f"{where}.shrink", "a factor in (0, 1)", repr(out["shrink"]))
+    if controller == "OfflineRMPC":
+        check_ellipsoid_count(out["n_ellipsoids"], out["shrink"], f"{where}.n_ellipsoids")

@@ -63,6 +63,7 @@ from benchmarks.core.family import (
     check_bool,
     check_choice,
     check_real,
+    check_run_length,
     controller_specs,
 )
 from benchmarks.core.metrics import step_timing
@@ -133,6 +134,9 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
     if values["duration"] is not None and values["duration"] < values["dt"]:
         expected = f"at least one sample (dt = {values['dt']:g} s)"
         raise ConfigError(name("duration"), expected, repr(values["duration"]))
+    if values["duration"] is None:  # the experiment's own length, in samples of dt
+        length = max(defaults.EXPERIMENT_DURATIONS[values["experiment"]] * values["time_scale"], values["dt"])
+        check_run_length(length, values["dt"], name("dt"))
 
 
 def controller_name(scenario: Any) -> str:
@@ -290,7 +294,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     table = getattr(inner, "table", None)
     extra = {
         "controller_name": controller_name(scenario),
-        "duration_used": case.duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "angle_deg_used": case.angle_deg,
         "n_vertices": None if poly is None else poly.n_vertices,
         "n_ellipsoids": None if table is None else table.n_ellipsoids,

@@ -39,7 +39,15 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import CaseResult, Field, PlantFamily, check_choice, check_real, controller_specs
+from benchmarks.core.family import (
+    CaseResult,
+    Field,
+    PlantFamily,
+    check_choice,
+    check_real,
+    check_run_length,
+    controller_specs,
+)
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
@@ -81,6 +89,11 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
     if values["duration"] is not None and values["duration"] < values["dt"]:
         expected = f"at least one sample (dt = {values['dt']:g} s)"
         raise ConfigError(name("duration"), expected, repr(values["duration"]))
+    if values["duration"] is None:  # the scenario's own length, in samples of dt
+        from models import paper_m_scenario
+
+        length = paper_m_scenario(values["scenario"]).duration * values["time_scale"]
+        check_run_length(length, values["dt"], name("dt"))
 
 
 def _label(scenario: Any) -> str:
@@ -153,7 +166,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         late = traj.t[:-1] >= lo
         metrics["td_est_err_max"] = float(np.abs(est[late] - traj.d[late]).max()) if late.any() else None
     extra = {
-        "duration_used": case.duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "steady_window": [lo, hi],
         "inertia_scale_used": case.inertia_scale,
         "disk": case.disk,

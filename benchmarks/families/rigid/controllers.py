@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import BuiltController
+from benchmarks.core.family import BuiltController, check_ellipsoid_count, check_horizon
 from toolkit_common.errors import ConfigError
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "settings_check"]
@@ -170,5 +170,9 @@ def settings_check(controller: str, out: dict[str, Any], where: str) -> None:
         )
     if controller == "OfflineRMPC" and out["shrink"] >= 1.0:
         raise ConfigError(f"{where}.shrink", "a number in (0, 1)", repr(out["shrink"]))
+    if controller == "OfflineRMPC":
+        check_ellipsoid_count(out["n_ellipsoids"], out["shrink"], f"{where}.n_ellipsoids")
+    if controller == "GIPC":
+        check_horizon(out["Np"], f"{where}.Np")
     if controller == "GIPC" and out["Nc"] > out["Np"]:
         raise ConfigError(f"{where}.Nc", f"an integer <= Np = {out['Np']}", repr(out["Nc"]))

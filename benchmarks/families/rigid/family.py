@@ -216,6 +216,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     )
     extra = {
         "x0": x0.tolist(),
+        "duration_used": traj.n_steps * traj.dt,  # what ran: simulate rounds duration / dt to whole samples
         "true_inertia_used": np.diag(true_sat.inertia).tolist(),
         "linearization_point": x_lin.tolist(),  # of the nominal model (the linear plant without true_inertia)
         "limiter_in_loop": limiter is not None,

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.family import BuiltController
+from benchmarks.core.family import BuiltController, check_horizon
 from toolkit_common.errors import ConfigError
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "WheelModel", "settings_check"]
@@ -135,5 +135,7 @@ def settings_check(controller: str, out: dict[str, Any], where: str) -> None:
         raise ConfigError(
             f"{where}.theta_fraction", "a fraction of u_max in (0, 1)", repr(out["theta_fraction"])
         )
+    if controller == "GIPC":
+        check_horizon(out["Np"], f"{where}.Np")
     if controller == "GIPC" and out["Nc"] > out["Np"]:
         raise ConfigError(f"{where}.Nc", f"an integer <= Np = {out['Np']}", repr(out["Nc"]))

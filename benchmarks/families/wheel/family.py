@@ -61,6 +61,7 @@ from benchmarks.core.family import (
     PlantFamily,
     check_choice,
     check_real,
+    check_run_length,
     controller_specs,
 )
 from benchmarks.core.metrics import compute_metrics
@@ -157,6 +158,8 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         raise ConfigError(
             name("duration"), f"at least one sample (dt = {values['dt']:g} s)", repr(values["duration"])
         )
+    if values["duration"] is None:  # the scenario's own length, in samples of dt
+        check_run_length(length, values["dt"], name("dt"))
     kind = values["fault_kind"]
     if kind == "scenario":
         last = max((f.t_on for f in _paper_scenario(values).faults), default=0.0) * values["time_scale"]
@@ -247,7 +250,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     metrics["faults"] = faults
     extra = {
         "x0": x0.tolist(),
-        "duration_used": duration,
+        "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "inertia_scale_used": scale,
         "polytope_inertia_spread": spread,
         "n_vertices": poly.n_vertices,
