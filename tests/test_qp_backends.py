@@ -35,7 +35,7 @@ from rmpc.qp import (
     make_backend,
 )
 from rmpc.qp.base import DEFAULT_TIME_LIMIT
-from rmpc.qp.proxqp_backend import FIRST_CHUNK, ProxQPBackend
+from rmpc.qp.proxqp_backend import ProxQPBackend
 from rmpc.qp.reference import reference_solution
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
 from toolkit_common.status import describe
@@ -266,6 +266,7 @@ def test_unknown_setting_is_rejected_by_name(name: str) -> None:
     ("name", "setting", "value"),
     [("osqp", "eps_abs", -1.0), ("osqp", "max_iter", 0), ("osqp", "polishing", "yes"),
      ("proxqp", "eps_abs", 0.0), ("proxqp", "dense_backend", "sparse"), ("proxqp", "box", "both"),
+     ("proxqp", "first_chunk", 0), ("proxqp", "first_chunk", 2.5),
      ("clarabel", "tol_feas", float("nan")), ("clarabel", "max_iter", 2.5),
      ("cvxpy", "solver", "GUROBI")],
 )
@@ -395,7 +396,7 @@ def test_a_tiny_time_limit_stops_the_solve_with_time_limit(name: str, extra: dic
     assert res.status == "time_limit" and not res.ok
     assert np.all(np.isnan(res.x)) and np.isnan(res.objective)
     if name == "proxqp":
-        assert res.info["outer_iterations"] == FIRST_CHUNK < 2000
+        assert res.info["outer_iterations"] == ProxQPBackend().settings.first_chunk < 2000
 
 
 @pytest.mark.filterwarnings("ignore:Solution may be inaccurate")
@@ -487,7 +488,7 @@ def test_proxqp_chunked_solve_equals_the_unchunked_one_within_the_first_chunk(
     chunked = _proxqp_run(qps, warm)
     whole = _proxqp_run(qps, warm, time_limit=INF)
     outer = [r.info["outer_iterations"] for r in whole]
-    assert max(outer) < FIRST_CHUNK  # the premise: each ended in what is the first chunk
+    assert max(outer) < ProxQPBackend().settings.first_chunk  # the premise: each ended in the first chunk
     if warm:
         # long solves, where a cut first chunk is a real risk: one of 10 outer iterations changed
         # answers in every element here (those of 50 and 100 happened to change no bit)
@@ -502,7 +503,7 @@ def test_proxqp_chunked_solve_equals_the_unchunked_one_within_the_first_chunk(
 
 @pytest.mark.parametrize("warm", [True, False])
 def test_proxqp_chunks_resume_where_the_previous_one_stopped(
-    hard_gipc_qps: list, warm: bool, monkeypatch: pytest.MonkeyPatch
+    hard_gipc_qps: list, warm: bool
 ) -> None:
     """Cut into chunks of 5 outer iterations, every solve still converges to the same answer.
 
@@ -512,8 +513,7 @@ def test_proxqp_chunks_resume_where_the_previous_one_stopped(
     """
     qps = hard_gipc_qps if warm else hard_gipc_qps[::10]
     whole = _proxqp_run(qps, warm, time_limit=INF)
-    monkeypatch.setattr("rmpc.qp.proxqp_backend.FIRST_CHUNK", 5)
-    chunked = _proxqp_run(qps, warm)
+    chunked = _proxqp_run(qps, warm, first_chunk=5)
     if warm:  # chunks of 5 do cut these solves (the cold ones after setup need 5 to 15)
         assert max(r.info["outer_iterations"] for r in whole) > 5
     for a, b in zip(chunked, whole, strict=True):

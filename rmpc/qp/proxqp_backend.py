@@ -39,15 +39,25 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   first warm-started from the previous chunk's result (proxsuite keeps its proximal
   parameters across such a solve), and the clock is read between chunks: past the deadline
   the solve stops with ``"time_limit"``; ``max_iter`` still bounds the outer iterations of all
-  chunks together. The first chunk has :data:`FIRST_CHUNK` (500) outer iterations, and
-  proxsuite uses ``max_iter`` only as its loop bound, so a solve that converges within it is
-  bit-for-bit the unchunked solve: the most a GIPC solve needed in paper P's suites (full
-  length, 30010 solves) and paper W's (short, 1656 solves) was 157. Later chunks are sized to
-  take at most half the time left even if each of their outer iterations ran ``max_iter_in``
-  inner ones (at the cost per inner iteration measured in the call), so the bound is passed by
-  at most one first chunk of an attempt begun in the first half of the budget, or by
-  :data:`MIN_CHUNK` outer iterations. The deadline is one for the whole ``solve`` call: the
-  cold solve after ``init`` and a ``retry_cold`` count against it (no retry starts past it).
+  chunks together. The deadline is one for the whole ``solve`` call: the cold solve after
+  ``init`` and a ``retry_cold`` count against it (no retry starts past it).
+
+  The first chunk (``first_chunk``, 1000 outer iterations) is bit-for-bit the unchunked
+  solve for every solve that converges within it: proxsuite uses ``max_iter`` only as its
+  loop bound. Measured with proxsuite's own counts on about 300000 GIPC solves (paper P's
+  suite at full length and the shipped sweeps with GIPC, paper W's suite at full length),
+  the most outer iterations a solve needed was 654 (``gipc_tuning``; 203 in the suites).
+  Those solves hold no clock reading, so ProxQP's normal answers do not depend on the
+  machine's load. The first chunk is also what the clock cannot interrupt: at most
+  ``first_chunk * max_iter_in`` inner iterations; at the state of 1e8 (about 1450 inner per
+  outer) it took 5-8 s on a shared 2-core machine, so such a step ends ``"time_limit"``
+  after about that long. Later chunks are sized to take at most half the time left even if
+  each of their outer iterations ran ``max_iter_in`` inner ones (at the cost per inner
+  iteration measured in the call), so past the first chunk the bound is overrun by at most
+  :data:`MIN_CHUNK` outer iterations (an attempt begun in the second half of the budget gets
+  such a chunk first, too). Cut into chunks after 50 or 100 outer iterations the long solves
+  of a GIPC closed loop came out bit-for-bit the same; after 10 they differed in the last
+  digits (within the tolerances).
 """
 
 from __future__ import annotations
@@ -64,12 +74,9 @@ from rmpc.qp.base import DEFAULT_TIME_LIMIT, BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
 from toolkit_common.status import Status
 
-__all__ = ["FIRST_CHUNK", "MIN_CHUNK", "ProxQPBackend", "ProxQPSettings"]
+__all__ = ["MIN_CHUNK", "ProxQPBackend", "ProxQPSettings"]
 
-#: Outer iterations of the first chunk of a time-limited solve (see the module docstring:
-#: GIPC's solves in the suites needed at most 157, so this is about three times that).
-FIRST_CHUNK = 500
-#: The fewest outer iterations of a later chunk.
+#: The fewest outer iterations of a chunk after the first (see the module docstring).
 MIN_CHUNK = 10
 
 
@@ -98,6 +105,10 @@ class ProxQPSettings(BackendSettings):
         (:data:`~rmpc.qp.base.DEFAULT_TIME_LIMIT` by default, ``inf`` for none: then each
         attempt is one proxsuite solve); a solve it stops reports ``"time_limit"``. Checked
         between chunks of outer iterations (see the module docstring).
+    first_chunk : int
+        Outer iterations of the first chunk of each attempt, and the most of any later one
+        (1000, about 1.5 times the most a GIPC solve of the suites and sweeps needed): a solve
+        that converges within it is the unchunked one, and the clock cannot stop it earlier.
     warm_start : bool
         Start each solve after the first from the previous result.
     retry_cold : bool
@@ -122,6 +133,7 @@ class ProxQPSettings(BackendSettings):
     max_iter: int = 10000
     max_iter_in: int = 1500
     time_limit: float = DEFAULT_TIME_LIMIT
+    first_chunk: int = 1000
     warm_start: bool = True
     retry_cold: bool = True
     dense_backend: str = "automatic"
@@ -132,7 +144,7 @@ class ProxQPSettings(BackendSettings):
         "eps_abs", "eps_duality_gap_abs", "eps_primal_inf", "eps_dual_inf",
     )
     _NONNEGATIVE: ClassVar[tuple[str, ...]] = ("eps_rel", "eps_duality_gap_rel")
-    _COUNTS: ClassVar[tuple[str, ...]] = ("max_iter", "max_iter_in")
+    _COUNTS: ClassVar[tuple[str, ...]] = ("max_iter", "max_iter_in", "first_chunk")
     _SECONDS: ClassVar[tuple[str, ...]] = ("time_limit",)
     _FLAGS: ClassVar[tuple[str, ...]] = ("check_duality_gap", "warm_start", "retry_cold", "verbose")
     _CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {
@@ -237,11 +249,12 @@ class ProxQPBackend(QPBackend):
     def _chunk(self, deadline: float, spent: list[float], left: int, first: bool) -> int:
         """Outer iterations of the next chunk (see the module docstring)."""
         now = time.perf_counter()
+        most = self.settings.first_chunk
         if spent[1] == 0 or (first and deadline - now >= 0.5 * self.settings.time_limit):
-            return min(FIRST_CHUNK, left)
+            return min(most, left)
         worst = self.settings.max_iter_in * spent[0] / spent[1]  # seconds per outer iteration, at most
-        room = 0.5 * (deadline - now) / worst if worst > 0 else FIRST_CHUNK
-        return int(min(FIRST_CHUNK, left, max(MIN_CHUNK, room)))
+        room = 0.5 * (deadline - now) / worst if worst > 0 else most
+        return int(min(most, left, max(MIN_CHUNK, room)))
 
     def _run(self, deadline: float, spent: list[float]) -> tuple[int, int, bool]:
         """One attempt from the current initial guess: ``(inner, outer iterations, timed out)``.
