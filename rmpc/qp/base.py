@@ -29,14 +29,14 @@ from toolkit_common.validation import check_bool
 __all__ = ["DEFAULT_TIME_LIMIT", "BackendSettings", "QPBackend"]
 
 #: Default bound in seconds on the wall time of one ``solve`` call of every back-end (the
-#: ``time_limit`` setting; ``inf`` switches it off). Measured on GIPC's QPs at the shipped
-#: horizons (paper P's suite at full length and its sweeps with GIPC, paper W's suite at full
-#: length): of 298631 ProxQP solves, 298620 took under 20 ms (a warm-started one about 10
+#: ``time_limit`` setting; ``inf`` switches it off). Measured on GIPC's QPs (paper P's and
+#: paper W's suites, short and at full length, and the GIPC cases of the shipped sweeps): of
+#: 298631 ProxQP solves, 298620 took under 20 ms (a warm-started one about 10
 #: microseconds) and the slowest 104 ms, a warm solve of 2 iterations that the loaded shared
 #: 2-core machine had descheduled; the first cvxpy step, with its modelling, took 0.24 s. 5 s
 #: is 50 times that slowest solve, so load does not bring a normal solve near it, and it keeps
 #: a hopeless step far from a minute: one ``GIPC.step`` with ProxQP at a state of 1e8 ran
-#: 54-61 s before (10000 outer iterations of about 1450 inner ones each). A larger QP (a long
+#: 54-76 s before (10000 outer iterations of about 1450 inner ones each). A larger QP (a long
 #: control horizon ``Nc``) may need a larger value.
 DEFAULT_TIME_LIMIT = 5.0
 

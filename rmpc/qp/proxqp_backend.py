@@ -33,7 +33,7 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   solve that ends non-optimal is repeated once in a freshly built solver (``init`` + cold
   solve; ``retry_cold``, ``QPResult.info["retried_cold"]``).
 * Time: proxsuite 0.8 has no time limit, and an outer iteration may run up to ``max_iter_in``
-  inner ones. At a state of 1e8, one ``GIPC.step`` ran 54-61 s: 10000 outer iterations of
+  inner ones. At a state of 1e8, one ``GIPC.step`` ran 54-76 s: 10000 outer iterations of
   about 1450 inner ones each, to ``max_iter``. With a finite ``time_limit`` a solve runs in
   chunks of outer iterations (proxsuite's ``max_iter`` set to the chunk), each chunk after the
   first warm-started from the previous chunk's result (proxsuite keeps its proximal
@@ -45,13 +45,13 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   The first chunk (``first_chunk``, 1000 outer iterations) is bit-for-bit the unchunked
   solve for every solve that converges within it: proxsuite uses ``max_iter`` only as its
   loop bound. Measured with proxsuite's own counts on about 300000 GIPC solves (paper P's
-  suite at full length and the shipped sweeps with GIPC, paper W's suite at full length),
+  and paper W's suites, short and at full length, and the GIPC cases of the shipped sweeps),
   the most outer iterations a solve needed was 654 (``gipc_tuning``; 203 in the suites).
   Those solves hold no clock reading, so ProxQP's normal answers do not depend on the
   machine's load. The first chunk is also what the clock cannot interrupt: at most
   ``first_chunk * max_iter_in`` inner iterations; at the state of 1e8 (about 1450 inner per
-  outer) it took 5-8 s on a shared 2-core machine, so such a step ends ``"time_limit"``
-  after about that long. Later chunks are sized to take at most half the time left even if
+  outer) it took 7-8 s on a shared 2-core machine (17.5 s under a load of 5), so such a
+  step ends ``"time_limit"`` after about that long. Later chunks are sized to take at most half the time left even if
   each of their outer iterations ran ``max_iter_in`` inner ones (at the cost per inner
   iteration measured in the call), so past the first chunk the bound is overrun by at most
   :data:`MIN_CHUNK` outer iterations (an attempt begun in the second half of the budget gets
