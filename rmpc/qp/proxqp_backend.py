@@ -51,13 +51,14 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   machine's load. The first chunk is also what the clock cannot interrupt: at most
   ``first_chunk * max_iter_in`` inner iterations; at the state of 1e8 (about 1450 inner per
   outer) it took 7-8 s on a shared 2-core machine (17.5 s under a load of 5), so such a
-  step ends ``"time_limit"`` after about that long. Later chunks are sized to take at most half the time left even if
-  each of their outer iterations ran ``max_iter_in`` inner ones (at the cost per inner
-  iteration measured in the call), so past the first chunk the bound is overrun by at most
-  :data:`MIN_CHUNK` outer iterations (an attempt begun in the second half of the budget gets
-  such a chunk first, too). Cut into chunks after 50 or 100 outer iterations the long solves
-  of a GIPC closed loop came out bit-for-bit the same; after 10 they differed in the last
-  digits (within the tolerances).
+  step ends ``"time_limit"`` after about that long. Later chunks are sized to take at most
+  half the time left even if each of their outer iterations ran ``max_iter_in`` inner ones
+  (at the cost per inner iteration measured in the call), so past the first chunk the bound
+  is overrun by at most :data:`MIN_CHUNK` outer iterations; an attempt that starts in the
+  second half of the budget (a retry, the solve after the cold one) is sized so from its first
+  chunk on. Cut after 50 or 100 outer iterations, the long solves of a GIPC closed loop came
+  out bit-for-bit the same (proxsuite resumes from its saved state); cut after 10, some
+  answers differed, within the tolerances.
 """
 
 from __future__ import annotations
