@@ -42,23 +42,24 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   chunks together. The deadline is one for the whole ``solve`` call: the cold solve after
   ``init`` and a ``retry_cold`` count against it (no retry starts past it).
 
-  The first chunk (``first_chunk``, 1000 outer iterations) is bit-for-bit the unchunked
-  solve for every solve that converges within it: proxsuite uses ``max_iter`` only as its
-  loop bound. Measured with proxsuite's own counts on about 300000 GIPC solves (paper P's
-  and paper W's suites, short and at full length, and the GIPC cases of the shipped sweeps),
-  the most outer iterations a solve needed was 654 (``gipc_tuning``; 203 in the suites).
-  Those solves hold no clock reading, so ProxQP's normal answers do not depend on the
-  machine's load. The first chunk is also what the clock cannot interrupt: at most
-  ``first_chunk * max_iter_in`` inner iterations; at the state of 1e8 (about 1450 inner per
-  outer) it took 7-8 s on a shared 2-core machine (17.5 s under a load of 5), so such a
-  step ends ``"time_limit"`` after about that long. Later chunks are sized to take at most
-  half the time left even if each of their outer iterations ran ``max_iter_in`` inner ones
-  (at the cost per inner iteration measured in the call), so past the first chunk the bound
-  is overrun by at most :data:`MIN_CHUNK` outer iterations; an attempt that starts in the
-  second half of the budget (a retry, the solve after the cold one) is sized so from its first
-  chunk on. Cut after 50 or 100 outer iterations, the long solves of a GIPC closed loop came
-  out bit-for-bit the same (proxsuite resumes from its saved state); cut after 10, some
-  answers differed, within the tolerances.
+  The first chunk (``first_chunk``, 1000 outer iterations) is the unchunked solve, the same
+  computation, for every solve that converges within it: proxsuite uses ``max_iter`` only as
+  its loop bound (its arithmetic itself varies in the last digits from run to run, by up to
+  3e-12 of ``x`` on GIPC's QPs, with or without chunks). Measured with proxsuite's own counts
+  on about 300000 GIPC solves (paper P's and paper W's suites, short and at full length, and
+  the GIPC cases of the shipped sweeps), the most outer iterations a solve needed was 654
+  (``gipc_tuning``; 203 in the suites). Those solves hold no clock reading, so ProxQP's normal
+  answers do not depend on the machine's load. The first chunk is also what the clock cannot
+  interrupt: at most ``first_chunk * max_iter_in`` inner iterations; at the state of 1e8
+  (about 1450 inner per outer) it took 7-8 s on a shared 2-core machine (17.5 s under a load
+  of 5), so such a step ends ``"time_limit"`` after about that long. Later chunks are sized to
+  take at most half the time left even if each of their outer iterations ran ``max_iter_in``
+  inner ones (at the cost per inner iteration measured in the call), so past the first chunk
+  the bound is overrun by at most :data:`MIN_CHUNK` outer iterations; an attempt that starts
+  in the second half of the budget (a retry, the solve after the cold one) is sized so from
+  its first chunk on. Cut after 10, 50 or 100 outer iterations, the long solves of a GIPC
+  closed loop came out the same to that run-to-run noise (proxsuite resumes from its saved
+  state); cut after 5, they moved by up to 3.5e-8, within the tolerances.
 """
 
 from __future__ import annotations
