@@ -431,6 +431,28 @@ def test_proxqp_time_limit_counts_the_cold_solve_after_setup() -> None:
     assert be.solve().status == "optimal" and len(attempts) == 2
 
 
+def test_proxqp_first_solve_that_raises_is_a_status() -> None:
+    """The cold solve after ``init`` moved from ``setup`` into ``solve``; a binding that raises
+    there is still a ``"numerical_error"`` (as a failed ``setup`` was), not an exception."""
+
+    class Raising:
+        def __init__(self, solver: object) -> None:
+            self._solver = solver
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(self._solver, name)
+
+        def solve(self) -> None:
+            raise RuntimeError("the binding refused")
+
+    be = ProxQPBackend()
+    be.setup(FEASIBLE_QP)
+    be._solver = Raising(be._solver)  # type: ignore[assignment]
+    res = be.solve()
+    assert res.status == "numerical_error" and "the binding refused" in res.raw_status
+    assert np.all(np.isnan(res.x))
+
+
 @pytest.mark.parametrize(("limit", "status", "retried"), [(1e-9, "time_limit", False),
                                                           (INF, "max_iterations", True)])
 def test_proxqp_retry_cold_starts_only_within_the_time_limit(

@@ -300,7 +300,10 @@ class ProxQPBackend(QPBackend):
         deadline = start + self.settings.time_limit
         spent = [0.0, 0]
         if self._fresh:  # the cold solve after init, then the call goes on as after any solve
-            inner, outer, timed_out = self._run(deadline, spent)
+            try:  # as when setup made this solve: a solver that refuses the data is a status
+                inner, outer, timed_out = self._run(deadline, spent)
+            except Exception as err:  # the binding's own exception types
+                return self._failed(f"first solve failed: {type(err).__name__}: {err}", start)
             if timed_out:
                 return self._report(Status.TIME_LIMIT, inner, outer, start, False)
             self._set_guess(self._solver.results.info.status == _O.PROXQP_SOLVED)
@@ -312,14 +315,20 @@ class ProxQPBackend(QPBackend):
         if retry and time.perf_counter() < deadline:
             self._build()  # a fresh solver (init), then a cold solve with the current data
             if self._setup_error is not None:
-                return self._result(
-                    Status.NUMERICAL_ERROR, f"rebuild failed: {self._setup_error}", None, None, None, -1,
-                    time.perf_counter() - start, SolverResiduals(),
-                )
-            inner, outer, timed_out = self._run(deadline, spent)
+                return self._failed(f"rebuild failed: {self._setup_error}", start)
+            try:
+                inner, outer, timed_out = self._run(deadline, spent)
+            except Exception as err:
+                return self._failed(f"rebuild failed: {type(err).__name__}: {err}", start)
             status = Status.TIME_LIMIT if timed_out else self.map_status(self._solver.results.info.status)
             retried = True
         return self._report(status, inner, outer, start, retried)
+
+    def _failed(self, raw: str, start: float) -> QPResult:
+        self._set_guess(False)
+        return self._result(
+            Status.NUMERICAL_ERROR, raw, None, None, None, -1, time.perf_counter() - start, SolverResiduals()
+        )
 
     def _report(self, status: Status, inner: int, outer: int, start: float, retried: bool) -> QPResult:
         elapsed = time.perf_counter() - start
