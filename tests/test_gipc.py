@@ -188,7 +188,7 @@ class FailingBackend(ProxQPBackend):
 @pytest.mark.parametrize(
     ("status", "x_scale", "expected"),
     [("numerical_error", 0.0, "numerical_error"), ("max_iterations", 0.0, "max_iterations"),
-     ("optimal", 0.5, "bound_violation")],
+     ("time_limit", 0.0, "time_limit"), ("optimal", 0.5, "bound_violation")],
 )
 def test_solver_failure_holds_the_previous_input(
     lin: PolytopicModel, sat: RigidSatellite, status: str, x_scale: float, expected: str
@@ -201,6 +201,26 @@ def test_solver_failure_holds_the_previous_input(
     np.testing.assert_array_equal(u, u_before)  # du = 0: inside both bounds
     assert ctrl.last.status == expected and ctrl.last.fallback
     assert ctrl.last.iterations == 7
+
+
+@pytest.mark.parametrize("backend", ["osqp", "clarabel"])
+def test_a_solve_stopped_by_its_time_limit_holds_the_previous_input(
+    lin: PolytopicModel, sat: RigidSatellite, backend: str
+) -> None:
+    """A real ``time_limit`` from the back-end (not a faked status) is a fallback like any failure.
+
+    OSQP and Clarabel read their clock before the first iteration, so 1e-9 s stops every solve.
+    """
+    x0 = sat.initial_state()
+    ctrl = GIPC(lin, backend=backend, solver_options={"time_limit": 1e-9}, u0=[0.1, -0.1, 0.0])
+    for _ in range(2):
+        u = ctrl.step(x0)
+        np.testing.assert_array_equal(u, [0.1, -0.1, 0.0])  # u0 held: du = 0
+        assert ctrl.last.status == "time_limit" and ctrl.last.fallback
+        np.testing.assert_array_equal(ctrl.last.extra["du"], np.zeros(3))
+    free = GIPC(lin, backend=backend, u0=[0.1, -0.1, 0.0])  # the default limit: the same step solves
+    free.step(x0)
+    assert free.last.status == "optimal" and not free.last.fallback
 
 
 # -- arguments ---------------------------------------------------------------------------------

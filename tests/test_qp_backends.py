@@ -16,6 +16,7 @@ bound fails. Measured while writing these tests, on the same QPs: OSQP at its de
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 import textwrap
@@ -24,7 +25,7 @@ import numpy as np
 import pytest
 
 from models import RigidSatellite
-from rmpc import GIPC, simulate
+from rmpc import GIPC, StepDisturbance, simulate
 from rmpc.qp import (
     BACKENDS,
     QP,
@@ -33,8 +34,11 @@ from rmpc.qp import (
     kkt_residuals,
     make_backend,
 )
+from rmpc.qp.base import DEFAULT_TIME_LIMIT
+from rmpc.qp.proxqp_backend import ProxQPBackend
 from rmpc.qp.reference import reference_solution
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
+from toolkit_common.status import describe
 
 FAST = ("osqp", "proxqp", "clarabel")
 ALL = (*FAST, "cvxpy")
@@ -262,6 +266,7 @@ def test_unknown_setting_is_rejected_by_name(name: str) -> None:
     ("name", "setting", "value"),
     [("osqp", "eps_abs", -1.0), ("osqp", "max_iter", 0), ("osqp", "polishing", "yes"),
      ("proxqp", "eps_abs", 0.0), ("proxqp", "dense_backend", "sparse"), ("proxqp", "box", "both"),
+     ("proxqp", "first_chunk", 0), ("proxqp", "first_chunk", 2.5),
      ("clarabel", "tol_feas", float("nan")), ("clarabel", "max_iter", 2.5),
      ("cvxpy", "solver", "GUROBI")],
 )
@@ -332,11 +337,223 @@ def test_update_validation(name: str) -> None:
     assert be.solve().status == "optimal"  # a rejected update left the problem unchanged
 
 
+# -- bounds in time and iterations -----------------------------------------------------------
+#: z1 + z2 >= 3 with |z_i| <= 1: OSQP, Clarabel and cvxpy prove it infeasible in a few iterations,
+#: ProxQP (infeasibility detection nearly off) runs to its max_iter.
+INFEASIBLE_QP = QP(
+    H=np.eye(2), g=[1.0, 1.0], C=[[1.0, 1.0]], l=[3.0], u=[4.0], lb=[-1.0, -1.0], ub=[1.0, 1.0]
+)
+#: The same rows with a feasible range.
+FEASIBLE_QP = INFEASIBLE_QP.replace(l=[-1.0], u=[1.0])
+#: Every way a solve is bounded in time: each back-end, cvxpy through both of its solvers.
+TIMED = [("osqp", {}), ("proxqp", {}), ("clarabel", {}), ("cvxpy", {}), ("cvxpy", {"solver": "OSQP"})]
+INF = float("inf")
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_every_backend_is_bounded_in_time_and_iterations_by_default(name: str) -> None:
+    settings = make_backend(name).settings
+    assert settings.time_limit == DEFAULT_TIME_LIMIT
+    assert math.isfinite(DEFAULT_TIME_LIMIT) and DEFAULT_TIME_LIMIT > 0
+    assert isinstance(settings.max_iter, int) and settings.max_iter >= 1
+
+
+def test_the_default_time_limit_is_the_one_the_status_table_states() -> None:
+    assert f"{DEFAULT_TIME_LIMIT:g} s by default" in describe("time_limit").meaning
+
+
+@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), -INF])
+def test_time_limit_must_be_a_positive_number_of_seconds(name: str, value: float) -> None:
+    with pytest.raises(InvalidArgumentError, match=r"Settings\.time_limit: .*seconds > 0"):
+        make_backend(name, time_limit=value)
+
+
+@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize("value", ["5", True, None, [1.0]])
+def test_time_limit_of_another_type_is_refused(name: str, value: object) -> None:
+    with pytest.raises(ArgumentTypeError, match=r"Settings\.time_limit: "):
+        make_backend(name, time_limit=value)
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_time_limit_inf_switches_the_bound_off_and_integers_are_seconds(name: str) -> None:
+    assert make_backend(name, time_limit=INF).settings.time_limit == INF
+    assert make_backend(name, time_limit=2).settings.time_limit == 2
+
+
+@pytest.mark.filterwarnings("ignore:Solution may be inaccurate")  # cvxpy's word on a user limit
+@pytest.mark.parametrize(("name", "extra"), TIMED)
+def test_a_tiny_time_limit_stops_the_solve_with_time_limit(name: str, extra: dict) -> None:
+    """Without the bound the same solve ends otherwise; with 1e-9 s it ends ``"time_limit"``.
+
+    OSQP and Clarabel read the clock before their first iteration; ProxQP, between chunks of
+    outer iterations, stops after its first chunk (the QP keeps it from converging).
+    """
+    free = solve_fresh(name, INFEASIBLE_QP, time_limit=INF, max_iter=2000, **extra)
+    assert free.status in {"infeasible", "max_iterations"}
+    res = solve_fresh(name, INFEASIBLE_QP, time_limit=1e-9, max_iter=2000, **extra)
+    assert res.status == "time_limit" and not res.ok
+    assert np.all(np.isnan(res.x)) and np.isnan(res.objective)
+    if name == "proxqp":
+        assert res.info["outer_iterations"] == ProxQPBackend().settings.first_chunk < 2000
+
+
+@pytest.mark.filterwarnings("ignore:Solution may be inaccurate")
+@pytest.mark.parametrize("solver", ["CLARABEL", "OSQP"])
+def test_cvxpy_tells_the_iteration_limit_from_the_time_limit(solver: str) -> None:
+    """cvxpy reports both as ``"user_limit"``; the back-end reads which one its solver met."""
+    res = solve_fresh("cvxpy", random_qp(3), solver=solver, max_iter=1)
+    assert res.raw_status == "user_limit" and res.status == "max_iterations"
+
+
+@pytest.mark.parametrize("max_iter", [2000, 1234])
+@pytest.mark.parametrize("limit", [DEFAULT_TIME_LIMIT, INF])
+def test_proxqp_max_iter_bounds_the_chunks_together(max_iter: int, limit: float) -> None:
+    res = solve_fresh("proxqp", INFEASIBLE_QP, max_iter=max_iter, time_limit=limit)
+    assert res.status == "max_iterations"
+    assert res.info["outer_iterations"] == max_iter
+
+
+def test_proxqp_time_limit_counts_the_cold_solve_after_setup() -> None:
+    """``setup`` only builds; the cold solve that must follow ``init`` runs inside ``solve``.
+
+    On a QP it cannot solve, a 1e-9 s limit ends the call after that one attempt.
+    """
+    be = ProxQPBackend(time_limit=1e-9)
+    be.setup(INFEASIBLE_QP)
+    attempts = []
+    run = be._run
+    be._run = lambda *args: attempts.append(1) or run(*args)  # type: ignore[method-assign]
+    res = be.solve()
+    assert res.status == "time_limit" and len(attempts) == 1 and not res.info["retried_cold"]
+    be.update(l=[-1.0], u=[1.0])  # after a failed solve the next one is cold, and it converges
+    assert be.solve().status == "optimal" and len(attempts) == 2
+
+
+def test_proxqp_first_solve_that_raises_is_a_status() -> None:
+    """The cold solve after ``init`` moved from ``setup`` into ``solve``; a binding that raises
+    there is still a ``"numerical_error"`` (as a failed ``setup`` was), not an exception."""
+
+    class Raising:
+        def __init__(self, solver: object) -> None:
+            self._solver = solver
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(self._solver, name)
+
+        def solve(self) -> None:
+            raise RuntimeError("the binding refused")
+
+    be = ProxQPBackend()
+    be.setup(FEASIBLE_QP)
+    be._solver = Raising(be._solver)  # type: ignore[assignment]
+    res = be.solve()
+    assert res.status == "numerical_error" and "the binding refused" in res.raw_status
+    assert np.all(np.isnan(res.x))
+
+
+@pytest.mark.parametrize(("limit", "status", "retried"), [(1e-9, "time_limit", False),
+                                                          (INF, "max_iterations", True)])
+def test_proxqp_retry_cold_starts_only_within_the_time_limit(
+    limit: float, status: str, retried: bool
+) -> None:
+    """A warm-started solve that fails is retried cold, unless the call's time is up."""
+    be = ProxQPBackend(time_limit=limit, max_iter=2000)
+    be.setup(FEASIBLE_QP)
+    assert be.solve().status == "optimal"  # converges in its first chunk: the limit plays no part
+    be.update(l=[3.0], u=[4.0])  # infeasible: the warm-started solve cannot converge
+    res = be.solve()
+    assert res.status == status and res.info["retried_cold"] is retried
+    be.update(l=[-1.0], u=[1.0])
+    assert be.solve().status == "optimal"
+
+
+@pytest.fixture(scope="module")
+def hard_gipc_qps() -> list[QP]:
+    """GIPC's QPs at every step of paper P's E5 (true inertia 1.7 times the model's, 0.5 N m step
+    disturbance), shortened: after the step, warm-started ProxQP solves need up to 155 outer
+    iterations (the most of any GIPC solve in the paper suite)."""
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    heavy = RigidSatellite(inertia=1.7 * np.asarray(sat.inertia))
+    ctrl = GIPC(sat.linear_model(x0, 0.01))
+    traj = simulate(ctrl, heavy, x0, duration=1.2, dt=0.01, disturbance=StepDisturbance([0.5] * 3, 0.75))
+    return [ctrl.qp_at(traj.x[0])] + [
+        ctrl.qp_at(traj.x[k], traj.x[k - 1], traj.u_cmd[k - 1]) for k in range(1, traj.n_steps)
+    ]
+
+
+def _proxqp_run(qps: list[QP], warm: bool, **settings: object) -> list:
+    be = make_backend("proxqp", **settings)
+    out = []
+    for i, qp in enumerate(qps):
+        if i == 0 or not warm:
+            be.setup(qp)
+        else:
+            be.update(g=qp.g, l=qp.l, u=qp.u, lb=qp.lb, ub=qp.ub)
+        out.append(be.solve())
+    return out
+
+
+@pytest.mark.parametrize("warm", [True, False])
+def test_proxqp_chunked_solve_equals_the_unchunked_one_within_the_first_chunk(
+    hard_gipc_qps: list, warm: bool
+) -> None:
+    """The time limit changes nothing in a solve that converges in the first chunk.
+
+    GIPC's QPs along a closed loop (one setup and updates, or a setup for each: then the cold
+    solve after ``init`` and the warm one after it), with the default limit (chunks) and with
+    none (one proxsuite solve each). proxsuite's arithmetic is not reproducible to the bit from
+    one run to the next even with the same settings (on these QPs: ``x`` to 2.75e-12, the
+    multipliers to 3.9e-9 of about 1e3, iteration counts exactly, over 20 runs without a
+    limit), so iterations and statuses must agree exactly and the vectors to 1e-10 of their
+    scale, about 36 times that noise. A first chunk of 5 outer iterations moves ``x`` by
+    3.5e-8 and the iteration counts.
+    """
+    qps = hard_gipc_qps if warm else hard_gipc_qps[::10]
+    chunked = _proxqp_run(qps, warm)
+    whole = _proxqp_run(qps, warm, time_limit=INF)
+    outer = [r.info["outer_iterations"] for r in whole]
+    assert max(outer) < ProxQPBackend().settings.first_chunk  # the premise: each ended in the first chunk
+    if warm:  # long solves, where a cut first chunk would show
+        assert max(outer) > 100
+    for a, b in zip(chunked, whole, strict=True):
+        assert a.status == b.status == "optimal"
+        assert (a.iterations, a.info, a.raw_status) == (b.iterations, b.info, b.raw_status)
+        np.testing.assert_allclose(a.x, b.x, rtol=0, atol=1e-10 * max(1.0, np.abs(b.x).max()))
+        y_scale = max(1.0, np.abs(b.y_C).max(initial=0.0), np.abs(b.y_box).max())
+        np.testing.assert_allclose(a.y_C, b.y_C, rtol=0, atol=1e-10 * y_scale)
+        np.testing.assert_allclose(a.y_box, b.y_box, rtol=0, atol=1e-10 * y_scale)
+
+
+@pytest.mark.parametrize("warm", [True, False])
+def test_proxqp_chunks_resume_where_the_previous_one_stopped(
+    hard_gipc_qps: list, warm: bool
+) -> None:
+    """Cut into chunks of 5 outer iterations, every solve still converges to the same answer.
+
+    Each chunk starts from the previous chunk's result (a cold restart would never get past the
+    fifth iteration). Measured: the answers agree with the unchunked ones to 3.5e-8 (3.5e-6 of
+    the du bound, within the solver's tolerance); 1e-6 leaves a margin of about 30.
+    """
+    qps = hard_gipc_qps if warm else hard_gipc_qps[::10]
+    whole = _proxqp_run(qps, warm, time_limit=INF)
+    chunked = _proxqp_run(qps, warm, first_chunk=5)
+    if warm:  # chunks of 5 do cut these solves (the cold ones after setup need 5 to 15)
+        assert max(r.info["outer_iterations"] for r in whole) > 5
+    for a, b in zip(chunked, whole, strict=True):
+        assert a.status == "optimal"
+        np.testing.assert_allclose(a.x, b.x, rtol=0, atol=1e-6)
+
+
 # -- back-end specific pitfalls ------------------------------------------------------------
 def test_proxqp_update_before_any_solve_does_not_crash() -> None:
     """proxsuite 0.8.0's dense QP segfaults on init -> update -> warm-started solve.
 
-    The back-end solves once inside ``setup``; run in a subprocess so a crash is a failure
+    The first solve after ``init`` is cold; then the paths of the time limit: chunks each
+    warm-started from the previous one, a stopped solve followed by update -> solve, a failed
+    warm-started solve retried in a new solver. Run in a subprocess so a crash is a failure
     of this test, not of the whole run.
     """
     code = textwrap.dedent(
@@ -353,6 +570,19 @@ def test_proxqp_update_before_any_solve_does_not_crash() -> None:
             be.setup(qp)
             be.update(g=rng.standard_normal(n))
             assert be.solve().status == "optimal"
+        infeasible = QP(H=np.eye(2), g=[1.0, 1.0], C=[[1.0, 1.0]], l=[3.0], u=[4.0],
+                        lb=[-1.0, -1.0], ub=[1.0, 1.0])
+        for box in ("rows", "native"):
+            for limit, stopped, retried in ((1e-9, "time_limit", False), (5.0, "max_iterations", True)):
+                be = make_backend("proxqp", box=box, time_limit=limit, max_iter=1200)
+                be.setup(infeasible)
+                be.update(g=[0.5, 1.0])  # init -> update -> the cold solve, chunks after it
+                assert be.solve().status == stopped
+                be.update(l=[-1.0], u=[1.0])  # a stopped solve -> update -> solve
+                assert be.solve().status == "optimal"
+                be.update(l=[3.0], u=[4.0])  # a warm-started solve that fails (and a retry)
+                res = be.solve()
+                assert (res.status, res.info["retried_cold"]) == (stopped, retried), (box, limit, res)
         print("ok")
         """
     )

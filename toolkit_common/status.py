@@ -127,7 +127,10 @@ STATUS_TABLE: tuple[StatusInfo, ...] = (
                "The objective is unbounded below (dual infeasible).", _SOLVER_FAILURE),
     StatusInfo(Status.MAX_ITERATIONS, False, "solver", "The iteration limit was reached first.",
                _SOLVER_FAILURE),
-    StatusInfo(Status.TIME_LIMIT, False, "solver", "The time limit was reached first.", _SOLVER_FAILURE),
+    StatusInfo(Status.TIME_LIMIT, False, "solver",
+               "The time limit was reached first: for a QP back-end its ``time_limit`` setting "
+               "(seconds per solve call, retries included; 5 s by default), for an LMI solver a "
+               "limit passed to it.", _SOLVER_FAILURE),
     StatusInfo(Status.NUMERICAL_ERROR, False, "solver",
                "The solver stopped on a numerical difficulty (a failed factorisation, no progress, "
                "a non-finite answer).", _SOLVER_FAILURE),

@@ -582,10 +582,14 @@ def _nan_callback_simulation(where: str) -> Any:
 
 
 def _gipc_huge_state(backend: str) -> Any:
+    """One GIPC step at a state of 1e8: the input, the step's status and whether it fell back."""
     from rmpc import GIPC
 
     ctrl = GIPC(satellite_polytope(), Np=400, Nc=4, backend=backend)
-    return ctrl.step(np.full(6, 1e8))
+    u = ctrl.step(np.full(6, 1e8))
+    if not np.all(np.isfinite(u)):
+        raise AssertionError(f"non-finite input at a huge state (status {ctrl.last.status})")
+    return {"u": u.tolist(), "status": str(ctrl.last.status), "fallback": ctrl.last.fallback}
 
 
 def _rmpc_tiny_state() -> Any:

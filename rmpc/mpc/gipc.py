@@ -184,6 +184,12 @@ class GIPC:
     breaks the bounds by more than 1e-5 relative), the step holds the previous input
     (``du = 0``, which satisfies both bounds), ``last.fallback`` is ``True`` and
     ``last.status`` is the back-end's status (``"bound_violation"`` for the latter case).
+    Every back-end bounds a solve by ``max_iter`` and by ``time_limit`` seconds
+    (:data:`rmpc.qp.base.DEFAULT_TIME_LIMIT`, 5 s, by default; ``solver_options``), so a
+    step ends with ``"max_iterations"`` or ``"time_limit"`` rather than running on: at a
+    state of 1e8 one ProxQP step ran 54-76 s before that bound and ends ``"time_limit"``
+    after 7-8 s with it (ProxQP reads the clock only between chunks of outer iterations:
+    see :mod:`rmpc.qp.proxqp_backend`).
 
     Examples
     --------

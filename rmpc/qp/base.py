@@ -5,6 +5,10 @@ A back-end is built with its settings, ``setup`` once with a :class:`~rmpc.qp.pr
 (``g, l, u, lb, ub``) and ``solve``d as often as needed. Each back-end maps its solver's
 statuses into :data:`~rmpc.qp.problem.STATUSES` through its ``STATUS_MAP`` and rejects
 unknown settings with an error naming the setting.
+
+Every back-end is bounded in iterations (``max_iter``) and in wall time per ``solve`` call
+(``time_limit``, :data:`DEFAULT_TIME_LIMIT` seconds by default, ``inf`` for none): a solve
+stopped by the first reports ``"max_iterations"``, by the second ``"time_limit"``.
 """
 
 from __future__ import annotations
@@ -22,7 +26,19 @@ from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, Solve
 from toolkit_common.status import Status
 from toolkit_common.validation import check_bool
 
-__all__ = ["BackendSettings", "QPBackend"]
+__all__ = ["DEFAULT_TIME_LIMIT", "BackendSettings", "QPBackend"]
+
+#: Default bound in seconds on the wall time of one ``solve`` call of every back-end (the
+#: ``time_limit`` setting; ``inf`` switches it off). Measured on GIPC's QPs (paper P's and
+#: paper W's suites, short and at full length, and the GIPC cases of the shipped sweeps): of
+#: 298631 ProxQP solves, 298620 took under 20 ms (a warm-started one about 10
+#: microseconds) and the slowest 104 ms, a warm solve of 2 iterations that the loaded shared
+#: 2-core machine had descheduled; the first cvxpy step, with its modelling, took 0.24 s. 5 s
+#: is 50 times that slowest solve, so load does not bring a normal solve near it, and it keeps
+#: a hopeless step far from a minute: one ``GIPC.step`` with ProxQP at a state of 1e8 ran
+#: 54-76 s before (10000 outer iterations of about 1450 inner ones each). A larger QP (a long
+#: control horizon ``Nc``) may need a larger value.
+DEFAULT_TIME_LIMIT = 5.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,11 +46,13 @@ class BackendSettings:
     """Base of the typed settings of a back-end (a frozen dataclass).
 
     Subclasses declare their fields with defaults and list which fields are tolerances
-    (``_POSITIVE``), counts (``_COUNTS``), flags (``_FLAGS``) and choices (``_CHOICES``);
-    ``__post_init__`` checks them.
+    (``_POSITIVE``), counts (``_COUNTS``), flags (``_FLAGS``), choices (``_CHOICES``) and
+    time limits in seconds (``_SECONDS``: a number > 0, ``inf`` for none); ``__post_init__``
+    checks them.
     """
 
     _POSITIVE: ClassVar[tuple[str, ...]] = ()
+    _SECONDS: ClassVar[tuple[str, ...]] = ()
     _NONNEGATIVE: ClassVar[tuple[str, ...]] = ()
     _COUNTS: ClassVar[tuple[str, ...]] = ()
     _FLAGS: ClassVar[tuple[str, ...]] = ()
@@ -48,6 +66,12 @@ class BackendSettings:
                 raise ArgumentTypeError(f"{label}.{name}", "a finite real number", repr(value))
             if value < 0 or (value == 0 and name in self._POSITIVE):
                 expected = "a number > 0" if name in self._POSITIVE else "a number >= 0"
+                raise InvalidArgumentError(f"{label}.{name}", expected, repr(value))
+        for name in self._SECONDS:
+            value, expected = getattr(self, name), "a number of seconds > 0 (inf: none)"
+            if isinstance(value, bool) or not isinstance(value, Real):
+                raise ArgumentTypeError(f"{label}.{name}", expected, repr(value))
+            if not value > 0:  # NaN fails too
                 raise InvalidArgumentError(f"{label}.{name}", expected, repr(value))
         for name in self._COUNTS:
             value = getattr(self, name)

@@ -27,7 +27,7 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
-from rmpc.qp.base import BackendSettings, QPBackend
+from rmpc.qp.base import DEFAULT_TIME_LIMIT, BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
 from toolkit_common.status import Status
 
@@ -49,7 +49,8 @@ class ClarabelSettings(BackendSettings):
     max_iter : int
         Iteration limit.
     time_limit : float
-        Seconds; ``inf`` means none.
+        Bound in seconds on one solve (:data:`~rmpc.qp.base.DEFAULT_TIME_LIMIT` by default;
+        ``inf`` means none); a solve it stops reports ``"time_limit"`` (Clarabel's ``MaxTime``).
     equilibrate_enable : bool
         Ruiz equilibration.
     direct_solve_method : str
@@ -65,7 +66,7 @@ class ClarabelSettings(BackendSettings):
     tol_infeas_rel: float = 1e-9
     tol_ktratio: float = 1e-7
     max_iter: int = 200
-    time_limit: float = float("inf")
+    time_limit: float = DEFAULT_TIME_LIMIT
     equilibrate_enable: bool = True
     direct_solve_method: str = "qdldl"
     verbose: bool = False
@@ -74,19 +75,9 @@ class ClarabelSettings(BackendSettings):
         "tol_gap_abs", "tol_gap_rel", "tol_feas", "tol_infeas_abs", "tol_infeas_rel", "tol_ktratio",
     )
     _COUNTS: ClassVar[tuple[str, ...]] = ("max_iter",)
+    _SECONDS: ClassVar[tuple[str, ...]] = ("time_limit",)
     _FLAGS: ClassVar[tuple[str, ...]] = ("equilibrate_enable", "verbose")
     _CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {"direct_solve_method": ("qdldl", "auto")}
-
-    def __post_init__(self) -> None:
-        from toolkit_common.errors import InvalidArgumentError
-
-        super().__post_init__()
-        if isinstance(self.time_limit, bool) or not isinstance(self.time_limit, int | float) or not (
-            self.time_limit > 0
-        ):
-            raise InvalidArgumentError(
-                "ClarabelSettings.time_limit", "a number > 0 (inf: none)", repr(self.time_limit)
-            )
 
 
 class ClarabelBackend(QPBackend):

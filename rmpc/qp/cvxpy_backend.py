@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from rmpc.qp.base import BackendSettings, QPBackend
+from rmpc.qp.base import DEFAULT_TIME_LIMIT, BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
 from toolkit_common.status import Status
 
@@ -42,6 +42,13 @@ class CvxpySettings(BackendSettings):
         ``tol_feas``; OSQP: ``eps_abs``, ``eps_rel``, with polishing).
     max_iter : int
         Iteration limit passed to the solver.
+    time_limit : float
+        Bound in seconds on the solver's run, passed to it (Clarabel's and OSQP's
+        ``time_limit``; :data:`~rmpc.qp.base.DEFAULT_TIME_LIMIT` by default, ``inf`` for none).
+        cvxpy's own work around the solver (parameters, re-stuffing the data: about a
+        millisecond per solve at GIPC's size) is not bounded by it. cvxpy reports both limits
+        as ``"user_limit"``; the back-end tells them apart by the solver's own status (OSQP)
+        or its iteration count (Clarabel: ``max_iter`` reached means the iteration limit).
     verbose : bool
         Let cvxpy and the solver print.
     """
@@ -49,10 +56,12 @@ class CvxpySettings(BackendSettings):
     solver: str = "CLARABEL"
     tol: float = 1e-10
     max_iter: int = 500
+    time_limit: float = DEFAULT_TIME_LIMIT
     verbose: bool = False
 
     _POSITIVE: ClassVar[tuple[str, ...]] = ("tol",)
     _COUNTS: ClassVar[tuple[str, ...]] = ("max_iter",)
+    _SECONDS: ClassVar[tuple[str, ...]] = ("time_limit",)
     _FLAGS: ClassVar[tuple[str, ...]] = ("verbose",)
     _CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {"solver": ("CLARABEL", "OSQP")}
 
@@ -60,8 +69,9 @@ class CvxpySettings(BackendSettings):
         """Keyword arguments for ``Problem.solve``."""
         if self.solver == "CLARABEL":
             return {"tol_gap_abs": self.tol, "tol_gap_rel": self.tol, "tol_feas": self.tol,
-                    "max_iter": self.max_iter}
-        return {"eps_abs": self.tol, "eps_rel": self.tol, "polishing": True, "max_iter": self.max_iter}
+                    "max_iter": self.max_iter, "time_limit": float(self.time_limit)}
+        return {"eps_abs": self.tol, "eps_rel": self.tol, "polishing": True, "max_iter": self.max_iter,
+                "time_limit": min(float(self.time_limit), 1e10)}  # OSQP's "none" is 1e10 s
 
 
 class CvxpyBackend(QPBackend):
@@ -87,7 +97,7 @@ class CvxpyBackend(QPBackend):
         "infeasible_inaccurate": Status.INFEASIBLE,
         "unbounded": Status.UNBOUNDED,
         "unbounded_inaccurate": Status.UNBOUNDED,
-        "user_limit": Status.MAX_ITERATIONS,
+        "user_limit": Status.MAX_ITERATIONS,  # or TIME_LIMIT: see _user_limit
         "solver_error": Status.NUMERICAL_ERROR,
     }
 
@@ -127,6 +137,19 @@ class CvxpyBackend(QPBackend):
         self._z = z
         self._problem = cp.Problem(cp.Minimize(objective), [grp[5] for grp in self._groups])
 
+    def _user_limit(self, stats: Any) -> Status:
+        """``"time_limit"`` or ``"max_iterations"`` for cvxpy's ``"user_limit"`` (it merges both)."""
+        info = getattr(getattr(stats, "extra_stats", None), "info", None)
+        if info is not None and hasattr(info, "status_val"):  # OSQP: its own status is kept
+            import osqp
+
+            timed_out = int(info.status_val) == int(osqp.SolverStatus.OSQP_TIME_LIMIT_REACHED)
+            return Status.TIME_LIMIT if timed_out else Status.MAX_ITERATIONS
+        iters = None if stats is None else stats.num_iters
+        if iters is not None and iters < self.settings.max_iter:  # Clarabel: stopped short of max_iter
+            return Status.TIME_LIMIT
+        return Status.MAX_ITERATIONS
+
     def _update(self, changed: dict[str, np.ndarray]) -> None:
         if {"l", "u", "lb", "ub"} & changed.keys() and self._structure() != self._key:
             self._build()
@@ -154,13 +177,15 @@ class CvxpyBackend(QPBackend):
         elapsed = time.perf_counter() - start
         raw = str(self._problem.status)
         status = self.map_status(raw)
+        stats = self._problem.solver_stats
+        if raw == "user_limit":
+            status = self._user_limit(stats)
         n, m = self._qp.n_vars, self._qp.n_cons
         y_c, y_box = np.zeros(m), np.zeros(n)
         if status in (Status.OPTIMAL, Status.INACCURATE):
             for part, _key, idx, sign, _par, con in self._groups:
                 target = y_c if part == "C" else y_box
                 target[idx] += sign * np.asarray(con.dual_value, dtype=float).reshape(-1)
-        stats = self._problem.solver_stats
         iters = stats.num_iters if stats is not None and stats.num_iters is not None else -1
         return self._result(
             status, raw, self._z.value, y_c, y_box, int(iters), elapsed, SolverResiduals(),
