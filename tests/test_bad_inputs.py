@@ -23,7 +23,7 @@ from models import (
     zoh,
 )
 from rmpc import GIPC, LQR, OfflineRMPC, SineDisturbance, StepDisturbance, simulate
-from toolkit_common.errors import SingularityError, ToolkitError
+from toolkit_common.errors import InvalidArgumentError, SingularityError, ToolkitError
 
 NAN, INF = float("nan"), float("inf")
 SAT = RigidSatellite.paper_p()
@@ -203,6 +203,10 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("gipc-Np-beyond-max_horizon", lambda: GIPC(POLY, Np=10**6), "Np"),
     ("gipc-Np-beyond-lifted-max_horizon", lambda: GIPC(POLY, Np=11, Nc=2, max_horizon=10), "Np"),
     ("gipc-max_horizon-zero", lambda: GIPC(POLY, max_horizon=0), "max_horizon"),
+    # Np = Nc = 20000 is within max_horizon but the prediction matrix would take 29 GB
+    ("gipc-prediction-matrix-too-large", lambda: GIPC(POLY, Np=20_000, Nc=20_000), "Nc"),
+    ("gipc-prediction-limit-lowered", lambda: GIPC(POLY, Np=20, Nc=10, max_prediction_entries=100), "Nc"),
+    ("gipc-prediction-limit-zero", lambda: GIPC(POLY, max_prediction_entries=0), "max_prediction_entries"),
     ("offline-n_ellipsoids-beyond-shrink", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=10**7),
      "n_ellipsoids"),
     ("offline-n_ellipsoids-41-at-half", lambda: OfflineRMPC(POLY, Q6, R3, u_max=1.0, n_ellipsoids=41),
@@ -317,3 +321,12 @@ def test_simulation_through_gimbal_lock_raises_instead_of_returning_nan():
     x0 = np.array([0.0, np.radians(85.0), 0.0, 0.0, 1.0, 0.0])
     with pytest.raises(SingularityError, match="theta"):
         simulate(Zero(), SAT, x0, duration=0.5, dt=0.01)
+
+
+def test_gipc_prediction_bound_is_the_matrix_size():
+    """The bound counts the prediction matrix's entries, (Np q) x (Nc m): at exactly that many a
+    GIPC is built, one fewer is refused naming Nc and the limit."""
+    entries = 20 * 3 * 10 * 3  # Np = 20, q = 3 outputs, Nc = 10, m = 3 inputs
+    assert GIPC(POLY, Np=20, Nc=10, max_prediction_entries=entries).Nc == 10
+    with pytest.raises(InvalidArgumentError, match="max_prediction_entries = 1799"):
+        GIPC(POLY, Np=20, Nc=10, max_prediction_entries=entries - 1)

@@ -54,7 +54,7 @@ from toolkit_common.validation import (
     as_vector,
 )
 
-__all__ = ["GIPC", "MAX_HORIZON", "prediction_matrices", "velocity_form"]
+__all__ = ["GIPC", "MAX_HORIZON", "MAX_PREDICTION_ENTRIES", "prediction_matrices", "velocity_form"]
 
 
 def velocity_form(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,6 +105,13 @@ MAX_HORIZON = 20_000
 memory (paper P uses 400); ``GIPC(..., max_horizon=N)`` lifts it."""
 
 
+MAX_PREDICTION_ENTRIES = 2**27
+"""Default bound on the entries of the prediction matrix, ``(Np q) x (Nc m)`` (``q`` outputs, ``m``
+inputs): 2^27 float64 entries are 1 GiB (paper P's 400 x 400 horizons at 3 outputs and 3 inputs:
+1.4 million). ``Np = Nc = 20000`` within :data:`MAX_HORIZON` would need 29 GB;
+``GIPC(..., max_prediction_entries=N)`` lifts it."""
+
+
 def _horizon(value: Any, name: str, upper: int | None = None, limit: int | None = None) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
         raise InvalidArgumentError(name, "a positive integer", repr(value))
@@ -151,6 +158,10 @@ class GIPC:
     max_horizon : int
         The largest ``Np`` accepted (default :data:`MAX_HORIZON`, 20000); a larger ``Np`` is
         refused with an error naming this limit (``Np = 10**6`` ended in a MemoryError).
+    max_prediction_entries : int
+        The largest prediction matrix accepted, in entries (default
+        :data:`MAX_PREDICTION_ENTRIES`, 2^27, 1 GiB); larger horizons are refused naming ``Nc``
+        and this limit.
 
     Attributes
     ----------
@@ -222,6 +233,7 @@ class GIPC:
         x_ref: Any = None,
         u0: Any = None,
         max_horizon: int = MAX_HORIZON,
+        max_prediction_entries: int = MAX_PREDICTION_ENTRIES,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
@@ -229,11 +241,19 @@ class GIPC:
         limit = _horizon(max_horizon, "max_horizon")
         self.Np = _horizon(Np, "Np", limit=limit)
         self.Nc = _horizon(Nc, "Nc", self.Np)
+        entries_limit = _horizon(max_prediction_entries, "max_prediction_entries")
         if C is None:
             c = np.eye(n)[:3] if n == 6 else np.eye(n)
         else:
             c = as_matrix(C, "C", (None, n))
         q = c.shape[0]
+        entries = self.Np * q * self.Nc * m
+        if entries > entries_limit:
+            raise InvalidArgumentError(
+                "Nc", f"horizons whose prediction matrix ({self.Np * q} x {self.Nc * m}) has at most "
+                f"max_prediction_entries = {entries_limit} entries (pass a larger "
+                "max_prediction_entries to lift it)", f"Np = {self.Np}, Nc = {self.Nc}: {entries} entries",
+            )
         self.C = c
         self.Qy = as_square_matrix(Qy, "Qy", q, allow_zero=True, definite="psd")
         self.R_du = as_square_matrix(R_du, "R_du", m)
