@@ -234,16 +234,22 @@ def test_a_sweep_name_must_be_one_printable_line(tmp_path, name):
 
 
 def test_a_case_past_its_time_limit_is_stored_as_time_limit_and_the_rest_runs(tmp_path):
-    """Two RMPC cases on the linear plant: 0.2 s (20 solves, well under a second) is done; 120 s
-    (12000 solves, a minute or more) is stopped by a 5 s limit and stored as a time_limit error."""
-    body = TINY.replace('controller = "LQR"', 'controller = "RMPC"') + "[grid]\nduration = [0.2, 120.0]\n"
+    """Two RMPC cases on the linear plant: 0.2 s (20 samples, well under a second) is done; 1200 s
+    (120000 samples; 120 s of it took 6-9 s here, 1200 s about ten times that) is stopped by a
+    5 s limit and stored as a time_limit error.
+    The solver's compiled kernels are loaded first (after a fresh install that compiles them,
+    10-20 s), so the short case's time is its own: at 5 s and a load of about 6 it was once cut."""
+    from lmi.ipm import BlockLMISolver
+
+    BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])])  # loads (or compiles) the kernels
+    body = TINY.replace('controller = "LQR"', 'controller = "RMPC"') + "[grid]\nduration = [0.2, 1200.0]\n"
     config = _write_sweep(tmp_path, body)
     out = tmp_path / "out"
     args = ["--out", str(out), "--workers", "0", "--no-progress", "--case-time-limit", "5"]
     assert main(["bench", "sweep", "--config", str(config), *args]) == 1  # a case failed
     with CaseStore(out / "sweep.sqlite") as store:
         rows = {row["scenario"]["duration"]: row for row in store.rows()}
-    stopped = rows[120.0]
+    stopped = rows[1200.0]
     assert stopped["status"] == "error" and stopped["error"].startswith("time_limit: "), stopped["error"]
     assert rows[0.2]["status"] == "done"
 
