@@ -7,7 +7,14 @@ from typing import Any, Literal
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_positive_values, as_vector, check_choice, check_positive, check_real
+from toolkit_common.validation import (
+    as_positive_values,
+    as_vector,
+    check_choice,
+    check_count,
+    check_positive,
+    check_real,
+)
 
 __all__ = ["MAX_AXES", "ReactionWheelActuator", "TorqueLimiter"]
 
@@ -68,13 +75,8 @@ class ReactionWheelActuator:
         *,
         max_axes: int = MAX_AXES,
     ) -> None:
-        if isinstance(max_axes, bool) or not isinstance(max_axes, int | np.integer) or max_axes < 1:
-            raise InvalidArgumentError("max_axes", "a positive integer", repr(max_axes))
-        if isinstance(n_axes, bool) or not isinstance(n_axes, int | np.integer) or n_axes < 1:
-            raise InvalidArgumentError("n_axes", "a positive integer", repr(n_axes))
-        if n_axes > max_axes:
-            expected = f"at most max_axes = {max_axes} axes (pass a larger max_axes to lift it)"
-            raise InvalidArgumentError("n_axes", expected, repr(n_axes))
+        limit = check_count(max_axes, "max_axes")
+        n_axes = check_count(n_axes, "n_axes", limit=limit, limit_name="max_axes", unit=" axes")
         self.a = check_real(a, "a")
         if not 0.0 <= self.a < 1.0:
             expected = "a decaying first-order pole, 0 <= a < 1 (a = exp(-dt / tau))"

@@ -38,6 +38,7 @@ __all__ = [
     "as_vector",
     "check_bool",
     "check_choice",
+    "check_count",
     "check_pd",
     "check_positive",
     "check_psd",
@@ -252,6 +253,32 @@ def check_bool(value: Any, name: str) -> bool:
     if not isinstance(value, bool | np.bool_):
         raise ArgumentTypeError(name, "True or False", f"{type(value).__name__} {value!r}")
     return bool(value)
+
+
+def check_count(value: Any, name: str, *, limit: int | None = None, limit_name: str = "limit",
+                unit: str = "", expected: str = "a positive integer") -> int:
+    """Return ``value`` as an ``int >= 1`` (a NumPy integer is accepted, a ``bool`` is not), at most
+    ``limit`` when one is given: the error then names the limit's argument ``limit_name`` and how to
+    lift it.
+
+    Examples
+    --------
+    >>> from toolkit_common.validation import check_count
+    >>> check_count(3, "n_axes", limit=1000, limit_name="max_axes", unit=" axes")
+    3
+    >>> try:
+    ...     check_count(5000, "n_axes", limit=1000, limit_name="max_axes", unit=" axes")
+    ... except ValueError as err:
+    ...     print(err)
+    n_axes: expected at most max_axes = 1000 axes (pass a larger max_axes to lift it), but found 5000
+    """
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+        raise InvalidArgumentError(name, expected, repr(value))
+    if limit is not None and value > limit:
+        raise InvalidArgumentError(
+            name, f"at most {limit_name} = {limit}{unit} (pass a larger {limit_name} to lift it)", repr(value)
+        )
+    return int(value)
 
 
 def _positive_values(

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
-from toolkit_common.validation import as_matrix, as_positive_values, as_vector
+from toolkit_common.validation import as_matrix, as_positive_values, as_vector, check_count
 
 __all__ = [
     "MAX_WHEELS",
@@ -195,14 +195,9 @@ class WheelArray:
 
 def _wheel_count(n_wheels: Any, max_wheels: Any) -> int:
     """``n_wheels`` as an int in ``[1, max_wheels]``, else an error naming it (or ``max_wheels``)."""
-    if isinstance(max_wheels, bool) or not isinstance(max_wheels, int | np.integer) or max_wheels < 1:
-        raise InvalidArgumentError("max_wheels", "a positive integer", repr(max_wheels))
-    if isinstance(n_wheels, bool) or not isinstance(n_wheels, int | np.integer) or n_wheels < 1:
-        raise InvalidArgumentError("n_wheels", "a positive number of wheels", repr(n_wheels))
-    if n_wheels > max_wheels:
-        expected = f"at most max_wheels = {max_wheels} wheels (pass a larger max_wheels to lift it)"
-        raise InvalidArgumentError("n_wheels", expected, repr(n_wheels))
-    return int(n_wheels)
+    limit = check_count(max_wheels, "max_wheels")
+    return check_count(n_wheels, "n_wheels", limit=limit, limit_name="max_wheels", unit=" wheels",
+                       expected="a positive number of wheels")
 
 
 def _rank(mat: np.ndarray) -> int:

@@ -52,6 +52,7 @@ from toolkit_common.validation import (
     as_optional_limits,
     as_square_matrix,
     as_vector,
+    check_count,
 )
 
 __all__ = ["GIPC", "MAX_HORIZON", "MAX_PREDICTION_ENTRIES", "prediction_matrices", "velocity_form"]
@@ -113,15 +114,10 @@ inputs): 2^27 float64 entries are 1 GiB (paper P's 400 x 400 horizons at 3 outpu
 
 
 def _horizon(value: Any, name: str, upper: int | None = None, limit: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-        raise InvalidArgumentError(name, "a positive integer", repr(value))
+    value = check_count(value, name, limit=limit, limit_name="max_horizon", unit=" samples")
     if upper is not None and value > upper:
         raise InvalidArgumentError(name, f"an integer <= Np = {upper}", repr(value))
-    if limit is not None and value > limit:
-        raise InvalidArgumentError(
-            name, f"at most max_horizon = {limit} samples (pass a larger max_horizon to lift it)", repr(value)
-        )
-    return int(value)
+    return value
 
 
 class GIPC:
