@@ -2,11 +2,14 @@
 
 The main object is :class:`KothareProblem` (Kothare, Balakrishnan & Morari 1996): built once
 over a polytope of discrete-time models, solved for each measured state, every answer checked
-by :func:`certify`.
+by :func:`certify`. Under it, and usable on its own, is :class:`BlockLMISolver`, the toolkit's
+interior-point method for ``min c'x`` subject to ``C_j - sum_i x_i A_ij >= 0`` (its result:
+:class:`IPMResult`).
 """
 
 from lmi.certificate import Certificate, certify
 from lmi.data import KothareData, build_kothare_data
+from lmi.ipm import BlockLMISolver, IPMResult
 from lmi.kothare import KothareProblem, LMISolution
 from lmi.status import FAILURE_STATUSES, OPTIMAL, STATUSES
 
@@ -14,7 +17,9 @@ __all__ = [
     "FAILURE_STATUSES",
     "OPTIMAL",
     "STATUSES",
+    "BlockLMISolver",
     "Certificate",
+    "IPMResult",
     "KothareData",
     "KothareProblem",
     "LMISolution",

@@ -28,7 +28,7 @@ from lmi.ipm import BlockLMISolver
 from lmi.ipm.solver import INFEASIBILITY_RADIUS
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
-from lmi.status import INACCURATE, INFEASIBLE, MAX_ITERATIONS, NUMERICAL_ERROR, OPTIMAL
+from lmi.status import INFEASIBLE, NUMERICAL_ERROR, OPTIMAL
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
@@ -83,13 +83,6 @@ DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "phase_one": True,
     "rebalance": True,
     "infeasibility_radius": INFEASIBILITY_RADIUS,
-}
-_STATUS = {
-    "optimal": OPTIMAL,
-    "inaccurate": INACCURATE,
-    "max_iterations": MAX_ITERATIONS,
-    "numerical_error": NUMERICAL_ERROR,
-    "insufficient_progress": NUMERICAL_ERROR,
 }
 
 
@@ -389,6 +382,6 @@ class IPMKothare(KothareBackend):
                              elapsed)
         q_mat, y_mat = self.conic.variables(res.x)
         return RawResult(
-            _STATUS.get(res.status, NUMERICAL_ERROR), res.status, self.gamma(res.x[0]), q_mat, y_mat,
+            res.status, res.solver_status, self.gamma(res.x[0]), q_mat, y_mat,
             res.iterations, elapsed,
         )

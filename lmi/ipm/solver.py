@@ -59,10 +59,15 @@ from lmi.infeasibility import MIN_RADIUS
 from lmi.ipm import kernels as _kernels
 from lmi.ipm.blocks import BlockData, BlockFactor
 from lmi.ipm.phase_one import PhaseOneResult, run_phase_one
+from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.status import Status
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["INFEASIBILITY_RADIUS", "QR_SWITCH", "REDUCED_TOL", "STALL_WINDOW", "BlockLMISolver", "IPMResult"]
+__all__ = [
+    "INFEASIBILITY_RADIUS", "QR_SWITCH", "REDUCED_TOL", "SOLVER_STATUS_MAP", "STALL_WINDOW", "BlockLMISolver",
+    "IPMResult",
+]
 
 _LOG = logging.getLogger(__name__)
 
@@ -96,16 +101,34 @@ INFEASIBILITY_RADIUS = MIN_RADIUS
 #: :meth:`BlockLMISolver.solve`).
 RAY_TOL = 1e-6
 
+#: The solver's own words (``IPMResult.solver_status``) mapped to the status vocabulary
+#: (``IPMResult.status``). ``"insufficient_progress"``: the run stalled (see :data:`STALL_WINDOW`)
+#: without an answer; like Clarabel's ``InsufficientProgress`` it is a numerical failure.
+SOLVER_STATUS_MAP: dict[str, Status] = {
+    "optimal": Status.OPTIMAL,
+    "inaccurate": Status.INACCURATE,
+    "infeasible": Status.INFEASIBLE,
+    "max_iterations": Status.MAX_ITERATIONS,
+    "numerical_error": Status.NUMERICAL_ERROR,
+    "insufficient_progress": Status.NUMERICAL_ERROR,
+}
+
 
 @dataclass
 class IPMResult:
     """Outcome of :meth:`BlockLMISolver.solve`.
 
-    ``x`` is the variable vector; ``S`` and ``Z`` are the slack and dual blocks (in the order
-    the blocks were given, without padding). With status ``"infeasible"``, ``Z`` is the Farkas
-    ray (scaled to unit Frobenius norm over all blocks, positive definite) and
-    ``infeasibility_radius`` the radius it proves: ``sum_j <C_j, Z_j> < 0`` and no ``x`` with
-    ``||x|| < infeasibility_radius`` satisfies the LMIs (see :meth:`BlockLMISolver.solve`);
+    ``status`` is a word of the toolkit's status vocabulary (:class:`toolkit_common.status.Status`):
+    ``"optimal"`` (residuals and gap within the tolerances), ``"inaccurate"`` (a stalled run that
+    reached :data:`REDUCED_TOL`), ``"infeasible"`` (with a Farkas ray, below),
+    ``"max_iterations"`` or ``"numerical_error"``; ``solver_status`` is the solver's own word, which
+    tells a stall (``"insufficient_progress"``) from a breakdown (``"numerical_error"``, see
+    :data:`SOLVER_STATUS_MAP`). ``x`` is the variable vector; ``S`` and ``Z`` are the slack and
+    dual blocks (in the order the blocks were given, without padding). With status
+    ``"infeasible"``, ``Z`` is the Farkas ray (scaled to unit Frobenius norm over all blocks,
+    positive definite) and ``infeasibility_radius`` the radius it proves: ``sum_j <C_j, Z_j> < 0``
+    and no ``x`` with ``||x|| < infeasibility_radius`` satisfies the LMIs (see
+    :meth:`BlockLMISolver.solve`);
     otherwise ``infeasibility_radius`` is NaN.
     """
 
@@ -121,6 +144,7 @@ class IPMResult:
     gap: float
     solve_time: float
     infeasibility_radius: float = float("nan")
+    solver_status: str = ""
 
 
 
@@ -211,6 +235,7 @@ class BlockLMISolver(BlockData):
         self._warm: tuple | None = None
         super().__init__(n, blocks, factors)
         self._phase_one_solver: BlockLMISolver | None = None
+        self._blas = SingleThreadBlas()
         _load_kernels()
 
     def reset_warm_start(self) -> None:
@@ -244,16 +269,19 @@ class BlockLMISolver(BlockData):
         problems of 6-14 states, the proof came after 18-60 iterations (78 problems).
         """
         start = time.perf_counter()
-        self._refresh()
-        res = None
-        spent = 0
-        if warm_start and self._warm is not None:
-            res = self._run(self._warm, self.warm_max_iter)
-            if res.status not in ("optimal", "infeasible"):
-                spent, res = res.iterations, None
-        if res is None:
-            res = self._run(None, self.max_iter)
+        with self._blas.limit():
+            self._refresh()
+            res = None
+            spent = 0
+            if warm_start and self._warm is not None:
+                res = self._run(self._warm, self.warm_max_iter)
+                if res.status not in ("optimal", "infeasible"):
+                    spent, res = res.iterations, None
+            if res is None:
+                res = self._run(None, self.max_iter)
         res.iterations += spent
+        res.solver_status = res.status
+        res.status = SOLVER_STATUS_MAP[res.status]
         res.solve_time = time.perf_counter() - start
         return res
 
@@ -280,7 +308,8 @@ class BlockLMISolver(BlockData):
         blocks keep their factored form when their dictionary holds the identity columns) and
         reused.
         """
-        return run_phase_one(self)
+        with self._blas.limit():
+            return run_phase_one(self)
 
     def _initial_point(self, cvec: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """CVXOPT's initial point: least squares, shifted into the interiors."""
