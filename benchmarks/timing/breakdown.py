@@ -1,0 +1,253 @@
+"""Where an interior-point solve of paper P's LMIs spends its time, and the floor of its arithmetic.
+
+``python -m benchmarks.timing.breakdown [--vertices 2 8] [--states N] [--out DIR] [--compile]``
+
+For each polytope (paper P's satellite, 2 or 8 vertices, the default ``ipm`` path of
+:class:`lmi.KothareProblem`, warm-started along the closed loop of
+:func:`benchmarks.timing.rmpc.closed_loop_states`) every compiled kernel of an iteration and the
+factorisation of the Schur complement are timed by wrapping them, in CPU time of this thread
+(``time.thread_time``: a shared machine's other processes inflate wall time, much less the CPU
+time of this one). The table gives, per solve and per iteration, the time of each part, of the
+solver (:meth:`lmi.BlockLMISolver.solve`) and of the whole ``KothareProblem.solve`` (scaling,
+solver, certificate, gain); what the kernels leave of the solver's time is the Python around them.
+
+The floor, two ways, for the dense linear algebra one iteration of this method cannot avoid at the
+problem's dimensions (``n`` variables, packed size ``m``, blocks of order ``k_j``): the Schur
+complement ``H = P P'`` (``n x m`` times its transpose, ``n^2 m`` flops), its Cholesky
+factorisation (``n^3 / 3``), the two Newton solves' products with ``P`` and ``P'`` and their
+triangular solves (``2 (4 n m + 2 n^2)``) and the Nesterov-Todd scaling of each block (an
+eigen-decomposition with vectors and two products, about ``13 k^3``). *Calls*: each operation
+timed alone as a LAPACK/BLAS call on this machine (scipy's ``dsyevd`` for the scaling), which
+includes each call's fixed cost. *Arithmetic*: the flop count at the rate this machine reaches on
+``P P'`` (the best-vectorised operation of the iteration), a floor no implementation of this
+method beats. Both times the iterations per solve.
+
+With ``--compile``, the first-call cost of the kernels (numba): a fresh process builds a solver
+with an empty kernel cache (compilation) and then again with the cache filled (loading).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from collections import defaultdict
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.core.machine import machine_info
+
+__all__ = ["breakdown", "compile_cost", "floor_per_iteration", "format_breakdown", "main"]
+
+#: The parts of an iteration that are timed: the compiled kernels (module ``lmi.ipm.kernels``)
+#: and the factorisations of the Schur complement (module ``lmi.ipm.solver``).
+KERNELS = ("residuals", "scaling_and_schur_rows", "scaling_and_schur_grouped", "newton_step",
+           "cholesky_blocks", "pack")
+FACTORS = ("_factor", "_cholesky")
+
+
+def _median_time(fn: Callable[[], Any], repeats: int = 400) -> float:
+    """Median CPU time of ``fn()`` in seconds (after one call)."""
+    fn()
+    times = []
+    for _ in range(repeats):
+        start = time.thread_time()
+        fn()
+        times.append(time.thread_time() - start)
+    return float(np.median(times))
+
+
+def floor_per_iteration(n: int, size: int, orders: Sequence[int], seed: int = 0) -> dict[str, float]:
+    """CPU seconds of the unavoidable dense linear algebra of one iteration (see the module notes).
+
+    Returns the timed calls (their ``"total"``), the flop count (``"flops"``), the rate of
+    ``P P'`` (``"flops_per_s"``) and the arithmetic floor (``"arithmetic"``, flops / rate).
+    """
+    from scipy.linalg import solve_triangular
+    from scipy.linalg.lapack import dpotrf, dsyevd
+
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(n, size))
+    h = p @ p.T + n * np.eye(n)
+    r = dpotrf(h, lower=0)[0]
+    v, w = rng.normal(size=size), rng.normal(size=n)
+    blocks = [(lambda a: a @ a.T)(rng.normal(size=(k, k))) for k in orders]
+    parts = {
+        "H = P P'": _median_time(lambda: p @ p.T),
+        "Cholesky of H": _median_time(lambda: dpotrf(h, lower=0, clean=1)),
+        "2 Newton solves": 2 * (_median_time(lambda: p @ v) + _median_time(lambda: p.T @ w)
+                                + 2 * _median_time(lambda: solve_triangular(r, w, check_finite=False))),
+        "NT scaling (dsyevd per block)": sum(_median_time(lambda b=b: dsyevd(b)) for b in blocks),
+    }
+    parts["total"] = sum(parts.values())
+    flops = n * n * size + n**3 / 3 + 2 * (4 * n * size + 2 * n * n) + sum(13 * k**3 for k in orders)
+    parts["flops"] = flops
+    parts["flops_per_s"] = n * n * size / parts["H = P P'"]
+    parts["arithmetic"] = flops / parts["flops_per_s"]
+    return parts
+
+
+def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
+    """Time the parts of the warm solves along the closed loop; see the module notes."""
+    import lmi.ipm.solver as solver_module
+    from benchmarks.timing.common import Q1, U_MAX, R, polytope
+    from benchmarks.timing.rmpc import closed_loop_states
+    from lmi import KothareProblem
+
+    poly = polytope(n_vertices)
+    states = closed_loop_states(n_states, "scalar" if n_vertices == 2 else "box")
+    prob = KothareProblem(poly.A, poly.B, Q1, R, dt=poly.dt, u_max=U_MAX)
+    for x in states[:3]:  # kernels loaded, warm point set
+        prob.solve(x)
+    solver = prob._backend._solver
+    spent: dict[str, float] = defaultdict(float)
+    calls: dict[str, int] = defaultdict(int)
+
+    def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            start = time.thread_time()
+            out = fn(*args, **kwargs)
+            spent[name] += time.thread_time() - start
+            calls[name] += 1
+            return out
+        return wrapper
+
+    originals = {name: getattr(solver_module._kernels, name) for name in KERNELS}
+    originals_f = {name: getattr(solver_module, name) for name in FACTORS}
+    solve = solver.solve
+    iterations = 0
+    totals = []
+    try:
+        for name, fn in originals.items():
+            setattr(solver_module._kernels, name, timed(name, fn))
+        for name, fn in originals_f.items():
+            setattr(solver_module, name, timed(name, fn))
+        solver.solve = timed("BlockLMISolver.solve", solve)
+        for x in states:
+            start = time.thread_time()
+            sol = prob.solve(x)
+            totals.append(time.thread_time() - start)
+            iterations += sol.iterations or 0
+    finally:
+        for name, fn in originals.items():
+            setattr(solver_module._kernels, name, fn)
+        for name, fn in originals_f.items():
+            setattr(solver_module, name, fn)
+        del solver.solve
+    count = len(states)
+    per_iteration = iterations / count
+    solver_time = spent.pop("BlockLMISolver.solve")
+    calls.pop("BlockLMISolver.solve")
+    parts = {name: {"per_solve_us": 1e6 * t / count, "per_iteration_us": 1e6 * t / iterations,
+                    "calls_per_solve": calls[name] / count} for name, t in spent.items()}
+    kernels = sum(spent.values())
+    floor = floor_per_iteration(solver.n, solver._layout.size, solver.block_orders)
+    rate, flops = floor.pop("flops_per_s"), floor.pop("flops")
+    arithmetic = floor.pop("arithmetic")
+    return {
+        "vertices": n_vertices, "states": count, "variables": solver.n, "packed_size": solver._layout.size,
+        "block_orders": list(solver.block_orders), "iterations_per_solve": per_iteration,
+        "kothare_solve_us": 1e6 * float(np.sum(totals)) / count,
+        "kothare_solve_p50_us": 1e6 * float(np.median(totals)),
+        "solver_us": 1e6 * solver_time / count,
+        "python_around_kernels_us": 1e6 * (solver_time - kernels) / count,
+        "outside_solver_us": 1e6 * (float(np.sum(totals)) - solver_time) / count,
+        "parts": parts,
+        "floor_per_iteration_us": {k: 1e6 * v for k, v in floor.items()},
+        "floor_per_solve_us": 1e6 * floor["total"] * per_iteration,
+        "flops_per_iteration": flops, "gflops_per_s": 1e-9 * rate,
+        "arithmetic_floor_per_iteration_us": 1e6 * arithmetic,
+        "arithmetic_floor_per_solve_us": 1e6 * arithmetic * per_iteration,
+    }
+
+
+def compile_cost() -> dict[str, float]:
+    """Seconds to build the first solver of a fresh process: empty kernel cache, then filled."""
+    code = ("import time; t = time.perf_counter(); from lmi import BlockLMISolver; import numpy as np; "
+            "BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve(); "
+            "print(time.perf_counter() - t)")
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+        runs = [float(subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True,
+                                     text=True).stdout.split()[-1]) for _ in range(2)]
+    return {"empty_cache_s": runs[0], "filled_cache_s": runs[1]}
+
+
+def format_breakdown(results: Sequence[dict[str, Any]], compile_s: dict[str, float] | None = None) -> str:
+    """The Markdown report."""
+    lines = ["# Where an interior-point solve spends its time", ""]
+    machine = machine_info()
+    lines.append(f"Machine: {machine.get('platform')}, {machine.get('cpu_count')} CPUs, load average "
+                 f"{machine.get('load_average')}. CPU time of this thread (time.thread_time), means over "
+                 "the warm solves of the closed loop.")
+    for res in results:
+        lines += ["", f"## Paper P, {res['vertices']} vertices", "",
+                  f"{res['states']} states; {res['variables']} variables, packed size {res['packed_size']}, "
+                  f"blocks of order {res['block_orders']}; {res['iterations_per_solve']:.2f} iterations per "
+                  "solve.", "",
+                  "| part | us per solve | us per iteration | calls per solve |",
+                  "| --- | ---: | ---: | ---: |"]
+        for name, part in sorted(res["parts"].items(), key=lambda kv: -kv[1]["per_solve_us"]):
+            lines.append(f"| {name} | {part['per_solve_us']:.0f} | {part['per_iteration_us']:.1f} | "
+                         f"{part['calls_per_solve']:.2f} |")
+        it = res["iterations_per_solve"]
+        lines.append(f"| Python around the kernels | {res['python_around_kernels_us']:.0f} | "
+                     f"{res['python_around_kernels_us'] / it:.1f} | |")
+        lines.append(f"| **solver** (BlockLMISolver.solve) | {res['solver_us']:.0f} | "
+                     f"{res['solver_us'] / it:.1f} | |")
+        lines.append(f"| outside the solver (scaling, certificate, gain) | {res['outside_solver_us']:.0f} "
+                     "| | |")
+        lines.append(f"| **KothareProblem.solve** (mean; p50 {res['kothare_solve_p50_us']:.0f}) | "
+                     f"{res['kothare_solve_us']:.0f} | | |")
+        lines += ["", "Floor, calls (the dense linear algebra of one iteration, each call timed alone):", "",
+                  "| part | us per iteration |", "| --- | ---: |"]
+        for name, value in res["floor_per_iteration_us"].items():
+            lines.append(f"| {name} | {value:.1f} |")
+        lines.append(f"| x {it:.2f} iterations = floor per solve | {res['floor_per_solve_us']:.0f} |")
+        lines += ["", f"Floor, arithmetic: {res['flops_per_iteration'] / 1e6:.2f} Mflop per iteration at "
+                  f"{res['gflops_per_s']:.1f} Gflop/s (the rate of P P') = "
+                  f"{res['arithmetic_floor_per_iteration_us']:.0f} us per iteration, "
+                  f"{res['arithmetic_floor_per_solve_us']:.0f} us per solve."]
+    if compile_s is not None:
+        lines += ["", "## First call", "",
+                  f"A fresh process building its first solver: {compile_s['empty_cache_s']:.1f} s with an "
+                  f"empty kernel cache (numba compiles), {compile_s['filled_cache_s']:.2f} s with the cache "
+                  "filled (the kernels are cached next to their files after an install's first use)."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: print the report, and write ``breakdown.md`` and ``breakdown.json`` with ``--out``."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.timing.breakdown",
+                                     description=(__doc__ or "").split("\n")[0])
+    parser.add_argument("--vertices", type=int, nargs="+", default=[2, 8], choices=[2, 4, 8])
+    parser.add_argument("--states", type=int, default=40,
+                        help="closed-loop states per polytope (default 40)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="directory for breakdown.md and breakdown.json")
+    parser.add_argument("--compile", action="store_true", help="also measure the kernels' first-call cost")
+    args = parser.parse_args(argv)
+    if not 1 <= args.states <= 10000:
+        parser.error(f"--states: expected an integer in [1, 10000], but found {args.states}")
+    results = [breakdown(v, args.states) for v in args.vertices]
+    compile_s = compile_cost() if args.compile else None
+    text = format_breakdown(results, compile_s)
+    print(text)
+    if args.out is not None:
+        args.out.mkdir(parents=True, exist_ok=True)
+        (args.out / "breakdown.md").write_text(text, encoding="utf-8")
+        (args.out / "breakdown.json").write_text(
+            json.dumps({"machine": machine_info(), "results": results, "compile": compile_s}, indent=2),
+            encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

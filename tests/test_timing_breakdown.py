@@ -1,0 +1,46 @@
+"""The per-iteration breakdown of ``python -m benchmarks.timing.breakdown`` adds up.
+
+No wall-clock assertion: the times are whatever the machine gives; what is checked is that the
+parts are the solver's parts (their sum within the solver's time, every kernel called once per
+iteration), that the wrappers are removed afterwards, and the flop count of the floor.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import lmi.ipm.solver as solver_module
+from benchmarks.timing import breakdown as bd
+
+
+@pytest.fixture(scope="module")
+def result():
+    return bd.breakdown(2, n_states=3)
+
+
+def test_the_parts_are_one_call_per_iteration_and_sum_within_the_solver(result):
+    iterations = result["iterations_per_solve"]
+    assert iterations >= 1
+    assert result["parts"]["newton_step"]["calls_per_solve"] == pytest.approx(iterations)
+    assert result["parts"]["residuals"]["calls_per_solve"] == pytest.approx(iterations + 1)
+    kernels = sum(part["per_solve_us"] for part in result["parts"].values())
+    assert kernels <= result["solver_us"] <= result["kothare_solve_us"]
+    assert result["python_around_kernels_us"] == pytest.approx(result["solver_us"] - kernels)
+
+
+def test_the_wrappers_are_removed(result):
+    assert solver_module._kernels.newton_step.__name__ == "newton_step"
+    assert solver_module._factor.__name__ == "_factor"
+
+
+def test_the_flop_count_of_the_floor():
+    floor = bd.floor_per_iteration(4, 10, [2, 3], seed=1)
+    n, m = 4, 10
+    assert floor["flops"] == n * n * m + n**3 / 3 + 2 * (4 * n * m + 2 * n * n) + 13 * (8 + 27)
+    assert floor["arithmetic"] == pytest.approx(floor["flops"] / floor["flops_per_s"])
+
+
+def test_the_report_names_every_part(result):
+    text = bd.format_breakdown([result], {"empty_cache_s": 12.0, "filled_cache_s": 0.5})
+    for name in ("newton_step", "Python around the kernels", "Floor, arithmetic", "12.0 s with an empty"):
+        assert name in text
