@@ -341,9 +341,10 @@ def test_infeasible_or_unbounded_problem_is_a_status_not_an_answer(case):
         assert res.status == "infeasible"
         off = BlockLMISolver(c, blocks, infeasibility_radius=np.inf).solve()
         assert off.solver_status in failed and off.status == SOLVER_STATUS_MAP[off.solver_status]
-    else:
-        assert res.solver_status in failed
-        assert res.status in ("max_iterations", "numerical_error")
+    else:  # unbounded: the primal iterate is the ray (see test_an_unbounded_problem_ends_unbounded)
+        assert res.status == "unbounded"
+        off = BlockLMISolver(c, blocks, infeasibility_radius=np.inf).solve()
+        assert off.solver_status in failed and off.status in ("max_iterations", "numerical_error")
 
 
 # -- argument checks -----------------------------------------------------------------------------
@@ -537,3 +538,39 @@ def test_status_is_a_vocabulary_word_and_solver_status_the_solvers_own():
     res = BlockLMISolver([1.0], [block]).solve()
     assert isinstance(res.status, Status) and res.status == "optimal" and res.solver_status == "optimal"
     assert set(SOLVER_STATUS_MAP.values()) <= set(Status)
+
+
+def _recession_problem(seed: int = 3, n: int = 4, order: int = 5):
+    """``min c'x`` over ``C - sum_i x_i A_i >= 0`` with a known direction of recession ``d``:
+    ``sum_i d_i A_i = -E E'`` (negative semidefinite, rank 2) and ``c'd = -1``; ``C`` positive
+    definite, so ``x = 0`` is feasible and ``x = t d`` stays feasible for every ``t >= 0``."""
+    rng = np.random.default_rng(seed)
+    c_mat = _sym(rng.normal(size=(order, order))) + order * np.eye(order)
+    e = rng.normal(size=(order, 2))
+    d = rng.normal(size=n)
+    d /= np.linalg.norm(d)
+    a = np.array([_sym(rng.normal(size=(order, order))) for _ in range(n)])
+    # make sum_i d_i A_i = -E E' by correcting along d
+    a -= np.einsum("i,jk->ijk", d, np.einsum("i,ijk->jk", d, a) + e @ e.T)
+    c = rng.normal(size=n)
+    c -= (c @ d + 1.0) * d  # c'd = -1
+    return c, [(c_mat, a)], d
+
+
+def test_an_unbounded_problem_ends_unbounded_with_a_feasible_far_point_and_its_direction():
+    """The primal iterate runs out along the direction of recession: the answer is a feasible ``x``
+    (every block's smallest eigenvalue recomputed >= 0) with ``c'x`` below ``-1e8``, and
+    ``x / ||x||`` a direction of recession, recomputed: ``sum_i x_i A_i / ||x||`` has no eigenvalue
+    above ``1e-6`` of its norm and ``c'x / ||x|| < 0``."""
+    c, blocks, d = _recession_problem()
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status == "unbounded" and res.solver_status == "unbounded"
+    c_mat, a = blocks[0]
+    s_mat = c_mat - np.einsum("i,ijk->jk", res.x, a)
+    assert np.linalg.eigvalsh(s_mat)[0] >= -1e-8 * np.linalg.norm(s_mat)
+    assert float(np.asarray(c) @ res.x) <= -1e8
+    direction = res.x / np.linalg.norm(res.x)
+    combination = np.einsum("i,ijk->jk", direction, a)
+    assert np.linalg.eigvalsh(combination)[-1] <= 1e-6 * np.linalg.norm(combination)
+    assert float(np.asarray(c) @ direction) < 0.0
+    assert float(np.asarray(c) @ d) == pytest.approx(-1.0)  # the construction: c'd = -1

@@ -19,9 +19,11 @@ predictor-corrector, as in Vandenberghe's CVXOPT ``coneqp`` (L. Vandenberghe, "T
 linear and quadratic cone program solvers", 2010), without the homogeneous self-dual embedding.
 An infeasible problem is recognised from the dual iterates themselves: they grow along a Farkas
 ray, and the run ends ``"infeasible"`` once the ray proves that no solution of norm below
-``infeasibility_radius`` exists (see :meth:`BlockLMISolver.solve`); an unbounded problem ends as
-``"insufficient_progress"``, ``"max_iterations"`` or ``"numerical_error"``, never as a wrong
-``"optimal"``. The NT scaling of each block comes from
+``infeasibility_radius`` exists (see :meth:`BlockLMISolver.solve`). An unbounded problem is
+recognised from the primal iterates in the same way: they run out along a direction of recession,
+and the run ends ``"unbounded"`` once a feasible iterate has ``c'x <= -infeasibility_radius
+max(1, ||c||)``; otherwise it ends ``"insufficient_progress"``, ``"max_iterations"`` or
+``"numerical_error"``, never as a wrong ``"optimal"``. The NT scaling of each block comes from
 one Cholesky factor and one small symmetric eigen-decomposition (as in SDPT3).
 Variables are equilibrated (unit Frobenius norm of each ``A_i``). ``H`` is factored by Cholesky until it
 becomes ill-conditioned near the optimum, then through a QR factorisation of ``P`` (which does
@@ -108,6 +110,7 @@ SOLVER_STATUS_MAP: dict[str, Status] = {
     "optimal": Status.OPTIMAL,
     "inaccurate": Status.INACCURATE,
     "infeasible": Status.INFEASIBLE,
+    "unbounded": Status.UNBOUNDED,
     "max_iterations": Status.MAX_ITERATIONS,
     "numerical_error": Status.NUMERICAL_ERROR,
     "insufficient_progress": Status.NUMERICAL_ERROR,
@@ -128,7 +131,10 @@ class IPMResult:
     ``"infeasible"``, ``Z`` is the Farkas ray (scaled to unit Frobenius norm over all blocks,
     positive definite) and ``infeasibility_radius`` the radius it proves: ``sum_j <C_j, Z_j> < 0``
     and no ``x`` with ``||x|| < infeasibility_radius`` satisfies the LMIs (see
-    :meth:`BlockLMISolver.solve`);
+    :meth:`BlockLMISolver.solve`). With status ``"unbounded"``, ``x`` satisfies the LMIs (to
+    ``tol_feas``) with ``c'x <= -infeasibility_radius max(1, ||c||)`` (``c`` as equilibrated) and
+    ``x / ||x||`` is a direction of recession (to :data:`RAY_TOL`): the objective has no finite
+    lower bound;
     otherwise ``infeasibility_radius`` is NaN.
     """
 
@@ -389,6 +395,11 @@ class BlockLMISolver(BlockData):
                     _kernels.pack(z, *packing))):
                 status, best = "infeasible", None
                 break
+            # the primal iterate as a ray: far out, feasible and along a direction of recession
+            if ray_test and pres <= self.tol_feas and -pcost >= self.infeasibility_radius * c_norm and (
+                    self._recession_direction(x)):
+                status, best = "unbounded", None
+                break
             merits.append(max(pres, dres, min(gap, rel_gap)))
             ray_merits.append(1.0 / radius if radius > 0.0 else np.inf)
             ray_grows = ray_test and it >= STALL_WINDOW and (
@@ -454,6 +465,17 @@ class BlockLMISolver(BlockData):
             status, x * dscale, s_out, z_out, it, float(cvec @ x), -float(h_vec @ zp), pres, dres,
             gap, 0.0, radius if status == "infeasible" else np.nan,
         )
+
+    def _recession_direction(self, x: np.ndarray) -> bool:
+        """Whether ``d = x / ||x||`` (equilibrated) is a direction of recession to :data:`RAY_TOL`:
+        ``sum_i d_i A_ij <= RAY_TOL ||sum_i d_i A_ij|| I`` for every block ``j`` (then ``C_j - sum_i
+        (x_i + t d_i) A_ij`` stays positive semidefinite, up to that tolerance, for every ``t >= 0``)."""
+        gd = self._g_mat @ (x / max(float(np.linalg.norm(x)), 1e-300))
+        scale = float(np.linalg.norm(gd))
+        blocks = self._unpack(gd)
+        return scale > 0.0 and all(
+            float(np.linalg.eigvalsh(blocks[j, :k, :k])[-1]) <= RAY_TOL * scale
+            for j, k in enumerate(self.block_orders))
 
     def _unpack(self, vec: np.ndarray) -> np.ndarray:
         return _kernels.unpack(vec, *self._layout.arrays, self._kmax)
