@@ -574,3 +574,51 @@ def test_an_unbounded_problem_ends_unbounded_with_a_feasible_far_point_and_its_d
     assert np.linalg.eigvalsh(combination)[-1] <= 1e-6 * np.linalg.norm(combination)
     assert float(np.asarray(c) @ direction) < 0.0
     assert float(np.asarray(c) @ d) == pytest.approx(-1.0)  # the construction: c'd = -1
+
+
+# -- variables that appear in no block ------------------------------------------------------------
+def _with_absent_variable(c_absent: float):
+    """``lambda_max`` of a 2 x 2 matrix (variable 0) and a variable 1 in no block, cost ``c_absent``."""
+    m = np.array([[2.0, 1.0], [1.0, 2.0]])
+    coef = np.zeros((2, 2, 2))
+    coef[0] = -np.eye(2)
+    return [1.0, c_absent], [(-m, coef)]
+
+
+def test_a_variable_in_no_block_with_zero_cost_is_left_at_zero():
+    """Before, the Schur complement was singular and the run ended ``"numerical_error"``."""
+    c, blocks = _with_absent_variable(0.0)
+    res = BlockLMISolver(c, blocks).solve()
+    alone = BlockLMISolver([1.0], [(blocks[0][0], blocks[0][1][:1])]).solve()
+    assert res.status == "optimal" and res.x[1] == 0.0
+    assert res.x[0] == pytest.approx(3.0, rel=1e-7) and res.x[0] == pytest.approx(alone.x[0], rel=1e-12)
+
+
+def test_a_variable_in_no_block_with_a_cost_makes_the_problem_unbounded():
+    c, blocks = _with_absent_variable(-2.0)
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status == "unbounded"
+    c_mat, coef = blocks[0]
+    assert np.linalg.eigvalsh(c_mat - np.einsum("i,ijk->jk", res.x, coef))[0] >= -1e-8
+    assert float(np.asarray(c) @ res.x) <= -1e8 and res.x[1] > 0.0
+
+
+def test_an_infeasible_rest_stays_infeasible_with_a_ray_for_the_whole_problem():
+    c, blocks = _with_absent_variable(1.0)
+    blocks.append((np.array([[-1.0]]), np.zeros((2, 1, 1))))  # -1 >= 0: infeasible
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status == "infeasible"
+    trace_c = sum(float(np.sum(c_j * z_j)) for (c_j, _), z_j in zip(blocks, res.Z, strict=True))
+    pairs = list(zip(blocks, res.Z, strict=True))
+    a_z = [sum(float(np.sum(a_j[i] * z_j)) for (_, a_j), z_j in pairs) for i in range(2)]
+    assert trace_c < 0.0 and max(abs(v) for v in a_z) <= 1e-6 * abs(trace_c)
+    assert all(np.linalg.eigvalsh(z_j)[0] >= -1e-12 for z_j in res.Z)
+
+
+@pytest.mark.parametrize(("const", "cost", "status"), [
+    (np.eye(2), 0.0, "optimal"), (np.eye(2), 1.0, "unbounded"), (-np.eye(2), 0.0, "infeasible")])
+def test_no_variable_in_any_block_the_constants_decide(const, cost, status):
+    res = BlockLMISolver([cost], [(const, np.zeros((1, 2, 2)))]).solve()
+    assert res.status == status
+    if status == "infeasible":
+        assert float(np.sum(const * res.Z[0])) < 0.0 and np.linalg.eigvalsh(res.Z[0])[0] >= 0.0

@@ -101,6 +101,7 @@ class BlockData:
         lay = self._layout
         self._kmax = max(orders)
         self._coef: list[np.ndarray] = [np.zeros((n, k, k)) for k in orders]
+        self._absent: np.ndarray | None = None
         self._dirty: set[int] = set()
         self._h_vec = np.zeros(lay.size)
         self._g_mat = np.zeros((lay.size, n))  # packed scaled coefficients
@@ -148,6 +149,16 @@ class BlockData:
         if coef is not None and not np.array_equal(coef, self._coef[j]):
             self._coef[j] = coef.copy()
             self._dirty.add(j)
+            self._absent = None
+
+    def absent_variables(self) -> np.ndarray:
+        """The indices of the variables that appear in no block (every ``A_ij = 0``)."""
+        if self._absent is None:
+            used = np.zeros(self.n, dtype=bool)
+            for coef in self._coef:
+                used |= np.any(coef != 0.0, axis=(1, 2))
+            self._absent = np.flatnonzero(~used)
+        return self._absent
 
     def _refresh(self) -> None:
         """Variable scaling (once) and the scaled coefficients of the changed blocks."""

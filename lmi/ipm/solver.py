@@ -275,6 +275,11 @@ class BlockLMISolver(BlockData):
         problems of 6-14 states, the proof came after 18-60 iterations (78 problems).
         """
         start = time.perf_counter()
+        empty = self.absent_variables()
+        if empty.size:
+            res = self._solve_without(empty)
+            res.solve_time = time.perf_counter() - start
+            return res
         with self._blas.limit():
             self._refresh()
             res = None
@@ -290,6 +295,39 @@ class BlockLMISolver(BlockData):
         res.status = SOLVER_STATUS_MAP[res.status]
         res.solve_time = time.perf_counter() - start
         return res
+
+    def _solve_without(self, empty: np.ndarray) -> IPMResult:
+        """Solve with the variables ``empty`` (in no block) taken out: they are free directions.
+
+        A fresh solver (cold, plain blocks) solves for the others. Where every absent variable
+        has ``c_i = 0`` it is set to 0 and the answer is that solver's. Otherwise the objective
+        has no lower bound as soon as the rest is feasible: ``x_i`` of an absent variable with
+        ``c_i != 0`` is moved along ``-sign(c_i)`` until ``c'x <= -infeasibility_radius max(1,
+        ||c||)`` and the status is ``"unbounded"`` (an ``"infeasible"`` rest stays infeasible, its
+        ray proves it for the whole problem: the absent variables add nothing to it)."""
+        keep = np.setdiff1d(np.arange(self.n), empty)
+        if keep.size:
+            rest = BlockLMISolver(
+                self.c[keep], [(c_j, a_j[keep]) for c_j, a_j in zip(self._const, self._coef, strict=True)],
+                tol_feas=self.tol_feas, tol_gap_abs=self.tol_gap_abs, tol_gap_rel=self.tol_gap_rel,
+                max_iter=self.max_iter, infeasibility_radius=self.infeasibility_radius).solve()
+        else:
+            rest = _constant_blocks(self._const)
+        x = np.zeros(self.n)
+        if keep.size:
+            x[keep] = rest.x
+        direction = -np.sign(self.c[empty])
+        if np.any(direction != 0.0) and rest.status in ("optimal", "inaccurate", "unbounded"):
+            radius = self.infeasibility_radius
+            if not np.isfinite(radius):
+                radius = INFEASIBILITY_RADIUS
+            target = radius * max(1.0, float(np.linalg.norm(self.c)))
+            pull = float(np.abs(self.c[empty]) @ np.abs(direction))
+            x[empty] = direction * (target + max(0.0, float(self.c @ x))) / pull
+            rest.status, rest.solver_status = Status.UNBOUNDED, "unbounded"
+        rest.x = x
+        rest.primal_objective = float(self.c @ x)
+        return rest
 
     def phase_one(self) -> PhaseOneResult:
         """Decide feasibility of the current data: ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0``.
@@ -506,6 +544,24 @@ def _load_kernels() -> None:
         return
     _KERNELS_LOADED.set()
     BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
+
+
+def _constant_blocks(consts: list[np.ndarray]) -> IPMResult:
+    """The answer when no variable appears in any block: ``"optimal"`` (``x`` anything, here
+    empty) if every ``C_j >= 0``, else ``"infeasible"`` with ``Z`` the eigenvector of the most
+    negative eigenvalue (``<C_j, Z_j> < 0``, and there are no ``A_ij`` to cancel it)."""
+    lows = [np.linalg.eigh(0.5 * (c_j + c_j.T)) for c_j in consts]
+    worst = int(np.argmin([w[0] for w, _ in lows]))
+    z = [np.zeros_like(c_j) for c_j in consts]
+    s = [c_j.copy() for c_j in consts]
+    empty = np.zeros(0)
+    if lows[worst][0][0] >= 0.0:
+        return IPMResult(Status.OPTIMAL, empty, s, z, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                         solver_status="optimal")
+    vec = lows[worst][1][:, 0]
+    z[worst] = np.outer(vec, vec)
+    return IPMResult(Status.INFEASIBLE, empty, s, z, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, float("inf"),
+                     solver_status="infeasible")
 
 
 def _cholesky(hmat: np.ndarray) -> tuple[np.ndarray | None, bool]:
