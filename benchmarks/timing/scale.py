@@ -1,14 +1,14 @@
 """The scale section of ``rmpc timing``: how an online robust MPC solve grows with the state.
 
-Plants: the flexible satellite of seed ``papers-S-V-flexible.md`` (section 2.5, Di Gennaro's
-modes, hub inertia **assumed** there) linearised at zero attitude, ZOH at ``Ts = 0.05`` s, with
+Plants: the flexible satellite of :class:`models.FlexibleSatellite` (Di Gennaro's modes, the hub
+inertia **assumed**) linearised at zero attitude, ZOH at ``Ts = 0.05`` s, with
 0, 2, 4 and 7 modes: 6, 10, 14 and 20 states (0 modes is the rigid hub). The published set has
 4 modes; modes 5-7 are **assumed** here, for the size only: frequencies 3.3, 4.2 and 5.1 rad/s,
 damping 0.03, and the coupling rows of modes 2-4 halved (the mass matrix stays positive
 definite; the constructor checks it). Polytope of the hub-torque effectiveness: 2 vertices
 ``B`` x 0.8 and x 1.2; 8 vertices each axis' torque column x 0.8 or x 1.2 independently.
 ``Q1 = diag(100 I6, I_2N)``, ``R = I3``, peak bound 2 N m per axis, initial attitude 10 deg
-off (the issue's flexible problem at 4 modes).
+off (the flexible satellite's problem at 4 modes).
 
 At the states of one closed loop driven by the default path (the toolkit's IPM, warm-started,
 on vertex 0), every path solves the same states, interleaved state by state: the IPM warm
@@ -180,7 +180,7 @@ def format_scale_markdown(records: Sequence[dict[str, Any]], plot_name: str | No
         return []
     lines = [
         "## Scale (flexible satellite, 6-20 states; see benchmarks.timing.scale)", "",
-        "The issue-12 flexible problem (ZOH 0.05 s, Q1 = diag(100 I6, I), R = I3, peak 2 N m, 10 deg "
+        "The flexible satellite's problem (ZOH 0.05 s, Q1 = diag(100 I6, I), R = I3, peak 2 N m, 10 deg "
         "off) with 0, 2, 4, 7 modes (modes 5-7 assumed); hub-torque effectiveness 0.8/1.2 (2 vertices: "
         "all axes together, 8: per axis). Error = max |gamma / gamma_clarabel - 1|.", "",
         "| states | vertices | path | formulation | steps | p50 (ms) | p95 (ms) | max (ms) | iterations p50 "
