@@ -44,3 +44,16 @@ def test_the_report_names_every_part(result):
     text = bd.format_breakdown([result], {"empty_cache_s": 12.0, "filled_cache_s": 0.5})
     for name in ("newton_step", "Python around the kernels", "Floor, arithmetic", "12.0 s with an empty"):
         assert name in text
+
+
+def test_rmpc_timing_runs_it_as_the_breakdown_problem(tmp_path):
+    from benchmarks.cli import main
+
+    args = ["--problems", "Breakdown", "--vertices", "2", "--steps", "2", "--no-progress"]
+    assert main(["timing", "--out", str(tmp_path), *args]) == 0
+    text = (tmp_path / "timing.md").read_text(encoding="utf-8")
+    assert "Where an interior-point solve spends its time" in text and "Floor, arithmetic" in text
+    import json
+
+    report = json.loads((tmp_path / "timing.json").read_text(encoding="utf-8"))
+    assert report["breakdown"][0]["vertices"] == 2 and report["breakdown"][0]["iterations_per_solve"] >= 1

@@ -44,7 +44,9 @@ import numpy as np
 
 from benchmarks.core.machine import machine_info
 
-__all__ = ["breakdown", "compile_cost", "floor_per_iteration", "format_breakdown", "main"]
+__all__ = [
+    "breakdown", "breakdown_sections", "compile_cost", "floor_per_iteration", "format_breakdown", "main",
+]
 
 #: The parts of an iteration that are timed: the compiled kernels (module ``lmi.ipm.kernels``)
 #: and the factorisations of the Schur complement (module ``lmi.ipm.solver``).
@@ -182,13 +184,26 @@ def compile_cost() -> dict[str, float]:
 
 def format_breakdown(results: Sequence[dict[str, Any]], compile_s: dict[str, float] | None = None) -> str:
     """The Markdown report."""
-    lines = ["# Where an interior-point solve spends its time", ""]
+    lines = ["# Interior-point breakdown", ""]
     machine = machine_info()
     lines.append(f"Machine: {machine.get('platform')}, {machine.get('cpu_count')} CPUs, load average "
-                 f"{machine.get('load_average')}. CPU time of this thread (time.thread_time), means over "
-                 "the warm solves of the closed loop.")
+                 f"{machine.get('load_average')}.")
+    lines += breakdown_sections(results, level="##")
+    if compile_s is not None:
+        lines += ["", "## First call", "",
+                  f"A fresh process building its first solver: {compile_s['empty_cache_s']:.1f} s with an "
+                  f"empty kernel cache (numba compiles), {compile_s['filled_cache_s']:.2f} s with the cache "
+                  "filled (the kernels are cached next to their files after an install's first use)."]
+    return "\n".join(lines) + "\n"
+
+
+def breakdown_sections(results: Sequence[dict[str, Any]], level: str = "##") -> list[str]:
+    """The Markdown lines of one section per polytope (``level`` is the heading's ``#``)."""
+    lines = ["", f"{level} Where an interior-point solve spends its time (ipm, paper P)", "",
+             "CPU time of this thread (time.thread_time), means over the warm solves of the closed loop; "
+             "see benchmarks.timing.breakdown."]
     for res in results:
-        lines += ["", f"## Paper P, {res['vertices']} vertices", "",
+        lines += ["", f"{level}# {res['vertices']} vertices", "",
                   f"{res['states']} states; {res['variables']} variables, packed size {res['packed_size']}, "
                   f"blocks of order {res['block_orders']}; {res['iterations_per_solve']:.2f} iterations per "
                   "solve.", "",
@@ -215,12 +230,7 @@ def format_breakdown(results: Sequence[dict[str, Any]], compile_s: dict[str, flo
                   f"{res['gflops_per_s']:.1f} Gflop/s (the rate of P P') = "
                   f"{res['arithmetic_floor_per_iteration_us']:.0f} us per iteration, "
                   f"{res['arithmetic_floor_per_solve_us']:.0f} us per solve."]
-    if compile_s is not None:
-        lines += ["", "## First call", "",
-                  f"A fresh process building its first solver: {compile_s['empty_cache_s']:.1f} s with an "
-                  f"empty kernel cache (numba compiles), {compile_s['filled_cache_s']:.2f} s with the cache "
-                  "filled (the kernels are cached next to their files after an install's first use)."]
-    return "\n".join(lines) + "\n"
+    return [*lines, ""]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -138,6 +138,10 @@ def format_markdown(report: dict[str, Any], plot_name: str | None = "timing.png"
         from benchmarks.timing.scale import format_scale_markdown
 
         lines += format_scale_markdown(scale, "timing_scale.png" if plot_name else None)
+    if report.get("breakdown"):
+        from benchmarks.timing.breakdown import breakdown_sections
+
+        lines += breakdown_sections(report["breakdown"])
     if plot_name:
         lines += ["## Distributions", "", f"![per-step time distributions]({plot_name})", ""]
     return "\n".join(lines)

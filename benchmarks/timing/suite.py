@@ -93,7 +93,8 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
     machine["load_average_start"] = machine.pop("load_average")
     units = (cfg.steps * len(cfg.vertices) if "RMPC" in cfg.problems else 0) + (
         len(cfg.vertices) if "OfflineRMPC" in cfg.problems else 0) + (1 if "GIPC" in cfg.problems else 0) + (
-        2 * len(cfg.scale_sizes) if "Scale" in cfg.problems else 0)
+        2 * len(cfg.scale_sizes) if "Scale" in cfg.problems else 0) + (
+        len(cfg.vertices) if "Breakdown" in cfg.problems else 0)
     records: list[dict[str, Any]] = []
     samples: dict[str, np.ndarray] = {}
     ratios, references = [], []
@@ -126,6 +127,13 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
                              cvxpy_steps=cfg.scale_cvxpy_steps)
             records += res["records"]
             samples.update(res["samples"])
+        breakdowns = []
+        if "Breakdown" in cfg.problems:
+            from benchmarks.timing.breakdown import breakdown
+
+            for count in cfg.vertices:
+                breakdowns.append(breakdown(count, cfg.steps))
+                bar.advance(f"Breakdown {count} vertices")
     end_load = machine_info()["load_average"]
     machine["load_average_end"] = end_load
     report = {
@@ -134,6 +142,7 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
         "records": records,
         "rebuild_over_fast": ratios,
         "reference": {"RMPC": references, "GIPC": gipc_ref},
+        "breakdown": breakdowns,
         "settings": {
             "steps": cfg.steps, "cheap_steps": cfg.cheap_steps, "rebuild_steps": cfg.rebuild_steps,
             "scs_steps": cfg.scs_steps, "vertices": list(cfg.vertices), "problems": list(cfg.problems),
@@ -214,8 +223,10 @@ def add_timing_parser(subparsers: Any) -> None:
     parser.add_argument("--vertices", nargs="+", default=None, metavar="V",
                         help="polytope vertex counts among 2 4 8 (default all three)")
     parser.add_argument("--problems", nargs="+", default=None, metavar="P",
-                        help="problems among RMPC OfflineRMPC GIPC Scale (default the first three; Scale: "
-                        "the flexible satellite at 6-20 states, see benchmarks.timing.scale)")
+                        help="problems among RMPC OfflineRMPC GIPC Scale Breakdown (default the first "
+                        "three; Scale: the flexible satellite at 6-20 states, see benchmarks.timing.scale; "
+                        "Breakdown: the ipm's time per kernel and iteration on paper P and the floor of its "
+                        "arithmetic, see benchmarks.timing.breakdown)")
     parser.add_argument("--scale-steps", default=None, metavar="N",
                         help="Scale: closed-loop states per size and vertex count (default 10; --quick: 2)")
     parser.add_argument("--scale-sizes", nargs="+", default=None, metavar="n",
