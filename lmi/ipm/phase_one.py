@@ -1,14 +1,17 @@
 """Phase one of the block LMI solver: a feasible point, or a checked proof of infeasibility.
 
 :func:`run_phase_one` is :meth:`lmi.ipm.BlockLMISolver.phase_one` (which documents the method):
-it solves ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0`` with an auxiliary solver of the
-same blocks and one more variable (:func:`phase_one_solver`), watching every iterate
-(:class:`PhaseOneCheck`) for a strictly feasible ``x`` or a dual point that, moved onto
-``sum_j <A_ij, Z_j> = 0`` (:func:`dual_correction`), is a Farkas certificate of infeasibility
-(:class:`PhaseOneResult`). It reads the solver's packed data (:class:`lmi.ipm.blocks.BlockData`)
-directly. The auxiliary solver takes the block weights of the solver (:func:`lmi.ipm.blocks.block_weights`),
-so its iterates are in the same weighted units as that packed data; the certificate is returned,
-and its margins are measured, in the original blocks (``Z_j = w_j Z~_j``).
+it solves ``min t`` s.t. ``w_j (C_j - sum_i x_i A_ij) + t I >= 0`` (``w_j`` the solver's block
+weights, :func:`lmi.ipm.blocks.block_weights`; 1 unless the blocks are badly balanced) with an
+auxiliary solver of the same blocks and one more variable (:func:`phase_one_solver`), watching
+every iterate (:class:`PhaseOneCheck`) for a strictly feasible ``x`` or a dual point that, moved
+onto ``sum_j <A_ij, Z_j> = 0`` (:func:`dual_correction`), is a Farkas certificate of
+infeasibility (:class:`PhaseOneResult`). It reads the solver's packed data
+(:class:`lmi.ipm.blocks.BlockData`) directly. The auxiliary solver takes the solver's weights,
+so its iterates are in the weighted units of that packed data (its ``t`` has the coefficient
+``-I`` there: with ``-I`` in the original blocks, phase one of SDPLIB's control3 and control4
+took 5 and 6 iterations instead of 3 and 2); the certificate is returned, and its margins are
+measured, in the original blocks (``Z_j = w_j Z~_j``).
 """
 
 from __future__ import annotations

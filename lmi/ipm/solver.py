@@ -280,7 +280,9 @@ class BlockLMISolver(BlockData):
         return res
 
     def phase_one(self) -> PhaseOneResult:
-        """Decide feasibility of the current data: ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0``.
+        """Decide feasibility of the current data: ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0``
+        (for weighted blocks, :func:`lmi.ipm.blocks.block_weights`, ``w_j (C_j - ...) + t I >= 0``:
+        the sign of ``t``, which decides, is the same).
 
         The phase-one problem is strictly feasible by construction and started at a feasible
         point (``x = 0``, ``t = 1 + max(0, -lambda_min(C))``), so its primal iterates stay
