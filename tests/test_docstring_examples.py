@@ -44,6 +44,7 @@ MODULES_WITH_EXAMPLES = (
     "lmi.ipm.solver",
     "lmi.kothare",
     "lmi.offline",
+    "lmi.sdpa",
     "lmi.status",
     "models",
     "models.actuators",

@@ -3,12 +3,19 @@
 :class:`BlockData` is the data half of :class:`lmi.ipm.BlockLMISolver`: the blocks
 ``S_j = C_j - sum_i x_i A_ij`` checked (:func:`check_block`, :func:`check_factor`), each block's
 upper triangle packed into one vector (:class:`PackedLayout`, the layout of
-:mod:`lmi.ipm.kernels`), the variables equilibrated once, and the coefficients kept in the three
-forms the kernels take: packed (``G``), as their non-zero entries (the ``sp_*`` arrays) and in
-factored form ``A_ij = D_j N_ij D_j'`` (the ``dict_*`` and ``fe_*`` arrays, grouped by
-:func:`factor_groups`). :meth:`BlockData.set_block` replaces a block in place; the scaled forms
-are refreshed before the next iteration (``_refresh``), and :data:`DIRECT_MIN_VARIABLES` decides
-whether the Schur complement is formed from the factored coefficients.
+:mod:`lmi.ipm.kernels`), the blocks weighted and the variables equilibrated once, and the
+coefficients kept in the three forms the kernels take: packed (``G``), as their non-zero entries
+(the ``sp_*`` arrays) and in factored form ``A_ij = D_j N_ij D_j'`` (the ``dict_*`` and ``fe_*``
+arrays, grouped by :func:`factor_groups`). :meth:`BlockData.set_block` replaces a block in
+place; the scaled forms are refreshed before the next iteration (``_refresh``), and
+:data:`DIRECT_MIN_VARIABLES` decides whether the Schur complement is formed from the factored
+coefficients.
+
+Equilibration: ``x = D x~`` with every variable's weighted coefficients of unit Frobenius norm
+over all blocks, and, for badly balanced blocks, block weights ``w_j`` (:func:`block_weights`,
+powers of two): the kernels see ``w_j S_j = w_j C_j - sum_i x_i w_j A_ij`` and the dual
+``Z_j / w_j``. Both are fixed at the first solve. The data kept as given (``_const``,
+``_coef``) and the solver's outputs are in the original units.
 """
 
 from __future__ import annotations
@@ -21,8 +28,9 @@ import numpy as np
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = [
-    "DIRECT_MIN_VARIABLES", "BlockData", "BlockFactor", "PackedLayout", "check_block", "check_factor",
-    "concatenate_factors", "concatenate_sparse", "entry_weight", "factor_groups",
+    "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES", "BlockData", "BlockFactor",
+    "PackedLayout", "block_weights", "check_block", "check_factor", "concatenate_factors",
+    "concatenate_sparse", "entry_weight", "factor_groups",
 ]
 
 #: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
@@ -39,6 +47,31 @@ BlockFactor = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 #: direct path). On the 14-state flexible satellite (259 variables, 2 vertices) the direct form
 #: took the warm median from 876 ms to 21 ms (load ~7).
 DIRECT_MIN_VARIABLES = 64
+
+
+#: Block equilibration (:func:`block_weights`): the blocks are weighted only when the balancing
+#: weights span more than this factor. Weighting block ``j`` by ``w_j`` (slack ``w_j S_j``, dual
+#: ``Z_j / w_j``) leaves the central path and the Nesterov-Todd directions as they are; it
+#: changes the start point (every block is shifted into its interior by one multiple of ``I``)
+#: and the norms of the residuals. SDPLIB's control2-4 span 292-403 (the Lyapunov block's
+#: coefficients are about 100 times those of ``P >= I``): unweighted, their first steps are
+#: short (about 9 iterations of tiny steps) and they take 40/45/44 iterations; weighted, the
+#: first steps have length 0.99 and they take 29/32/34. With block 0 of control2-4 scaled down
+#: to spans of 10-30 the weights still saved 6-11 iterations. On Kothare problems, weighted at
+#: any span (measured by forcing it), the effect was mixed and no status changed: paper P (span
+#: 2.1-2.3) 130 -> 126 cold and 125 -> 129 warm-started iterations over 8 random states at 2
+#: vertices, 157 -> 158 and 145 -> 144 at 8; the stress set of 6-14 states
+#: (:mod:`benchmarks.stress`, spans up to 40) 1092 -> 1175 in all, two infeasibility proofs
+#: moving from the main run to phase one; the far states (:mod:`benchmarks.far_states`) 1734 ->
+#: 1616; random 8-16-state problems 358 -> 363. A threshold of 20 changed records of the fault
+#: suite (``rmpc bench faults``, W1-W3, by up to 3e-6 relative through their closed loops). At
+#: 100 no suite record changed (W4's CRMPC problems, span 512, are weighted and kept their
+#: records to 1e-8), paper P is untouched, the far states (whose input blocks, scaled by the
+#: bound at states far out, span up to about 1e4) took 1629 iterations and the stress set 1096 (one
+#: problem weighted, 47 -> 51), every status unchanged.
+BLOCK_WEIGHT_SPREAD = 100.0
+#: Alternating passes (variables, blocks) of the Ruiz-style balancing in :func:`block_weights`.
+BLOCK_WEIGHT_PASSES = 10
 
 
 class PackedLayout:
@@ -85,6 +118,10 @@ class BlockData:
         ``k_j``.
     degree : int
         ``sum_j k_j``.
+    block_weights : ndarray or None
+        The weights ``w_j`` of the blocks as the kernels see them (``w_j C_j``, ``w_j A_ij``;
+        :func:`block_weights`), fixed at the first solve like the variable scaling (``None``
+        before it); later updates of the data keep them.
     """
 
     def __init__(
@@ -93,6 +130,7 @@ class BlockData:
     ) -> None:
         self.n = n
         self._dscale: np.ndarray | None = None
+        self.block_weights: np.ndarray | None = None
         checked = [check_block(j, const, coef, n) for j, (const, coef) in enumerate(blocks)]
         orders = [const.shape[0] for const, _ in checked]
         self.block_orders = orders
@@ -145,6 +183,8 @@ class BlockData:
         rows = self._layout.rows(j)
         iu0, iu1, w = self._layout.triangle(j)
         self._h_vec[rows] = const[iu0, iu1] * w
+        if self.block_weights is not None:
+            self._h_vec[rows] *= self.block_weights[j]
         self._const[j] = const.copy()
         if coef is not None and not np.array_equal(coef, self._coef[j]):
             self._coef[j] = coef.copy()
@@ -163,16 +203,24 @@ class BlockData:
     def _refresh(self) -> None:
         """Variable scaling (once) and the scaled coefficients of the changed blocks."""
         if self._dscale is None:
-            # equilibrate the variables once, x = D x~ with unit-norm scaled coefficients
-            # (later coefficient updates, e.g. a bound scaling, keep D)
-            norms = np.sqrt(sum(np.einsum("ikl,ikl->i", a, a) for a in self._coef))
+            # weight the blocks and equilibrate the variables once, x = D x~ with unit-norm
+            # weighted coefficients (later updates, e.g. a bound scaling, keep both)
+            if self.block_weights is None:
+                self.block_weights = block_weights(self._coef, self._copies())
+            weights = self.block_weights
+            for j, const in enumerate(self._const):
+                rows = self._layout.rows(j)
+                iu0, iu1, w = self._layout.triangle(j)
+                self._h_vec[rows] = const[iu0, iu1] * w * weights[j]
+            norms = np.sqrt(sum(wj * wj * np.einsum("ikl,ikl->i", a, a)
+                                for wj, a in zip(weights, self._coef, strict=True)))
             self._dscale = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
             self._dirty = set(range(len(self.block_orders)))
         if not self._dirty:
             return
         rebuild = not self._sparse
         for j in sorted(self._dirty):
-            scaled = self._coef[j] * self._dscale[:, None, None]  # (n, k, k)
+            scaled = self._coef[j] * (self._dscale * self.block_weights[j])[:, None, None]  # (n, k, k)
             iu0, iu1, w = self._layout.triangle(j)
             upper = scaled[:, iu0, iu1]  # (n, entries), entries in packed order
             self._g_mat[self._layout.rows(j)] = (upper * w).T
@@ -198,6 +246,23 @@ class BlockData:
             self._groups = factor_groups(self._fact_parts, self._factor_raw)
             self._direct = self._direct_is_cheaper()
 
+    def _copies(self) -> list[int]:
+        """Per block, the first block with an equal given factor (itself if none): copies of one
+        block (a Kothare problem's vertex blocks) must get equal weights to stay one group of
+        :func:`factor_groups`."""
+        first: list[int] = []
+        for j, raw in enumerate(self._factor_raw):
+            first.append(j)
+            if raw is None:
+                continue
+            for i in range(j):
+                other = self._factor_raw[i]
+                if (other is not None and first[i] == i and other[0].shape == raw[0].shape
+                        and all(np.array_equal(a, b) for a, b in zip(raw[1:], other[1:], strict=True))):
+                    first[j] = i
+                    break
+        return first
+
     def _factored_part(self, j: int) -> tuple[np.ndarray, ...]:
         """``(D, var, p, q, value)`` of block ``j`` with the variable scaling and the weights of
         :func:`lmi.ipm.kernels.scaling_and_schur_direct`, sorted by variable."""
@@ -208,7 +273,7 @@ class BlockData:
             dmat = np.eye(self.block_orders[j])
         else:
             dmat, var, p, q, val = raw
-            val = val * self._dscale[var]
+            val = val * (self._dscale[var] * self.block_weights[j])
             order = np.argsort(var, kind="stable")
             var, p, q, val = var[order], p[order], q[order], val[order]
         return dmat, var, p, q, val * entry_weight(p, q)
@@ -225,6 +290,52 @@ class BlockData:
             direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
             rows += self._sparse_parts[j][1].shape[0] * size + size * n * n
         return n > DIRECT_MIN_VARIABLES and direct < rows
+
+
+def block_weights(coefs: Sequence[np.ndarray], copies: Sequence[int] | None = None) -> np.ndarray:
+    """Weights ``w_j`` (powers of two, the largest 1) that balance the blocks' coefficients.
+
+    Ruiz-style: :data:`BLOCK_WEIGHT_PASSES` alternating passes divide each variable's column by
+    the square root of its norm over all blocks and each block by the square root of its norm
+    per unit of order (``sqrt(sum_i ||w_j d_i A_ij||_F^2 / k_j)``). Only the block weights are
+    kept (the solver equilibrates the variables itself, on the weighted blocks); they are
+    normalised to a largest weight of 1 and rounded to powers of two, so that weighting and
+    unweighting are exact. All ones unless the weights span more than
+    :data:`BLOCK_WEIGHT_SPREAD`, and for a block without coefficients.
+
+    Parameters
+    ----------
+    coefs : sequence of (n, k_j, k_j) ndarray
+        Each block's coefficients ``A_ij``.
+    copies : sequence of int, optional
+        ``copies[j]`` is the index of the first block that block ``j`` copies (``j`` itself when
+        none): a copy gets that block's weight (the vertex blocks of a Kothare problem, which
+        the kernels sum as a group, :func:`factor_groups`).
+
+    Returns
+    -------
+    (len(coefs),) ndarray
+    """
+    count = len(coefs)
+    orders = np.array([a.shape[1] for a in coefs], dtype=float)
+    sq = np.array([np.einsum("ikl,ikl->i", a, a) for a in coefs])  # (blocks, n)
+    w = np.ones(count)
+    d = np.ones(sq.shape[1])
+    for _ in range(BLOCK_WEIGHT_PASSES):
+        col = np.sqrt(((w * w)[:, None] * sq).sum(axis=0)) * d
+        d = d / np.sqrt(np.where(col > 0.0, col, 1.0))
+        row = np.sqrt(((d * d)[None, :] * sq).sum(axis=1) / orders) * w
+        w = w / np.sqrt(np.where(row > 0.0, row, 1.0))
+    live = sq.sum(axis=1) > 0.0
+    if not np.any(live):
+        return np.ones(count)
+    w = np.where(live, w / float(np.max(w[live])), 1.0)
+    if float(np.max(w[live])) <= BLOCK_WEIGHT_SPREAD * float(np.min(w[live])):
+        return np.ones(count)
+    w = np.exp2(np.round(np.log2(w)))
+    if copies is not None:
+        w = w[np.asarray(copies, dtype=np.int64)]
+    return w
 
 
 def entry_weight(p: np.ndarray, q: np.ndarray) -> np.ndarray:

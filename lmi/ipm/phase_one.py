@@ -1,12 +1,17 @@
 """Phase one of the block LMI solver: a feasible point, or a checked proof of infeasibility.
 
 :func:`run_phase_one` is :meth:`lmi.ipm.BlockLMISolver.phase_one` (which documents the method):
-it solves ``min t`` s.t. ``C_j - sum_i x_i A_ij + t I >= 0`` with an auxiliary solver of the
-same blocks and one more variable (:func:`phase_one_solver`), watching every iterate
-(:class:`PhaseOneCheck`) for a strictly feasible ``x`` or a dual point that, moved onto
-``sum_j <A_ij, Z_j> = 0`` (:func:`dual_correction`), is a Farkas certificate of infeasibility
-(:class:`PhaseOneResult`). It reads the solver's packed data (:class:`lmi.ipm.blocks.BlockData`)
-directly.
+it solves ``min t`` s.t. ``w_j (C_j - sum_i x_i A_ij) + t I >= 0`` (``w_j`` the solver's block
+weights, :func:`lmi.ipm.blocks.block_weights`; 1 unless the blocks are badly balanced) with an
+auxiliary solver of the same blocks and one more variable (:func:`phase_one_solver`), watching
+every iterate (:class:`PhaseOneCheck`) for a strictly feasible ``x`` or a dual point that, moved
+onto ``sum_j <A_ij, Z_j> = 0`` (:func:`dual_correction`), is a Farkas certificate of
+infeasibility (:class:`PhaseOneResult`). It reads the solver's packed data
+(:class:`lmi.ipm.blocks.BlockData`) directly. The auxiliary solver takes the solver's weights,
+so its iterates are in the weighted units of that packed data (its ``t`` has the coefficient
+``-I`` there: with ``-I`` in the original blocks, phase one of SDPLIB's control3 and control4
+took 5 and 6 iterations instead of 3 and 2); the certificate is returned, and its margins are
+measured, in the original blocks (``Z_j = w_j Z~_j``).
 """
 
 from __future__ import annotations
@@ -80,12 +85,13 @@ def run_phase_one(slv: BlockLMISolver) -> PhaseOneResult:
     aux._refresh()
     n, kmax = slv.n, slv._kmax
     orders = slv.block_orders
-    low = min(float(np.linalg.eigvalsh(c)[0]) for c in slv._const)
+    weights = slv.block_weights
+    low = min(float(np.linalg.eigvalsh(c * w)[0]) for c, w in zip(slv._const, weights, strict=True))
     t0 = 1.0 + max(0.0, -low)
     s0 = np.zeros((len(orders), kmax, kmax))
     z0 = np.zeros_like(s0)
     for j, k in enumerate(orders):
-        s0[j, :k, :k] = slv._const[j] + t0 * np.eye(k)
+        s0[j, :k, :k] = slv._const[j] * weights[j] + t0 * np.eye(k)
         z0[j, :k, :k] = np.eye(k) / slv.degree
     x0 = np.zeros(n + 1)
     x0[n] = t0
@@ -97,7 +103,7 @@ def run_phase_one(slv: BlockLMISolver) -> PhaseOneResult:
         # the last chance: the final dual point (at t* = 0 it cannot prove anything)
         zfin = np.zeros_like(z0)
         for j, k in enumerate(orders):
-            zfin[j, :k, :k] = res.Z[j]
+            zfin[j, :k, :k] = res.Z[j] / weights[j]  # back to the weighted units
         if check(res.x / aux._dscale, None, zfin) == "infeasible":
             status, found = "infeasible", check.found
     return PhaseOneResult(
@@ -117,8 +123,10 @@ def phase_one_solver(slv: BlockLMISolver) -> BlockLMISolver:
     blocks, factors = [], []
     for j, k in enumerate(slv.block_orders):
         if fresh or not np.array_equal(aux._coef[j][:n], slv._coef[j]):
-            coef = np.concatenate([slv._coef[j], -np.eye(k)[None]])
-            factor = with_identity(slv._factor_raw[j], n, k)
+            # t's coefficient -I / w_j: -I in the weighted blocks w_j S_j the kernels see
+            unit = 1.0 / slv.block_weights[j]
+            coef = np.concatenate([slv._coef[j], -unit * np.eye(k)[None]])
+            factor = with_identity(slv._factor_raw[j], n, k, unit)
             if fresh:
                 blocks.append((slv._const[j], coef))
                 factors.append(factor)
@@ -133,6 +141,9 @@ def phase_one_solver(slv: BlockLMISolver) -> BlockLMISolver:
             cvec, blocks, tol_feas=PHASE_ONE_TOL, tol_gap_abs=PHASE_ONE_TOL,
             tol_gap_rel=PHASE_ONE_TOL, max_iter=PHASE_ONE_MAX_ITER, infeasibility_radius=np.inf,
             factors=factors)
+        # the weights of slv (fixed before its first refresh): the iterates of aux are then in
+        # the units of slv's packed data, which PhaseOneCheck reads
+        aux.block_weights = slv.block_weights.copy()
     return aux
 
 
@@ -173,10 +184,14 @@ class PhaseOneCheck:
         zc = np.zeros_like(z)
         for j, k in enumerate(slv.block_orders):
             zc[j, :k, :k] = blocks[j]
-        zp = _kernels.pack(zc, *packing)
+        # the certificate in the original blocks (weights are powers of two: exact)
+        weights = slv.block_weights
+        blocks = [zj * wj for zj, wj in zip(blocks, weights, strict=True)]
+        h_orig = np.concatenate([h[lay.rows(j)] / weights[j] for j in range(len(blocks))])
+        zp = _kernels.pack(zc * weights[:, None, None], *packing)
         z_norm = float(np.linalg.norm(zp))
-        objective = float(h @ zp)
-        if not (z_norm > 0.0 and objective <= -PHASE_ONE_MARGIN * float(np.linalg.norm(h)) * z_norm):
+        objective = float(h_orig @ zp)
+        if not (z_norm > 0.0 and objective <= -PHASE_ONE_MARGIN * float(np.linalg.norm(h_orig)) * z_norm):
             return None
         worst = np.inf
         for zj in blocks:
@@ -184,8 +199,10 @@ class PhaseOneCheck:
             worst = min(worst, float(lam[0] / max(float(np.max(np.abs(lam))), 1e-300)))
         if not worst >= 0.0:
             return None
-        # |sum_j <A_ij, Z_j>| relative to ||A_i|| ||Z|| (the equilibrated columns have unit norm)
-        residual = float(np.max(np.abs(slv._g_mat.T @ zp), initial=0.0)) / z_norm
+        # |sum_j <A_ij, Z_j>| relative to ||A_i|| ||Z|| (Frobenius norms over all blocks)
+        a_z = sum(np.einsum("ikl,kl->i", a, zj) for a, zj in zip(slv._coef, blocks, strict=True))
+        a_norm = np.sqrt(sum(np.einsum("ikl,ikl->i", a, a) for a in slv._coef))
+        residual = float(np.max(np.abs(a_z) / np.where(a_norm > 0.0, a_norm, 1.0), initial=0.0)) / z_norm
         self.found = {"Z": blocks, "objective": objective, "residual": residual,
                       "min_eigenvalue": worst, "t": t}
         return "infeasible"
@@ -198,7 +215,9 @@ def dual_correction(slv: BlockLMISolver, z: np.ndarray) -> list[np.ndarray] | No
     ``sum_j <L_j' A_ij L_j, F_j> = -sum_j <A_ij, Z_j>``. The result is positive semidefinite
     exactly when every ``I + F_j`` is (checked); a correction of least Frobenius norm in ``Z``'s
     coordinates instead falls mostly on the directions where ``Z`` is small and made it
-    indefinite (measured). ``None`` when it is not positive definite or ``I + F`` is not."""
+    indefinite (measured). ``Z`` and the result are in the solver's weighted units (``Z_j / w_j``;
+    the correction ``F`` is the same in either). ``None`` when it is not positive definite or
+    ``I + F`` is not."""
     factors, cols = [], []
     for j, k in enumerate(slv.block_orders):
         try:
@@ -206,7 +225,7 @@ def dual_correction(slv: BlockLMISolver, z: np.ndarray) -> list[np.ndarray] | No
         except np.linalg.LinAlgError:
             return None
         factors.append(low)
-        scaled = low.T @ (slv._coef[j] * slv._dscale[:, None, None]) @ low  # (n, k, k)
+        scaled = low.T @ (slv._coef[j] * (slv._dscale * slv.block_weights[j])[:, None, None]) @ low
         iu0, iu1, w = slv._layout.triangle(j)
         cols.append(scaled[:, iu0, iu1] * w)
     p_t = np.concatenate(cols, axis=1)  # (n, size): row i = packed L'A_i L
@@ -226,9 +245,9 @@ def dual_correction(slv: BlockLMISolver, z: np.ndarray) -> list[np.ndarray] | No
     return out
 
 
-def with_identity(raw: BlockFactor | None, n: int, k: int) -> BlockFactor | None:
+def with_identity(raw: BlockFactor | None, n: int, k: int, scale: float = 1.0) -> BlockFactor | None:
     """Block ``j``'s factored coefficients with one more variable (index ``n``) of coefficient
-    ``-I``, or ``None`` if the dictionary lacks an identity column for some row."""
+    ``-scale I``, or ``None`` if the dictionary lacks an identity column for some row."""
     if raw is None:
         return None
     dmat, var, p, q, val = raw
@@ -242,4 +261,4 @@ def with_identity(raw: BlockFactor | None, n: int, k: int) -> BlockFactor | None
         cols.append(int(hit[0]))
     idx = np.asarray(cols, dtype=np.int64)
     return (dmat, np.concatenate([var, np.full(k, n, dtype=np.int64)]), np.concatenate([p, idx]),
-            np.concatenate([q, idx]), np.concatenate([val, -np.ones(k)]))
+            np.concatenate([q, idx]), np.concatenate([val, -scale * np.ones(k)]))
