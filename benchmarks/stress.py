@@ -44,7 +44,7 @@ from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["StressProblem", "make_problem", "stress_set"]
 
-Kind = Literal["feasible", "infeasible"]
+Kind = Literal["feasible", "infeasible", "unknown"]
 #: Relative size of the vertex perturbations of ``A`` (Frobenius, per entry scale) and of ``B``.
 A_SPREAD = 0.01
 B_SPREAD = 0.2
@@ -62,30 +62,34 @@ class StressProblem:
         Vertices ``(N, n, n)`` and ``(N, n, m)``.
     Q1, R : ndarray
         Weights.
-    input_constraint : {"peak", "ellipsoid"}
-    u_max : float or ndarray
+    input_constraint : {"peak", "ellipsoid"} or None
+    u_max : float or ndarray or None
     x : ndarray
         The state.
     dt : float
         Sample time (for the delta formulations).
-    kind : {"feasible", "infeasible"}
-        Known by construction (see the module docstring).
+    kind : {"feasible", "infeasible", "unknown"}
+        Known by construction (see the module docstring); ``"unknown"`` only for the generic
+        problems of :mod:`benchmarks.generic_stress`.
     seed : int
     witness : tuple or None
         For feasible problems ``(gamma, Q, Y)``, a point satisfying every LMI.
+    tag : str
+        Names the problem in :attr:`label` instead of ``kind`` when given.
     """
 
     A: np.ndarray
     B: np.ndarray
     Q1: np.ndarray
     R: np.ndarray
-    input_constraint: str
-    u_max: float | np.ndarray
+    input_constraint: str | None
+    u_max: float | np.ndarray | None
     x: np.ndarray
     dt: float
     kind: Kind
     seed: int
     witness: tuple[float, np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    tag: str = ""
 
     @property
     def n_states(self) -> int:
@@ -98,7 +102,7 @@ class StressProblem:
     @property
     def label(self) -> str:
         """A short name, e.g. ``"n14-v2-feasible-s3"``."""
-        return f"n{self.n_states}-v{self.n_vertices}-{self.kind}-s{self.seed}"
+        return f"n{self.n_states}-v{self.n_vertices}-{self.tag or self.kind}-s{self.seed}"
 
     def kothare_kwargs(self) -> dict:
         """Keyword arguments of :class:`lmi.KothareProblem` (besides the back-end)."""
@@ -118,17 +122,13 @@ def _vertices(rng: np.random.Generator, a0: np.ndarray, b0: np.ndarray,
     return np.array(a), np.array(b)
 
 
-def _feasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: str):
-    """One draw of a feasible problem with its witness, or None if the draw is rejected."""
-    ac = rng.normal(size=(n, n)) / np.sqrt(n)
-    ac -= (np.max(np.linalg.eigvals(ac).real) + rng.uniform(-0.2, 0.3)) * np.eye(n)
-    a0 = expm(SAMPLE_TIME * ac)
-    b0 = SAMPLE_TIME * rng.normal(size=(n, m))
-    a, b = _vertices(rng, a0, b0, count)
-    q1 = np.diag(10.0 ** rng.uniform(-1.0, 1.0, size=n))
-    r = np.eye(m)
+def lqr_contraction(a: np.ndarray, b: np.ndarray, q1: np.ndarray,
+                    r: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(c P, F)``: the LQR gain ``F`` and Riccati matrix ``P`` of the vertex-mean model (state
+    weight ``b Q1``, ``b`` the first of 1, 10, 100 that works) with the smallest ``c`` in ``1, 2,
+    4, ..., 64`` for which every vertex's closed loop satisfies ``Acl_j' (c P) Acl_j - c P + Q1 +
+    F'RF <= 0``; ``None`` if there is none (or the Riccati equation has no solution)."""
     am, bm = a.mean(axis=0), b.mean(axis=0)
-    found = None
     for boost in (1.0, 10.0, 100.0):  # a more aggressive gain contracts more robustly
         try:
             p = solve_discrete_are(am, bm, boost * q1, r)
@@ -141,23 +141,44 @@ def _feasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: 
             worst = max(float(np.linalg.eigvalsh((aj + bj @ f).T @ pc @ (aj + bj @ f) - pc + stage)[-1])
                         for aj, bj in zip(a, b, strict=True))
             if worst < 0.0:
-                found = pc, f
-                break
-        if found is not None:
-            break
-    if found is None:
-        return None
-    pc, f = found
-    x = rng.normal(size=n)
-    x /= np.linalg.norm(x)
+                return pc, f
+    return None
+
+
+def lqr_witness(pc: np.ndarray, f: np.ndarray, x: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """The witness ``(gamma, Q, Y)`` of :func:`lqr_contraction`'s ``(c P, F)`` at the state ``x``:
+    ``Q = gamma (c P)^-1``, ``Y = F Q`` with ``gamma`` such that ``x`` lies on the boundary of the
+    ellipsoid scaled by 0.9 (``x' Q^-1 x = 0.9``)."""
     gamma = float(x @ pc @ x) / 0.9
     q = gamma * np.linalg.inv(pc)
-    y = f @ q
-    peak = np.sqrt(np.diag(y @ np.linalg.solve(q, y.T)))
+    return gamma, q, f @ q
+
+
+def witness_bound(constraint: str, q: np.ndarray, y: np.ndarray) -> float | np.ndarray:
+    """The input bound the witness ``(Q, Y)`` needs: per input ``sqrt((Y Q^-1 Y')_jj)`` (peak) or
+    ``sqrt(lambda_max(Y Q^-1 Y'))`` (ellipsoid)."""
+    yqy = y @ np.linalg.solve(q, y.T)
     if constraint == "peak":
-        u_max = 1.1 * peak
-    else:
-        u_max = 1.1 * float(np.sqrt(np.linalg.eigvalsh(y @ np.linalg.solve(q, y.T))[-1]))
+        return np.sqrt(np.diag(yqy))
+    return float(np.sqrt(np.linalg.eigvalsh(yqy)[-1]))
+
+
+def _feasible(rng: np.random.Generator, n: int, m: int, count: int, constraint: str):
+    """One draw of a feasible problem with its witness, or None if the draw is rejected."""
+    ac = rng.normal(size=(n, n)) / np.sqrt(n)
+    ac -= (np.max(np.linalg.eigvals(ac).real) + rng.uniform(-0.2, 0.3)) * np.eye(n)
+    a0 = expm(SAMPLE_TIME * ac)
+    b0 = SAMPLE_TIME * rng.normal(size=(n, m))
+    a, b = _vertices(rng, a0, b0, count)
+    q1 = np.diag(10.0 ** rng.uniform(-1.0, 1.0, size=n))
+    r = np.eye(m)
+    found = lqr_contraction(a, b, q1, r)
+    if found is None:
+        return None
+    x = rng.normal(size=n)
+    x /= np.linalg.norm(x)
+    gamma, q, y = lqr_witness(*found, x)
+    u_max = 1.1 * witness_bound(constraint, q, y)
     return a, b, q1, r, u_max, x, (gamma, q, y)
 
 

@@ -78,13 +78,21 @@ def state_scaling(data: KothareData) -> np.ndarray:
 
 
 def scale_data(data: KothareData, t: np.ndarray) -> KothareData:
-    """The problem in the coordinates ``x~ = T^-1 x``, ``T = diag(t)`` (see the module docstring)."""
-    a = data.A * (1.0 / t)[None, :, None] * t[None, None, :]
-    b = data.B * (1.0 / t)[None, :, None]
-    q1 = data.Q1 * np.outer(t, t)
+    """The problem in the coordinates ``x~ = T^-1 x``, ``T = diag(t)`` for ``t`` of shape ``(n,)``
+    or ``T = t`` of shape ``(n, n)`` (invertible; see the module docstring)."""
+    if t.ndim == 2:
+        t_inv = np.linalg.inv(t)
+        a = t_inv[None] @ data.A @ t[None]
+        b = t_inv[None] @ data.B
+        q1 = t.T @ data.Q1 @ t
+        c_out = None if data.C_out is None else data.C_out @ t
+    else:
+        a = data.A * (1.0 / t)[None, :, None] * t[None, None, :]
+        b = data.B * (1.0 / t)[None, :, None]
+        q1 = data.Q1 * np.outer(t, t)
+        c_out = None if data.C_out is None else data.C_out * t[None, :]
     u_max = None if data.input_constraint is None else (
         float(data.u_max[0]) if data.input_constraint == "ellipsoid" else data.u_max)
-    c_out = None if data.C_out is None else data.C_out * t[None, :]
     return build_kothare_data(
         a, b, 0.5 * (q1 + q1.T), data.R, dt=data.dt, input_constraint=data.input_constraint,
         u_max=u_max, output_matrix=c_out, y_max=None if c_out is None else data.y_max,

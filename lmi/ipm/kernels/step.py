@@ -63,21 +63,34 @@ def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_va
 
 
 @njit(**JIT)
-def _triangular_solve(r_fac, b):
-    """``x`` with ``R'R x = b`` for upper triangular ``R``."""
+def _forward(r_fac, b):
+    """``y`` with ``R' y = b`` for upper triangular ``R``."""
     n = b.shape[0]
     y = b.copy()
-    for i in range(n):  # R' y = b (forward), by rows of R: the subtractions of a row-by-column
-        y[i] = y[i] / r_fac[i, i]  # loop in the same order (p ascending), contiguous reads
+    for i in range(n):  # by rows of R: the subtractions of a row-by-column loop in the same
+        y[i] = y[i] / r_fac[i, i]  # order (p ascending), contiguous reads
         for p in range(i + 1, n):
             y[p] -= r_fac[i, p] * y[i]
+    return y
+
+
+@njit(**JIT)
+def _backward(r_fac, b):
+    """``x`` with ``R x = b`` for upper triangular ``R``."""
+    n = b.shape[0]
     x = np.empty(n)
-    for i in range(n - 1, -1, -1):  # R x = y (backward)
-        s = y[i]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
         for p in range(i + 1, n):
             s -= r_fac[i, p] * x[p]
         x[i] = s / r_fac[i, i]
     return x
+
+
+@njit(**JIT)
+def _triangular_solve(r_fac, b):
+    """``x`` with ``R'R x = b`` for upper triangular ``R``."""
+    return _backward(r_fac, _forward(r_fac, b))
 
 
 @njit(**JIT)
@@ -106,6 +119,68 @@ def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_
         if new_norm >= err_norm:
             break
         dx, dzt, err, err_norm = dx + ddx, dzt_new, err_new, new_norm
+    return dx, u - dzt, dzt
+
+
+@njit(**JIT)
+def _householder(qr_h, qr_tau, y, transpose):
+    """``Q' y`` (``transpose``) or ``Q y`` in place, ``Q = H_0 ... H_{n-1}`` the orthogonal factor
+    of ``P`` as LAPACK's ``geqrf`` leaves it (numpy's ``qr(mode="raw")``): reflector ``k`` is
+    ``H_k = I - tau_k v_k v_k'`` with ``v_k[k] = 1`` and ``v_k[k + 1:] = qr_h[k, k + 1:]``."""
+    n, m = qr_h.shape
+    for step in range(n):
+        k = step if transpose else n - 1 - step
+        s = y[k]
+        for t in range(k + 1, m):
+            s += qr_h[k, t] * y[t]
+        s *= qr_tau[k]
+        y[k] -= s
+        for t in range(k + 1, m):
+            y[t] -= s * qr_h[k, t]
+
+
+@njit(**JIT)
+def _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale):
+    """:func:`_newton` with the orthogonal factor of ``P = Q [R; 0]`` (the QR phase, ``P`` formed).
+
+    The equations ``P' dz~ = -r_d``, ``dz~ = P dx + v`` (``v = u + r~_p``) are solved as a
+    projection: with ``t = Q' v`` and ``R' w = r_d``, ``dz~ = Q [-w; t_2]`` (``t_2`` the rows of
+    ``t`` below ``n``) and ``R dx = -(w + t_1)``. Then ``P' dz~ + r_d`` is of the order of the
+    rounding of ``P`` and ``v``. Through the normal equations (``R'R dx = -r_d - P' v``, as
+    :func:`_newton` does) it is of the order ``eps ||P||^2 ||dx||``, which refinement cannot
+    reduce once ``eps cond(P)^2 > 1``: measured on a 12-state unstable Kothare problem, it grew
+    to 40 times ``||r_d||`` over the last iterations and the dual residual with it, from 3e-8 to
+    1 (see :mod:`benchmarks.generic_stress`). One refinement step on ``P' dz~ = -r_d`` (with the
+    formed ``P``) follows while it shrinks the residual.
+    """
+    n, m = qr_h.shape
+    v = u + rpt
+    w = _forward(r_fac, rd)
+    t = v.copy()
+    _householder(qr_h, qr_tau, t, True)
+    dx = _backward(r_fac, -(w + t[:n]))
+    y = t.copy()
+    for i in range(n):
+        y[i] = -w[i]
+    _householder(qr_h, qr_tau, y, False)
+    dzt = y
+    err = pt @ dzt + rd
+    err_norm = np.linalg.norm(err)
+    for _ in range(REFINE_STEPS):
+        if err_norm <= 1e-14 * ref_scale:
+            break
+        corr = np.zeros(m)
+        cw = _forward(r_fac, err)
+        for i in range(n):
+            corr[i] = cw[i]
+        _householder(qr_h, qr_tau, corr, False)
+        dzt_new = dzt - corr
+        err_new = pt @ dzt_new + rd
+        new_norm = np.linalg.norm(err_new)
+        if new_norm >= err_norm:
+            break
+        dx = dx - _backward(r_fac, cw)
+        dzt, err, err_norm = dzt_new, err_new, new_norm
     return dx, u - dzt, dzt
 
 
@@ -229,15 +304,24 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
 
 
 @njit(**JIT)
-def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
-                orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
-                pair_row, pair_col, s_out, z_out, chol_out):
+def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
+                ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+                pair_off, pair_row, pair_col, s_out, z_out, chol_out):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
 
     The new ``S`` is recomputed from ``x`` as ``h - G x + theta r0`` (``theta`` decays by
     ``1 - alpha``), so the primal residual decays exactly; its Cholesky factors go to
     ``chol_out`` (reused by the next scaling). If rounding leaves that ``S`` not positive
-    definite, the step is shortened (at most five times by 0.8).
+    definite, the step is shortened (at most five times by 0.8). The new ``Z`` is
+    ``Z + alpha K' dz~ K`` (``z``, the current dual blocks), so the dual residual decays by
+    ``1 - alpha`` up to the rounding of the step; formed through the scaling,
+    ``K'(lambda + alpha dz~) K``, each iterate was rounded afresh with ``K``, whose condition
+    number reaches 1e8 near the optimum of badly scaled problems (measured on a 12-state unstable
+    Kothare problem: the dual residual then grew from 2e-8 to 1e-5 over the last 8 iterations
+    instead of decaying). If rounding leaves ``Z + alpha dZ`` not positive definite (checked by
+    Cholesky), that block is formed through the scaling, positive definite by the step length.
+    In the QR phase (``qr_h``, ``qr_tau``: the Householder factors of ``P``, else empty) the
+    Newton equations are solved by :func:`_newton_qr`, otherwise by :func:`_newton`.
 
     ``pt`` is ``P'`` (``n x size``) when it was formed (QR phase), or ``n x 0`` when only ``H``
     was (:func:`scaling_and_schur_direct`); then the products with ``P`` come from the sparse
@@ -263,8 +347,11 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
         for a in range(k):
             u[diagonal_entry(offsets, j, k, a)] = -lam[j, a]
     sp = (sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)
-    _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col,
-                            ent_w, sp)
+    if qr_h.shape[0] > 0:
+        _dx, dsa, dza = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale)
+    else:
+        _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row,
+                                ent_col, ent_w, sp)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
     sigma = (1.0 - alpha_aff) ** 3
     # corrector: u = lambda^{o-1}(sigma mu e - lambda o lambda - ds_a o dz_a)
@@ -281,11 +368,15 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
             for b in range(k):
                 rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
         pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
-    dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
-                           ent_col, ent_w, sp)
+    if qr_h.shape[0] > 0:
+        dx, dst, dzt = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u_cor, ref_scale)
+    else:
+        dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
+                               ent_col, ent_w, sp)
     alpha = min(1.0, 0.99 * _max_step(lam, dst, dzt, orders, offsets, ent_row, ent_col, ent_w))
     if not (np.isfinite(alpha) and alpha > 1e-12):
         return 1, x, theta, alpha_aff, sigma, alpha
+    scratch = np.empty((z.shape[1], z.shape[2]))
     for _ in range(6):
         x_new = x + alpha * dx
         theta_new = theta * (1.0 - alpha)
@@ -303,10 +394,15 @@ def newton_step(pt, r_fac, kk, lam, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_
         for j in range(nb):
             k = orders[j]
             kj = np.ascontiguousarray(kk[j, :k, :k])
-            lz = alpha * unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w)
-            for a in range(k):
-                lz[a, a] += lam[j, a]
-            zn = kj.T @ lz @ kj
-            z_out[j, :k, :k] = 0.5 * (zn + zn.T)
+            dz = kj.T @ unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w) @ kj
+            z_out[j, :k, :k] = z[j, :k, :k] + (0.5 * alpha) * (dz + dz.T)
+            if not cholesky_into(z_out[j], k, scratch):
+                # rounding left Z + alpha dZ not positive definite: the same point through the
+                # scaling, K'(lambda + alpha dz~)K, positive definite by the step length
+                lz = alpha * unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w)
+                for a in range(k):
+                    lz[a, a] += lam[j, a]
+                zn = kj.T @ lz @ kj
+                z_out[j, :k, :k] = 0.5 * (zn + zn.T)
         return 0, x_new, theta_new, alpha_aff, sigma, alpha
     return 2, x, theta, alpha_aff, sigma, alpha
