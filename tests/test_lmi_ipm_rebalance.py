@@ -7,8 +7,8 @@ weights ``400`` on the hub angle and rate and ``0.1`` on the mode, peak bound 0.
 initial angle at rest. The input bound squeezes the optimal ellipsoid along the modal
 coordinates, which the nominal Riccati diagonal (:mod:`lmi.scaling`) does not predict: the
 balanced coordinates leave ``Q~``'s diagonal spanning about three decades. The IPM crawled
-(relative gap rising while the residuals fell) until its stall test, which then fired when the
-worst of the residuals and gap had not halved over the window, stopped it
+until its stall test, which then fired when the worst of the residuals and gap had not halved
+over the window, stopped it
 ("insufficient_progress" after 29 iterations), and the retry balanced on that run's ``Q~`` ended
 "optimal". The stall test now fires only when none of them has halved
 (:data:`lmi.ipm.solver.STALL_WINDOW`), and the run converges without the retry.

@@ -325,12 +325,14 @@ class IPMKothare(KothareBackend):
         the optimum's shape) and the condition number of ``Q~`` exceeds
         :data:`lmi.scaling.MIN_SPREAD`.
 
-        The full factor, not only the diagonal: on two 30-state problems of the generic stress
-        set (:mod:`benchmarks.generic_stress`; ``Q`` with eigenvalues from 0.03 to 1e5) the run
-        and a retry balanced on the diagonal ended "inaccurate" (``S`` and ``Z`` spanning 17
-        decades near the optimum, the relative gap stuck at 3e-8); in the coordinates of ``L``
-        the retry ended "optimal" after 22 more iterations, gamma within 4e-9 of the failed
-        run's.
+        The full factor, not only the diagonal: on the generic stress set's
+        ``n30-v2-generic-none-s1`` (:mod:`benchmarks.generic_stress`) the run ended "inaccurate"
+        after 52 iterations, ``S`` and ``Z`` spanning 17 decades near the optimum (block
+        eigenvalues from 3e-12 to 7e5 and from 3e-14 to 1e4) and the relative gap stuck at
+        1.5e-8; its ``Q`` had eigenvalues from 0.035 to 7.9e4 but a diagonal within a factor 4,
+        which the diagonal rule left as it was. In the coordinates of ``L`` the retry ended
+        "optimal" after 35 more iterations, gamma within 3e-9 of the failed run's; so did
+        ``n30-v2-feasible-ellipsoid-s1``.
         """
         if raw.Q is None or self._last_residual > REBALANCE_MAX_RESIDUAL:
             return None
