@@ -48,8 +48,8 @@ from scipy.linalg import expm
 from benchmarks.stress import SAMPLE_TIME, StressProblem, lqr_contraction, lqr_witness, witness_bound
 from toolkit_common.errors import InvalidArgumentError
 
-__all__ = ["GENERIC_BOUNDS", "GENERIC_KINDS", "GENERIC_SIZES", "format_generic", "generic_problem",
-           "generic_set", "run_generic"]
+__all__ = ["GENERIC_BOUNDS", "GENERIC_KINDS", "GENERIC_SIZES", "REFERENCES", "format_generic",
+           "generic_problem", "generic_set", "merge_records", "run_generic"]
 
 #: The sizes of the set (states).
 GENERIC_SIZES = (8, 12, 16, 20, 24, 30)
@@ -191,18 +191,23 @@ def has_witness(n: int, n_vertices: int, seed: int) -> bool:
 
 
 # -- the benchmark ---------------------------------------------------------------------------------
-def run_generic(problems: Sequence[StressProblem], reference: bool = True) -> list[dict]:
-    """Solve every problem with the IPM alone (fallback off, cold) and, if ``reference``, with cvxpy
-    + Clarabel on the textbook LMIs; one record per problem."""
+#: The references: cvxpy + Clarabel on Kothare's textbook LMIs (eq. (14), ``"standard"``) and on
+#: the toolkit's default form (``"delta_shared"``), each a key of the records.
+REFERENCES = {"cvxpy": "standard", "cvxpy_shared": "delta_shared"}
+
+
+def run_generic(problems: Sequence[StressProblem], references: Sequence[str] = tuple(REFERENCES),
+                ipm: bool = True) -> list[dict]:
+    """Solve every problem with the IPM alone (fallback off, cold), if ``ipm``, and with cvxpy +
+    Clarabel in the forms ``references`` (keys of :data:`REFERENCES`); one record per problem."""
     import time
     import warnings
 
     from lmi import KothareProblem
 
-    paths = [("ipm", {"backend": "ipm", "solver_options": {"fallback": False}})]
-    if reference:
-        paths.append(("cvxpy", {"backend": "cvxpy", "solver": "CLARABEL", "formulation": "standard"}))
-        paths.append(("cvxpy_shared", {"backend": "cvxpy", "solver": "CLARABEL"}))
+    paths = [("ipm", {"backend": "ipm", "solver_options": {"fallback": False}})] if ipm else []
+    for name in references:
+        paths.append((name, {"backend": "cvxpy", "solver": "CLARABEL", "formulation": REFERENCES[name]}))
     out = []
     for prob in problems:
         rec: dict = {"label": prob.label, "kind": prob.kind, "n_states": prob.n_states,
@@ -223,37 +228,60 @@ def run_generic(problems: Sequence[StressProblem], reference: bool = True) -> li
                 "contradiction": (sol.status == "optimal" and prob.kind == "infeasible") or (
                     sol.status == "infeasible" and prob.kind == "feasible"),
             }
-        for name in ("cvxpy", "cvxpy_shared") if reference else ():
-            ipm, ref = rec["ipm"], rec[name]
-            both = ipm["status"] == "optimal" and ref["status"] in ("optimal", "inaccurate")
-            rec[f"rel_diff_gamma_{name}"] = abs(ipm["gamma"] / ref["gamma"] - 1.0) if both else None
+        out.append(rec)
+    return out
+
+
+def merge_records(*runs: Sequence[dict]) -> list[dict]:
+    """Records of several runs of the same problems (e.g. the IPM and the references run apart),
+    merged by label in the order of the first run, with each reference's relative difference in
+    gamma to the IPM's (when the IPM is optimal and the reference optimal or inaccurate)."""
+    merged: dict[str, dict] = {}
+    for run in runs:
+        for rec in run:
+            merged.setdefault(rec["label"], {}).update(rec)
+    out = []
+    for rec in merged.values():
+        for name in REFERENCES:
+            if "ipm" in rec and name in rec:
+                ipm, ref = rec["ipm"], rec[name]
+                both = ipm["status"] == "optimal" and ref["status"] in ("optimal", "inaccurate")
+                rec[f"rel_diff_gamma_{name}"] = abs(ipm["gamma"] / ref["gamma"] - 1.0) if both else None
         out.append(rec)
     return out
 
 
 def format_generic(records: Sequence[dict]) -> str:
-    """A Markdown table, one row per problem."""
-    ref = any("cvxpy" in r for r in records)
+    """A Markdown table, one row per problem (records of :func:`merge_records`; a missing path
+    reads "-")."""
+    refs = [name for name in REFERENCES if any(name in r for r in records)]
     head = "| problem | known | IPM status | gamma | iterations | IPM s | margin / radius |"
     rule = "| --- | --- | --- | --- | --- | --- | --- |"
-    if ref:
-        head += (" textbook: cvxpy + Clarabel | gamma | s | rel diff gamma "
-                 "| delta_shared: cvxpy + Clarabel | gamma | s | rel diff gamma |")
-        rule += " --- | --- | --- | --- | --- | --- | --- | --- |"
+    for name in refs:
+        form = "textbook" if REFERENCES[name] == "standard" else REFERENCES[name]
+        head += f" {form}: cvxpy + Clarabel | gamma | s | rel diff gamma |"
+        rule += " --- | --- | --- | --- |"
     lines = ["IPM: fallback off, one cold solve (s: the solve, not the build). cvxpy + Clarabel at its "
              "default tolerances (1e-8) on the textbook LMIs (Kothare's eq. (14)) and on the toolkit's "
              "default form (delta_shared); s: the first solve, cvxpy's canonicalisation included. Every "
              "back-end solves at the state scaled to unit norm. rel diff gamma: to the IPM's, when the IPM "
              "is optimal and Clarabel optimal or inaccurate.", "", head, rule]
     for r in records:
-        ipm = r["ipm"]
-        proof = ipm["radius"] if ipm["status"] == "infeasible" else ipm["worst_margin"]
-        cells = [r["label"], r["kind"], ipm["status"] + (" (!)" if ipm["contradiction"] else ""),
-                 f"{ipm['gamma']:.8g}", str(ipm["iterations"]), f"{ipm['time_s']:.2f}",
-                 "n/a" if proof is None else f"{proof:.1e}"]
-        for name in ("cvxpy", "cvxpy_shared") if ref else ():
+        cells = [r["label"], r["kind"]]
+        if "ipm" in r:
+            ipm = r["ipm"]
+            proof = ipm["radius"] if ipm["status"] == "infeasible" else ipm["worst_margin"]
+            cells += [ipm["status"] + (" (!)" if ipm["contradiction"] else ""), f"{ipm['gamma']:.8g}",
+                      str(ipm["iterations"]), f"{ipm['time_s']:.2f}",
+                      "n/a" if proof is None else f"{proof:.1e}"]
+        else:
+            cells += ["-"] * 5
+        for name in refs:
+            if name not in r:
+                cells += ["-"] * 4
+                continue
             c = r[name]
-            diff = r[f"rel_diff_gamma_{name}"]
+            diff = r.get(f"rel_diff_gamma_{name}")
             cells += [c["status"] + (" (!)" if c["contradiction"] else ""), f"{c['gamma']:.8g}",
                       f"{c['time_s']:.2f}", "n/a" if diff is None else f"{diff:.1e}"]
         lines.append("| " + " | ".join(cells) + " |")
@@ -263,16 +291,21 @@ def format_generic(records: Sequence[dict]) -> str:
     return "\n".join(lines)
 
 
-def _warm_up() -> None:
-    """One untimed solve of each kind of path: the first call of a process loads the IPM's kernels
-    (and, after an install, compiles them) and imports cvxpy."""
+def _warm_up(references: Sequence[str]) -> None:
+    """One untimed solve of each path: the first call of a process loads the IPM's kernels (and,
+    after an install, compiles them) and imports cvxpy."""
     run_generic([generic_problem(8, 2, "peak", 0, "infeasible"), generic_problem(8, 2, None, 0)],
-                reference=False)
+                references=references[:1])
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m benchmarks.generic_stress [--sizes ...] [--vertices 2 8] [--seeds 0 1]
-    [--no-reference] [--out FILE]``."""
+    [--references cvxpy cvxpy_shared | --references] [--no-ipm] [--merge FILE ...] [--out FILE]``.
+
+    ``--references`` with no name runs the IPM only; ``--no-ipm`` the references only;
+    ``--merge`` prints the table of earlier ``--out`` files (records merged by problem) and
+    solves nothing.
+    """
     import argparse
     import json
     import os
@@ -281,17 +314,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--sizes", nargs="+", type=int, default=list(GENERIC_SIZES))
     parser.add_argument("--vertices", nargs="+", type=int, default=[2, 8])
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1])
-    parser.add_argument("--no-reference", action="store_true", help="the IPM only")
+    parser.add_argument("--references", nargs="*", choices=sorted(REFERENCES), default=list(REFERENCES))
+    parser.add_argument("--no-ipm", action="store_true", help="the references only")
+    parser.add_argument("--merge", nargs="+", metavar="FILE", help="print the table of these record files")
     parser.add_argument("--out", help="write the records as JSON to this file")
     args = parser.parse_args(argv)
-    _warm_up()
-    records = []
+    if args.merge:
+        runs = []
+        for name in args.merge:
+            with open(name, encoding="utf-8") as fh:
+                runs.append(json.load(fh))
+        print(format_generic(merge_records(*runs)))
+        return 0
+    _warm_up(args.references)
+    records: list[dict] = []
     for prob in generic_set(args.sizes, args.vertices, args.seeds):
-        records += run_generic([prob], reference=not args.no_reference)
+        records += run_generic([prob], references=args.references, ipm=not args.no_ipm)
         if args.out:  # written as it goes: the large problems take minutes
             with open(args.out, "w", encoding="utf-8") as fh:
                 json.dump(records, fh, indent=2)
-    print(format_generic(records))
+    print(format_generic(merge_records(records)))
     print(f"load average {os.getloadavg()}")
     return 0
 

@@ -25,9 +25,11 @@ import pytest
 
 from benchmarks.generic_stress import (
     WITNESS_SHARE,
+    format_generic,
     generic_problem,
     generic_set,
     has_witness,
+    merge_records,
     slab_reach,
     unstable_mode,
 )
@@ -181,3 +183,25 @@ def test_ipm_gamma_agrees_with_cvxpy_clarabel(spec):
         ref = KothareProblem(**prob.kothare_kwargs(), backend="cvxpy", solver="CLARABEL").solve(prob.x)
     assert ipm.status == "optimal" and ref.status == "optimal"
     assert ipm.gamma == pytest.approx(ref.gamma, rel=REFERENCE_RTOL)
+
+
+def test_records_run_apart_merge_into_one_table():
+    """The IPM's and the references' records of the same problem (run apart) merge by label, with
+    each reference's relative difference in gamma to an optimal IPM answer; a missing path reads
+    "-" in the table."""
+    def path(status, gamma):
+        return {"status": status, "gamma": gamma, "iterations": 20, "time_s": 0.1, "worst_margin": 0.0,
+                "radius": None, "contradiction": False}
+
+    base = {"kind": "feasible", "n_states": 8, "vertices": 2, "bound": None, "state_norm": 1.0}
+    ipm = [{"label": "a", **base, "ipm": path("optimal", 2.0)},
+           {"label": "b", **base, "ipm": path("optimal", 3.0)}]
+    refs = [{"label": "a", **base, "cvxpy": path("inaccurate", 2.002),
+             "cvxpy_shared": path("solver_error", np.nan)}]
+    merged = merge_records(ipm, refs)
+    assert [r["label"] for r in merged] == ["a", "b"]
+    assert merged[0]["rel_diff_gamma_cvxpy"] == pytest.approx(1.0 - 2.0 / 2.002, rel=1e-12)
+    assert merged[0]["rel_diff_gamma_cvxpy_shared"] is None and "rel_diff_gamma_cvxpy" not in merged[1]
+    table = format_generic(merged)
+    row_b = next(line for line in table.splitlines() if line.startswith("| b |"))
+    assert row_b.count("| - ") == 8  # two references, four cells each

@@ -265,7 +265,7 @@ class IPMKothare(KothareBackend):
             return self._unscale(raw, norm)
         if raw.status == INFEASIBLE:
             return dataclasses.replace(raw, solver_status=f"ipm {raw.solver_status}")
-        t_new = self._rebalanced_scaling(raw) if self._rebalance else None
+        t_new = self._rebalanced_scaling(raw, xs) if self._rebalance else None
         if t_new is not None:
             start = time.perf_counter()
             self._build(t_new)
@@ -303,22 +303,29 @@ class IPMKothare(KothareBackend):
         norm = float(np.linalg.norm(xs))
         return xs / norm, u_max / norm, y_max / norm, norm
 
-    def _rebalanced_scaling(self, raw: RawResult) -> np.ndarray | None:
-        """Coordinates balanced on the failed solve ``raw`` (``None``: nothing to gain).
+    def _rebalanced_scaling(self, raw: RawResult, xs: np.ndarray) -> np.ndarray | None:
+        """Coordinates balanced on the failed solve ``raw`` at the normalised state ``xs``
+        (``None``: nothing to gain).
 
-        ``T L / sqrt(max_k Q~_kk)`` with ``L`` the Cholesky factor of its last ``Q~ = L L'`` (the
-        current coordinates ``x~ = T^-1 x``): in the new coordinates that ``Q~`` is a multiple of
-        the identity, at the level of its largest diagonal entry (for a diagonal ``Q~`` this is
-        ``t_i sqrt(Q~_ii / max_k Q~_kk)``, no coordinate enlarged). Only if that run came within
-        :data:`REBALANCE_MAX_RESIDUAL` of feasibility (its ``Q~`` then has about the optimum's
-        shape) and the condition number of ``Q~`` exceeds :data:`lmi.scaling.MIN_SPREAD`.
+        ``T L ||L^-1 xs||`` with ``L`` the Cholesky factor of its last ``Q~ = L L'`` (the current
+        coordinates ``x~ = T^-1 x``): in the new coordinates that ``Q~`` is a multiple of the
+        identity, and the state keeps its length (``||L^-1 xs|| / ||L^-1 xs|| = 1``), so the
+        objective the solver sees, gamma at the normalised state, keeps its size. (Scaled to the
+        level of ``Q~``'s largest diagonal entry instead, the objective fell to 4e-6 on a fault
+        scenario's states, where the absolute gap tolerance of 1e-12 then decided termination at
+        a relative gap of 1e-6, and 5 of 1500 answers failed their certificate.) Only if that
+        run came within :data:`REBALANCE_MAX_RESIDUAL` of feasibility (its ``Q~`` then has about
+        the optimum's shape) and the condition number of ``Q~`` exceeds
+        :data:`lmi.scaling.MIN_SPREAD`.
 
-        The full factor, not only the diagonal: on two 30-state problems of the generic stress
-        set (:mod:`benchmarks.generic_stress`; ``Q`` with eigenvalues from 0.03 to 1e5) the run
-        and a retry balanced on the diagonal ended "inaccurate" (``S`` and ``Z`` spanning 17
-        decades near the optimum, the relative gap stuck at 3e-8); in the coordinates of ``L``
-        the retry ended "optimal" after 22 more iterations, gamma within 4e-9 of the failed
-        run's.
+        The full factor, not only the diagonal: on the generic stress set's
+        ``n30-v2-generic-none-s1`` (:mod:`benchmarks.generic_stress`) the run ended "inaccurate"
+        after 52 iterations, ``S`` and ``Z`` spanning 17 decades near the optimum (block
+        eigenvalues from 3e-12 to 7e5 and from 3e-14 to 1e4) and the relative gap stuck at
+        1.5e-8; its ``Q`` had eigenvalues from 0.035 to 7.9e4 but a diagonal within a factor 4,
+        which the diagonal rule left as it was. In the coordinates of ``L`` the retry ended
+        "optimal" after 35 more iterations, gamma within 3e-9 of the failed run's; so did
+        ``n30-v2-feasible-ellipsoid-s1``.
         """
         if raw.Q is None or self._last_residual > REBALANCE_MAX_RESIDUAL:
             return None
@@ -328,7 +335,8 @@ class IPMKothare(KothareBackend):
         lam = np.linalg.eigvalsh(q_mat)
         if not (lam[0] > 0.0 and lam[-1] > MIN_SPREAD * lam[0]):
             return None
-        step = np.linalg.cholesky(q_mat) / np.sqrt(float(np.max(np.diag(q_mat))))
+        low = np.linalg.cholesky(q_mat)
+        step = low * float(np.linalg.norm(np.linalg.solve(low, xs)))
         return self._t[:, None] * step if self._t.ndim == 1 else self._t @ step
 
     def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
