@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from benchmarks.core.runner import simulate_scenario
+from benchmarks.core.scenario import Scenario
 from benchmarks.families.mrp.family import LATE_WINDOW_START, chattering, late_window_start
 from benchmarks.suites import mrp_claims
 from benchmarks.suites.mrp import SHORT_TIME_SCALE, mrp_cases, paper_m_comparison
@@ -127,3 +128,21 @@ def test_each_verdict_flips_with_its_number():
     assert claims["R3"].verdict == "partly reproduced"
     assert claims["R4"].verdict == "partly reproduced" and "grew" in claims["R4"].why
     assert [c.verdict for c in assess_paper_m([])] == ["not run"] * 4
+
+
+def test_the_estimate_error_is_measured_from_20_s_on_a_run_longer_than_40_s():
+    """TF-AB on M2 for 60 s: the steady window is [30, 60] s, the late window [20, 60] s. TF-AB's
+    estimate error peaks once per half period of the disk's speed; the peak near 27 s is the
+    largest (6.2029e-3 N m against 6.2017e-3 after 30 s), so the two windows differ."""
+    sc = Scenario.from_dict({"family": "mrp", "controller": "TFAB", "scenario": "M2", "duration": 60.0,
+                             "dt": 0.05})
+    rec, trace = simulate_scenario(sc, keep_trace=True)
+    assert rec["settings"]["late_window"] == [20.0, 60.0] and rec["settings"]["steady_window"] == [30.0, 60.0]
+    t, err = trace["t"][:-1], np.abs(trace["torque_estimate"] - trace["d"]).max(axis=1)
+    from_20, from_30 = err[t >= 20.0].max(), err[t >= 30.0].max()
+    assert from_20 > from_30 * (1 + 1e-5)  # the two windows give different numbers on this run
+    assert rec["metrics"]["td_est_err_max"] == pytest.approx(from_20, rel=1e-12)
+    late = t >= 20.0
+    tv = chattering(trace["t"], trace["u_applied"], trace["d"], 20.0)
+    assert rec["metrics"]["chatter_ratio"] == pytest.approx(tv["chatter_ratio"], rel=1e-12)
+    assert late.sum() == 800
