@@ -163,14 +163,15 @@ def paper_m_comparison(records: list[dict[str, Any]]) -> list[str]:
     ]
     if robust:
         lines.append(
-            "- The robust MPC on the same plant (seed 9: RMPC, state feedback, is expected to keep a "
-            "persistent error like BS; CRMPC to reject the disk like MAB). M2 max error on the window: "
+            "- The robust MPC on the same plant (to be measured, not asserted: RMPC, state feedback, "
+            "might keep a persistent error like BS, CRMPC reject the disk like MAB). M2 max error on the "
+            "window: "
             + ", ".join(robust)
             + "."
         )
     lines += [
         "",
-        "Inconsistencies of paper M (seed 8), as `models.mrp.scenarios.PAPER_M_NOTES` states them:",
+        "Inconsistencies of paper M, as `models.mrp.scenarios.PAPER_M_NOTES` states them:",
         "",
     ]
     from models.mrp.scenarios import PAPER_M_NOTES
