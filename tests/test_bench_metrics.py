@@ -190,6 +190,18 @@ def test_tables_in_every_format_hold_the_same_values():
     assert obj["max settling (s)"] is None  # yaw did not settle
 
 
+def test_a_table_of_records_without_the_rigid_metrics_shows_dashes():
+    """The mrp family measures no per-axis IAE, settling time or overshoot: a sweep of it used to
+    stop at the table with KeyError 'iae'."""
+    rec = _record()
+    for key in ("iae", "settling_time", "overshoot"):
+        del rec["metrics"][key]
+    header, rows = metric_table([rec])
+    obj = dict(zip(header, rows[0], strict=True))
+    assert obj["max IAE (rad s)"] is None and obj["max overshoot (%)"] is None
+    assert obj["max|u| (N m)"] == rec["metrics"]["max_abs_u"]
+
+
 @pytest.mark.parametrize(
     "module",
     [

@@ -70,6 +70,14 @@ def test_shipped_gain_sweep_expands():
     assert bandwidths == {5.0, 10.0, 20.0, 40.0}
 
 
+def test_shipped_reference_sweep_expands_to_the_docs_table():
+    """mrp_reference: BS, MAB, TF-AB x M1-M3 x {none, limiter} at the 0.01 s step (the docs' table)."""
+    cases = expand(load_sweep("mrp_reference"))
+    assert len(cases) == 18
+    assert {(c.controller, c.scenario, c.saturation) for c in cases} >= {("MAB", "M3", "limiter")}
+    assert {(c.dt, c.plant_step) for c in cases} == {(0.01, 0.01)}
+
+
 def test_bench_mrp_short_writes_every_file(tmp_path, capsys, monkeypatch):
     built = capture(monkeypatch, mrp_figures, "mrp_group_figure")
     out = tmp_path / "mrp"

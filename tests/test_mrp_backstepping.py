@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from benchmarks.families.mrp.family import chattering
 from models import MRPSatellite, paper_m_scenario
 from models.attitude.mrp import mrp_error_angle
 from rmpc import MAB, NESO, CFBackstepping, CommandFilter, ConstantDisturbance, TuningFunctionAB, simulate
@@ -173,14 +174,12 @@ def test_m2_sampled_runs_match_the_continuous_ones(m2, m2_continuous, m2_sampled
 
 
 def test_m2_no_chattering_and_step_info(m2, m2_sampled) -> None:
-    """Total variation of the torque on [20, 60] s within 1.5 x that of the disk's (seed: 1.00-1.07)."""
+    """Total variation of the torque on [20, 60] s within 1.5 x that of the disk's (seed: 1.00-1.07),
+    measured by the suite's own metric (:func:`benchmarks.families.mrp.family.chattering`)."""
     for (name, dt), traj in m2_sampled.items():
         if dt != 0.01:
             continue
-        late = traj.t[:-1] >= 20.0
-        tv_u = np.abs(np.diff(traj.u_applied[late], axis=0)).sum()
-        tv_d = np.abs(np.diff(traj.d[late], axis=0)).sum()
-        assert tv_u <= 1.5 * tv_d, name
+        assert chattering(traj.t, traj.u_applied, traj.d, 20.0)["chatter_ratio"] <= 1.5, name
         assert traj.status_counts() == {"ok": traj.n_steps}
         assert "torque_estimate" in traj.info[-1].extra or name == "BS"
     mab = m2_sampled["MAB", 0.01]

@@ -52,6 +52,7 @@ __all__ = [
     "settle_index",
     "settling_time",
     "step_timing",
+    "total_variation_rate",
 ]
 
 #: Names of the attitude axes, in state order.
@@ -255,6 +256,33 @@ def step_timing(traj: Any) -> dict[str, Any]:
         "solve_time_solves_p95": float(np.percentile(solved, 95)) if solved.size else None,
         "status_counts": traj.status_counts(),
     }
+
+
+def total_variation_rate(u: Any, length: float) -> float:
+    """Total variation of a sampled signal per second: ``(1/L) sum_k ||u_(k+1) - u_k||_1``.
+
+    The chattering measure of the suites: a torque that switches sign from sample to sample
+    scores ``2 |u| / dt`` per axis, a smooth torque the mean slope of ``|u|``.
+
+    Parameters
+    ----------
+    u : (N, m) array_like
+        The samples ``u_0 .. u_(N-1)`` of one window, in time order (zero-order hold).
+    length : float
+        The window's length ``L`` (s); ``0`` gives ``0.0``.
+
+    Returns
+    -------
+    float
+        Units of ``u`` per second.
+
+    Examples
+    --------
+    >>> total_variation_rate([[0.0, 1.0], [1.0, 0.0], [0.0, 1.0]], 2.0)
+    2.0
+    """
+    arr = np.asarray(u, dtype=float)
+    return float(np.sum(np.abs(np.diff(arr, axis=0)))) / length if length > 0 else 0.0
 
 
 def overshoot(e: Any) -> float | None:

@@ -101,19 +101,29 @@ def _flatten(scenario: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def _cell(get: Any, metrics: Mapping[str, Any]) -> Any:
+    """One metric cell; ``None`` when the record's family does not measure it (the mrp and
+    flexible families have no per-axis IAE, settling time or overshoot)."""
+    try:
+        return get(metrics)
+    except KeyError:
+        return None
+
+
 def metric_table(
     records: Sequence[Mapping[str, Any]],
     lead: Sequence[str] = ("experiment", "controller", "plant", "saturation"),
     scenario_fields: Sequence[str] = (),
 ) -> tuple[list[str], list[Row]]:
-    """One row per record: the ``lead`` keys, chosen scenario fields, then :data:`METRIC_COLUMNS`."""
+    """One row per record: the ``lead`` keys, chosen scenario fields, then :data:`METRIC_COLUMNS`
+    (``None`` where the record lacks the metric)."""
     header = [*lead, *scenario_fields, *(name for name, _ in METRIC_COLUMNS)]
     rows = []
     for rec in records:
         flat = _flatten(rec.get("settings", {}))
         row: Row = [rec.get(k) for k in lead]
         row += [flat.get(k) for k in scenario_fields]
-        row += [get(rec["metrics"]) for _, get in METRIC_COLUMNS]
+        row += [_cell(get, rec["metrics"]) for _, get in METRIC_COLUMNS]
         rows.append(row)
     return header, rows
 

@@ -331,17 +331,85 @@ def _modal_bound_lines(recs: list[dict], polytope: str) -> list[str]:
     ]
 
 
-def _ipm_along_slew(poly: Any, Q: np.ndarray, R: np.ndarray, direction: np.ndarray) -> str:
-    """The RMPC's problem solved cold at rest at :data:`IPM_REACH_ANGLES` by the toolkit's ipm."""
+def _ipm_along_slew(poly: Any, Q: np.ndarray, R: np.ndarray, direction: np.ndarray) -> list[tuple]:
+    """The RMPC's problem solved cold at rest at :data:`IPM_REACH_ANGLES` by the toolkit's ipm.
+
+    Returns ``(angle_deg, status, solver_status, iterations)`` per angle.
+    """
     from lmi import KothareProblem
 
-    words = []
+    out = []
     for angle in IPM_REACH_ANGLES:
         prob = KothareProblem(poly.A, poly.B, Q, R, u_max=defaults.U_MAX, input_constraint="peak",
                               dt=poly.dt, backend="ipm")
         sol = prob.solve(np.sin(np.deg2rad(angle) / 2.0) * direction)
-        words.append(f"{angle:g} deg {sol.status} ({sol.solver_status}, {sol.iterations} iterations)")
-    return "; ".join(words)
+        out.append((angle, str(sol.status), str(sol.solver_status), int(sol.iterations)))
+    return out
+
+
+def _solved(status: str) -> bool:
+    from toolkit_common.status import USABLE_STATUSES
+
+    return status in {str(s) for s in USABLE_STATUSES}
+
+
+def ipm_reach_sentence(trials: Sequence[tuple]) -> str:
+    """The verdict on the ipm along the slew axis, from ``(angle_deg, status, solver_status, iterations)``.
+
+    Examples
+    --------
+    >>> trials = [(12.5, "optimal", "optimal", 42), (15.0, "numerical_error", "stall", 9)]
+    >>> ipm_reach_sentence(trials).split(": ")[-1]
+    'it stops at 15 deg'
+    """
+    words = "; ".join(f"{a:g} deg {st} ({ss}, {it} iterations)" for a, st, ss, it in trials)
+    failed = [a for a, st, _, _ in trials if not _solved(st)]
+    if failed:
+        verdict = f"it stops at {min(failed):g} deg"
+    else:
+        verdict = f"it solves at every angle tried, up to {max(a for a, *_ in trials):g} deg"
+    return f"measured now: {words}: {verdict}"
+
+
+def _delta_shared_trial(poly: Any, Q: np.ndarray, R: np.ndarray, direction: np.ndarray) -> tuple:
+    """Clarabel on the 'delta_shared' form, cold at rest at F4's angle on the slew axis."""
+    from lmi import KothareProblem
+
+    angle = defaults.EXPERIMENT_ANGLES["small"]
+    prob = KothareProblem(poly.A, poly.B, Q, R, u_max=defaults.U_MAX, input_constraint="peak", dt=poly.dt,
+                          backend="clarabel", formulation="delta_shared")
+    sol = prob.solve(np.sin(np.deg2rad(angle) / 2.0) * direction)
+    return (angle, str(sol.status), str(sol.solver_status), int(sol.iterations))
+
+
+def delta_shared_sentence(trial: tuple, n_vertices: int) -> str:
+    """The verdict on Clarabel with the 'delta_shared' form.
+
+    ``trial`` is ``(angle_deg, status, solver_status, iterations)`` of :func:`_delta_shared_trial`.
+
+    Examples
+    --------
+    >>> delta_shared_sentence((10.0, "numerical_error", "NumericalError", 18), 8).split(": ")[-1]
+    'it fails there'
+    """
+    angle, status, solver_status, iterations = trial
+    verdict = "it solves there too" if _solved(status) else "it fails there"
+    return (
+        f"Clarabel on the 'delta_shared' form, cold at rest at {angle:g} deg on the slew axis ({n_vertices} "
+        f"vertices), measured now: {status} ({solver_status}, {iterations} iterations): {verdict}"
+    )
+
+
+def _reach_verdict(reach: Sequence[Any]) -> str:
+    """Whether the certified reach along the slew axis passes F4's slew angle."""
+    angle = defaults.EXPERIMENT_ANGLES["small"]
+    certified = [r.angle_deg for r in reach if r.angle_deg is not None and r.certified]
+    if certified and max(certified) > angle:
+        return (
+            f"The Kothare problem is feasible past F4's {angle:g} deg slew (certified up to "
+            f"{max(certified):.1f} deg)."
+        )
+    return f"No certified reach passes F4's {angle:g} deg slew."
 
 
 def _reach_lines() -> list[str]:
@@ -356,6 +424,7 @@ def _reach_lines() -> list[str]:
     poly = _polytope(sat, defaults.LINEAR_PERIOD, s["polytope"])
     Q, R = linear_weights(s, sat.n_modes)
     direction = np.concatenate((np.ones(3) / np.sqrt(3), np.zeros(3 + 2 * sat.n_modes)))
+    shared = delta_shared_sentence(_delta_shared_trial(poly, Q, R, direction), poly.n_vertices)
     reach = [slew_reach(poly, Q, R, defaults.U_MAX, direction, g) for g in REACH_GAMMAS]
     measured = "; ".join(
         f"gamma_s = {r.gamma_s:g}: "
@@ -371,10 +440,10 @@ def _reach_lines() -> list[str]:
         f"- Where the LMIs reach on the slew axis ('{s['polytope']}' polytope, {poly.n_vertices} vertices, "
         f"peak bound {defaults.U_MAX:g} N m; the largest t with t (1, 1, 1)/sqrt(3) as q_v in an invariant "
         "ellipsoid meeting the bound at a fixed cost bound, one SDP by cvxpy + Clarabel, checked without "
-        f"the solver): {measured}. The Kothare problem is feasible well past the 10 deg slew. The "
-        "toolkit's ipm on the RMPC's problem, cold at rest on the slew axis, measured now: "
-        f"{_ipm_along_slew(poly, Q, R, direction)}. F4 slews 10 deg; the OfflineRMPC tables use "
-        "Clarabel on the 'delta' form (the 'delta_shared' form ends in solver_error).",
+        f"the solver): {measured}. {_reach_verdict(reach)} The toolkit's ipm on the RMPC's problem, "
+        f"cold at rest on the slew axis, {ipm_reach_sentence(_ipm_along_slew(poly, Q, R, direction))}. "
+        f"F4 slews {defaults.EXPERIMENT_ANGLES['small']:g} deg; the OfflineRMPC tables use Clarabel on the "
+        f"'delta' form; {shared}.",
     ]
 
 

@@ -10,7 +10,8 @@ toolkit's, **assumed**):
 - ``rms_error_tail``: RMS rotation error over the last ``tail`` seconds (paper V's "accuracy");
 - ``peak_u``: largest applied hub torque component (N m); ``saturated_fraction``: share of
   samples where the limiter changed the hub torque;
-- ``ci``: chattering index ``(1/T) sum_k ||u(k+1) - u(k)||_1`` of the applied hub torque (N m/s);
+- ``ci``: chattering index ``(1/T) sum_k ||u(k+1) - u(k)||_1`` of the applied hub torque (N m/s,
+  :func:`benchmarks.core.metrics.total_variation_rate` over the run);
 - ``effort``: ``int ||u||_1 dt`` of the applied hub torque (N m s);
 - ``hf_power_fraction``: the share of the applied hub torque's power (mean removed, all axes)
   at frequencies above the first modal frequency ``Lambda_1`` (seed 4.4; 0 without modes or
@@ -27,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.core.metrics import check_trajectory, last_time_above
+from benchmarks.core.metrics import check_trajectory, last_time_above, total_variation_rate
 from models import FlexibleSatellite
 from models.attitude.quaternion import rotation_angle
 from rmpc.sim.trajectory import Trajectory
@@ -116,7 +117,7 @@ def flexible_metrics(
         "rms_error_tail": float(np.sqrt(np.mean(error[in_tail] ** 2))),
         "peak_u": float(np.abs(u).max()) if u.size else 0.0,
         "saturated_fraction": float(np.mean(np.any(traj.u_cmd[:, :3] != u, axis=1))) if u.size else 0.0,
-        "ci": float(np.sum(np.abs(np.diff(u, axis=0)))) / duration if duration > 0 else 0.0,
+        "ci": total_variation_rate(u, duration),
         "effort": float(np.sum(np.abs(u)) * traj.dt),
         "eta_peak": eta.max(axis=0) if n else np.zeros(0),
         "eta_residual": eta[in_tail].max(axis=0) if n else np.zeros(0),

@@ -102,7 +102,10 @@ def rationale() -> str:
         "(an initial error of 57.8 deg). The robust MPC runs on the error attitude in 3-2-1 angles and "
         "the rates relative to the orbital frame (models.mrp.tracking.RMPCStateMap), designed on the rigid "
         "satellite linearised at the target; its polytope also covers the kinematics over the box of "
-        "attitude errors the manoeuvre sweeps, so its LMI guarantees hold along the large slew. "
+        "attitude errors the manoeuvre sweeps. Its LMI guarantees (invariant ellipsoid, torque bound) "
+        "hold for every frozen-attitude linear model over that box with the inertia scaled by 0.7 to 1.3, "
+        "not for the plant: the gyroscopic torque w x J w, the disk's torque and the orbital terms of "
+        "order n (about 1e-3 1/s) are outside the polytope and act on it as unmodelled disturbances. "
         "Paper M's controllers see the MRP state and the target; only MAB and TFAB estimate the disk's "
         "torque."
     )

@@ -29,6 +29,12 @@ dt : float
     Control step (s, default 0.01).
 plant_step : float
     RK4 step of the plant (s, default 0.01; at most ``dt``).
+
+Metrics beyond the core's (:func:`simulate_case`): the error angle ``4 atan|se|`` on the steady
+window (the run's second half): ``err_angle_ss_max_deg``, ``err_angle_rms_deg``; and on the
+*late window* ``t >= min(20 s, steady window's start)`` (:func:`late_window_start`; from 20 s on
+the 100 s runs): ``td_est_err_max``, the largest ``|Tdhat_i - Td_i|`` of MAB's and TF-AB's
+disk-torque estimate (N m), and the chattering pair of :func:`chattering`.
 """
 
 from __future__ import annotations
@@ -48,14 +54,78 @@ from benchmarks.core.family import (
     check_run_length,
     controller_specs,
 )
-from benchmarks.core.metrics import step_timing
+from benchmarks.core.metrics import step_timing, total_variation_rate
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
 from toolkit_common.errors import ConfigError
 
-__all__ = ["MRP", "simulate_case"]
+__all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
 
 COVER_MARGIN_DEG = 5.0
+
+LATE_WINDOW_START = 20.0
+"""Start (s) of the late window of the observer error and the chattering metric.
+
+Paper M's scenarios start 57.8 deg from the target: the torque peaks at ``t = 0``, the command
+filter and the estimators settle within about 15 s, and from 20 s on the torque only answers the
+disk (a period of its speed is 20.9 s). Measured over the slew, the torque's variation would be
+the slew's, not chattering."""
+
+
+def late_window_start(steady_start: float) -> float:
+    """Start of the late window: :data:`LATE_WINDOW_START`, or the steady window's start if earlier.
+
+    A run shorter than 40 s (``--short``) cannot hold 20 s of transient and a window; its late
+    window is its steady window (the second half).
+
+    Examples
+    --------
+    >>> late_window_start(50.0), late_window_start(2.5)
+    (20.0, 2.5)
+    """
+    return min(LATE_WINDOW_START, steady_start)
+
+
+def chattering(t: Any, u: Any, d: Any, start: float) -> dict[str, float | None]:
+    """The chattering metric of a run: the torque's total variation per second on ``t >= start``.
+
+    ``chatter_tv_rate`` is :func:`benchmarks.core.metrics.total_variation_rate` of the applied
+    torque samples ``u_k`` with ``t_k >= start``, over the window's length ``t_end - start``
+    (N m/s). ``chatter_ratio`` divides it by the same quantity of the disturbance torque ``d``
+    (the disk's), the yardstick of a torque that follows the disk smoothly: near 1 without
+    chattering, far above 1 when the law switches (paper M claims "no chattering"). ``None``
+    without a disturbance or with a constant one.
+
+    Parameters
+    ----------
+    t : (N + 1,) array_like
+        Sample times of the run (``t_N`` its end).
+    u, d : (N, 3) array_like
+        Applied torque and disturbance torque per sample (``d`` may have no rows).
+    start : float
+        Start of the window (s), :func:`late_window_start` in the suite.
+
+    Returns
+    -------
+    dict
+        ``chatter_tv_rate`` (None if the window holds fewer than two samples) and ``chatter_ratio``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(5.0)
+    >>> chattering(t, [[0, 0, 0], [1, 0, 0], [0, 0, 0], [1, 0, 0]], [[0, 0, 0], [0.5, 0, 0]] * 2, 0.0)
+    {'chatter_tv_rate': 0.75, 'chatter_ratio': 2.0}
+    """
+    t = np.asarray(t, dtype=float)
+    late = t[:-1] >= start
+    if late.sum() < 2:
+        return {"chatter_tv_rate": None, "chatter_ratio": None}
+    length = float(t[-1] - start)
+    tv_u = total_variation_rate(np.asarray(u, dtype=float)[late], length)
+    d = np.asarray(d, dtype=float)
+    tv_d = total_variation_rate(d[late], length) if d.size else 0.0
+    return {"chatter_tv_rate": tv_u, "chatter_ratio": tv_u / tv_d if tv_d > 0 else None}
 
 
 def _positive(value: Any, where: str) -> float:
@@ -147,6 +217,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     phi = np.degrees([mrp_error_angle(x[:3], case.sigma_ref) for x in traj.x])
     lo, hi = case.steady_window
     window = (traj.t >= lo) & (traj.t <= hi)
+    late_start = late_window_start(lo)
     err = np.array([state_map(x)[:3] for x in traj.x])
     metrics: dict[str, Any] = {
         "final_abs_err": {ax: float(abs(err[-1, i])) for i, ax in enumerate(("roll", "pitch", "yaw"))},
@@ -160,14 +231,16 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "max_abs_u_cmd": float(np.abs(traj.u_cmd).max()),
     }
     metrics.update(step_timing(traj))
+    metrics.update(chattering(traj.t, traj.u_applied, traj.d, late_start))
     estimate = [info.extra.get("torque_estimate") if info is not None else None for info in traj.info]
     if traj.d.size and all(e is not None for e in estimate):
         est = np.asarray(estimate, dtype=float)
-        late = traj.t[:-1] >= lo
+        late = traj.t[:-1] >= late_start
         metrics["td_est_err_max"] = float(np.abs(est[late] - traj.d[late]).max()) if late.any() else None
     extra = {
         "duration_used": traj.n_steps * traj.dt,  # what ran (whole samples of dt)
         "steady_window": [lo, hi],
+        "late_window": [late_start, hi],
         "inertia_scale_used": case.inertia_scale,
         "disk": case.disk,
         "initial_error_deg": case.initial_error_deg,
