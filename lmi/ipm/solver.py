@@ -53,7 +53,6 @@ the starting points, the iterations, their stopping rules and the warm starts.
 
 from __future__ import annotations
 
-import itertools
 import logging
 import threading
 import time
@@ -460,11 +459,12 @@ class BlockLMISolver(BlockData):
                            dres, gap)
             if agree and pres <= self.tol_feas and dres <= self.tol_feas and (
                 gap <= self.tol_gap_abs or rel_gap <= self.tol_gap_rel
-            ) and self._blocks_feasible(x, s, rp, self.tol_feas):
+            ) and _kernels.blocks_within(s, x, rp, g_mat, h_vec, self.tol_feas, *packing):
                 status = "optimal"
                 break
             if (stall_point is None and agree and max(pres, dres) <= REDUCED_TOL
-                    and min(gap, rel_gap) <= REDUCED_TOL and self._blocks_feasible(x, s, rp, REDUCED_TOL)):
+                    and min(gap, rel_gap) <= REDUCED_TOL
+                    and _kernels.blocks_within(s, x, rp, g_mat, h_vec, REDUCED_TOL, *packing)):
                 best = (x, s, z, pres, dres, gap)
             if monitor is not None and (word := monitor(x, s, z)) is not None:
                 status, best = word, None
@@ -551,27 +551,6 @@ class BlockLMISolver(BlockData):
             status, x * dscale, s_out, z_out, it, float(cvec @ x), -float(h_vec @ zp), pres, dres,
             gap, 0.0, radius if status == "infeasible" else np.nan,
         )
-
-    def _blocks_feasible(self, x: np.ndarray, s: np.ndarray, rp: np.ndarray, tol: float) -> bool:
-        """Whether every block's primal residual is within ``tol`` of that block's own size.
-
-        The relative primal residual of the stopping test is over all blocks together; a block
-        whose data are many orders of magnitude smaller than the others' can then be violated
-        entirely while it is small (see :data:`OBJECTIVE_AGREEMENT`). Per block ``j`` this asks
-        ``max |rp_j| <= tol max(max |h_j|, max (|G_j| |x|), max |s_j|)``, in max-norms (no
-        squares, so no underflow for tiny blocks) and with the magnitudes of the terms of
-        ``G_j x`` (a block whose terms cancel, e.g. a bound that is active at 0, keeps its size).
-        Checked only where the test over all blocks has passed.
-        """
-        sp = _kernels.pack(s, *self._layout.arrays)
-        terms = np.abs(self._g_mat) @ np.abs(x)
-        offsets = self._layout.arrays[1]
-        for lo, hi in itertools.pairwise(offsets):
-            size = max(float(np.max(np.abs(self._h_vec[lo:hi]))), float(np.max(terms[lo:hi])),
-                       float(np.max(np.abs(sp[lo:hi]))))
-            if not float(np.max(np.abs(rp[lo:hi]))) <= tol * size:
-                return False
-        return True
 
     def _recession_direction(self, x: np.ndarray) -> bool:
         """Whether ``d = x / ||x||`` (equilibrated) is a direction of recession to :data:`RAY_TOL`:

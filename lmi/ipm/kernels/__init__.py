@@ -41,7 +41,7 @@ from lmi.ipm.kernels.iteration import (
     grouped_iteration,
     rows_iteration,
 )
-from lmi.ipm.kernels.packed import cholesky_blocks, pack, residuals, unpack
+from lmi.ipm.kernels.packed import blocks_within, cholesky_blocks, pack, residuals, unpack
 from lmi.ipm.kernels.schur import (
     scaling_and_schur_direct,
     scaling_and_schur_grouped,
@@ -50,7 +50,7 @@ from lmi.ipm.kernels.schur import (
 from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
 
 __all__ = [
-    "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "cholesky_blocks",
+    "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blocks_within", "cholesky_blocks",
     "grouped_iteration", "newton_step", "pack", "residuals", "rows_iteration", "scaling_and_schur_direct",
     "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
 ]
