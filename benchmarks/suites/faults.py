@@ -1,15 +1,19 @@
-"""The benchmark suite "faults": paper W's scenarios S1-S4 as experiments W1-W4.
+"""The benchmark suite "faults": paper W's scenarios S1-S4 as experiments W1-W4, and three studies.
 
-Every experiment runs paper W's adaptive backstepping compensator (``ABFTC``) and the robust
-MPC family (``RMPC``, ``CRMPC``, ``GIPC``, on the wheel-effectiveness polytope) on the nonlinear
+W1-W4 run paper W's adaptive backstepping compensator (``ABFTC``) and the robust MPC family
+(``RMPC``, ``CRMPC``, ``GIPC``, on the wheel-effectiveness polytope) on the nonlinear
 four-wheel satellite with the scenario's faults; W4 runs twice per controller, with the plant's
-inertia at 1.2 J and at 0.8 J (the controllers keep J).
+inertia at 1.2 J and at 0.8 J (the controllers keep J). W5-W7 run on S1 (whose recovery time is
+paper W's one number).
 
 ====  ========================================================================================
 W1    S1: wheel 2 stuck at 0.05 N m for 8 < t < 37 s, from [40, -21, -80] deg, 60 s
 W2    S2: wheel 1 sinusoidal 30-80 s, wheel 4 stuck 90-120 s, from [23, 24, 73] deg, 150 s
 W3    S3: wheel 4 out throughout, wheel 1 sinusoidal 30-80 s, wheel 2 stuck 90-120 s, 150 s
 W4    S4: wheel 4 out, wheel 1 stuck 30-60 s, wheel 2 sinusoidal 70-100 s, wheel noise, J x1.2 / x0.8
+W5    S1, ABFTC: adaptation gain Gamma x wheel limits on/off x freeze off/on (sweep ``faults_gamma``)
+W6    S1, ABFTC: wheel friction and angle noise, apart and together (paper W's hardware, approximate)
+W7    S1: the plant's wheel axes tilted 5 deg (an error in D), the controllers on the nominal D
 ====  ========================================================================================
 
 :func:`fault_cases` lists the cases (settings from :mod:`benchmarks.families.wheel.defaults`);
@@ -58,6 +62,23 @@ EXPERIMENTS: dict[str, tuple[str, str]] = {
         "Wheel 4 out; wheel 1 stuck 30-60 s, wheel 2 sinusoidal 70-100 s; wheel-level noise; the "
         "plant's inertia 1.2 J and 0.8 J while the controllers keep J.",
     ),
+    "W5": (
+        "S1",
+        "The adaptation-gain study: ABFTC with Gamma_0 = Gamma_j = Gamma I3 (paper W's value is lost "
+        "with its appendix; 0.1 I3 elsewhere in this suite is assumed), with the wheels' torque and "
+        "momentum limits in the plant and without them, with the freeze option (the estimates held "
+        "while a command or a momentum is at its wheel's limit) off and on.",
+    ),
+    "W6": (
+        "S1",
+        "Paper W's hardware effects, approximated: ABFTC with wheel bearing friction, with 0.2 deg "
+        "angle noise, and with both (the friction values are assumed).",
+    ),
+    "W7": (
+        "S1",
+        "An error in the distribution matrix D: every wheel axis of the plant tilted by 5 deg in a "
+        "seeded direction; every controller keeps the nominal D.",
+    ),
 }
 
 #: The controllers every experiment runs.
@@ -67,19 +88,81 @@ CONTROLLERS: tuple[str, ...] = ("ABFTC", "RMPC", "CRMPC", "GIPC")
 SHORT_TIME_SCALE = 0.1
 
 
+def _w5_cases(time_scale: float) -> list[SuiteCase]:
+    short = time_scale < 1.0
+    gammas = defaults.W5_GAMMAS_SHORT if short else defaults.W5_GAMMAS
+    cases = []
+    for freeze in (False,) if short else (False, True):
+        for limits in (True, False):
+            for gamma in gammas:
+                data: dict[str, Any] = {
+                    "family": "wheel",
+                    "controller": "ABFTC",
+                    "scenario": "S1",
+                    "time_scale": time_scale,
+                    "wheel_limits": limits,
+                    "settings": {"gamma_g": gamma, "gamma_theta": gamma, "freeze": freeze},
+                }
+                tag = f"G{gamma:g}_{'limits' if limits else 'nolimits'}" + ("_freeze" if freeze else "")
+                cases.append(SuiteCase("W5", Scenario.from_dict(data), tag))
+    return cases
+
+
+#: W6's variants: tag -> the plant fields it changes.
+W6_VARIANTS: dict[str, dict[str, float]] = {
+    "nominal": {},
+    "friction": {"viscous_friction": defaults.VISCOUS_FRICTION, "coulomb_friction": defaults.COULOMB_FRICTION},
+    "noise": {"angle_noise": defaults.ANGLE_NOISE_DEG},
+    "friction_noise": {
+        "viscous_friction": defaults.VISCOUS_FRICTION,
+        "coulomb_friction": defaults.COULOMB_FRICTION,
+        "angle_noise": defaults.ANGLE_NOISE_DEG,
+    },
+}
+
+
+def _w6_cases(time_scale: float) -> list[SuiteCase]:
+    base = {"family": "wheel", "controller": "ABFTC", "scenario": "S1", "time_scale": time_scale}
+    return [SuiteCase("W6", Scenario.from_dict({**base, **v}), tag) for tag, v in W6_VARIANTS.items()]
+
+
+def _w7_cases(time_scale: float) -> list[SuiteCase]:
+    cases = []
+    for ctrl in CONTROLLERS:
+        data = {
+            "family": "wheel",
+            "controller": ctrl,
+            "scenario": "S1",
+            "time_scale": time_scale,
+            "d_misalignment": defaults.D_TILT_DEG,
+        }
+        cases.append(SuiteCase("W7", Scenario.from_dict(data), ctrl))
+    return cases
+
+
 def fault_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[SuiteCase]:
-    """The cases of W1-W4 (run lengths and fault windows multiplied by ``time_scale``).
+    """The cases of W1-W7 (run lengths and fault windows multiplied by ``time_scale``).
+
+    W5 runs every gain of :data:`~benchmarks.families.wheel.defaults.W5_GAMMAS` with the limits
+    on and off and the freeze off and on; a time scale below 1 (``--short``) keeps two gains and
+    the freeze off.
 
     Examples
     --------
     >>> cases = fault_cases()
     >>> len(cases), sorted({c.experiment for c in cases})
-    (20, ['W1', 'W2', 'W3', 'W4'])
+    (52, ['W1', 'W2', 'W3', 'W4', 'W5', 'W6', 'W7'])
+    >>> len(fault_cases(0.1, ["W5"]))
+    4
     """
     check_time_scale(time_scale)
     chosen = chosen_experiments(EXPERIMENTS, experiments)
     cases = []
+    extra = {"W5": _w5_cases, "W6": _w6_cases, "W7": _w7_cases}
     for exp in chosen:
+        if exp in extra:
+            cases += extra[exp](time_scale)
+            continue
         scenario = EXPERIMENTS[exp][0]
         scales = (1.2, 0.8) if scenario == "S4" else (None,)
         for ctrl in CONTROLLERS:
