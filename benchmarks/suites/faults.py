@@ -109,15 +109,12 @@ def _w5_cases(time_scale: float) -> list[SuiteCase]:
 
 
 #: W6's variants: tag -> the plant fields it changes.
+_FRICTION = {"viscous_friction": defaults.VISCOUS_FRICTION, "coulomb_friction": defaults.COULOMB_FRICTION}
 W6_VARIANTS: dict[str, dict[str, float]] = {
     "nominal": {},
-    "friction": {"viscous_friction": defaults.VISCOUS_FRICTION, "coulomb_friction": defaults.COULOMB_FRICTION},
+    "friction": _FRICTION,
     "noise": {"angle_noise": defaults.ANGLE_NOISE_DEG},
-    "friction_noise": {
-        "viscous_friction": defaults.VISCOUS_FRICTION,
-        "coulomb_friction": defaults.COULOMB_FRICTION,
-        "angle_noise": defaults.ANGLE_NOISE_DEG,
-    },
+    "friction_noise": {**_FRICTION, "angle_noise": defaults.ANGLE_NOISE_DEG},
 }
 
 

@@ -100,19 +100,27 @@ SETTING_CHOICES: Mapping[str, tuple[str, ...]] = MappingProxyType(
 def settings_rows() -> list[tuple[str, str, str]]:
     """(setting, value, source) for the report's settings table."""
     return [
-        ("control period / RK4 step (s)", f"{DT:g} / {SUBSTEP:g}", "assumed: paper W gives the 40 ms hardware loop, no simulation step"),
+        (
+            "control period / RK4 step (s)",
+            f"{DT:g} / {SUBSTEP:g}",
+            "assumed: paper W gives the 40 ms hardware loop, no simulation step",
+        ),
         ("per-wheel torque limit (N m)", f"{U_MAX:g}", "paper W"),
         ("run lengths S1/S2/S3/S4 (s)", "60 / 150 / 150 / 150", "assumed: paper W does not print them"),
         ("initial rates", "zero", "likely: paper W releases the platform by hand, at about rest"),
-        ("S1 stuck torque (N m)", "0.05 (0.03 in paper W's fault list)", "paper W, inconsistent (0.05 in its text, 0.03 in its fault list)"),
-        ("S4 plant inertia", "1.2 J and 0.8 J, controllers keep J", "assumed: paper W states a 20 % error, not its sign"),
+        ("S1 stuck torque (N m)", "0.05 (0.03 in paper W's fault list)", "paper W, inconsistent"),
+        (
+            "S4 plant inertia",
+            "1.2 J and 0.8 J, controllers keep J",
+            "assumed: paper W states a 20 % error, not its sign",
+        ),
         (
             "S4 wheel disturbance",
             "0.001 + 0.05 sin(2 pi t/800) + noise of variance 0.0052, every 40 ms, seed 0",
             "paper W / assumed placement",
         ),
-        ("gravity", "pendulous, known to ABFTC", "assumed: paper W's signs conflict; inverted would topple S1"),
-        ("recovery threshold", f"every angle within {RECOVERY_DEG:g} deg", "assumed: paper W gives no threshold"),
+        ("gravity", "pendulous, known to ABFTC", "assumed: paper W's signs conflict; inverted topples S1"),
+        ("recovery threshold", f"every angle within {RECOVERY_DEG:g} deg", "assumed: paper W gives none"),
         (
             "ABFTC c1, c2, Gamma_0, Gamma_j",
             "0.5, 3, 0.1 I, 0.1 I; basis [1, sin 0.2 t]; freeze and leakage off",

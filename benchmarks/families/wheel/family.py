@@ -271,10 +271,8 @@ def _label(scenario: Any) -> str:
     s, base = scenario.settings, defaults.CONTROLLER_DEFAULTS[scenario.controller]
     if scenario.controller == "ABFTC":
         if (s["gamma_g"], s["gamma_theta"]) != (base["gamma_g"], base["gamma_theta"]):
-            same = s["gamma_g"] == s["gamma_theta"]
-            parts.append(
-                f"Gamma {s['gamma_g']:g} I" if same else f"Gamma_0 {s['gamma_g']:g} I, Gamma_j {s['gamma_theta']:g} I"
-            )
+            g0, gj = s["gamma_g"], s["gamma_theta"]
+            parts.append(f"Gamma {g0:g} I" if g0 == gj else f"Gamma_0 {g0:g} I, Gamma_j {gj:g} I")
         if s["freeze"]:
             parts.append("freeze")
     if not scenario.wheel_limits:
