@@ -38,6 +38,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.suites.flexible",
     "benchmarks.suites.flexible_report",
     "benchmarks.suites.mrp",
+    "benchmarks.suites.faults_claims",
     "benchmarks.suites.mrp_claims",
     "benchmarks.suites.paper",
     "benchmarks.suites.paper_claims",

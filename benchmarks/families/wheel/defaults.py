@@ -49,7 +49,7 @@ VISCOUS_FRICTION: float = 5e-4
 COULOMB_FRICTION: float = 2e-3
 #: W6: standard deviation of the angle noise, deg (paper W's sensors: 0.2 deg accuracy).
 ANGLE_NOISE_DEG: float = 0.2
-#: W7: tilt of every wheel axis of the plant, deg (seeded directions; |d_j' - d_j| = 8.7 %).
+#: W7: tilt of every wheel axis of the plant, deg (seeded directions; each unit column moves 8.7 %).
 D_TILT_DEG: float = 5.0
 
 _Q_DIAG = (1.0, 1.0, 1.0, 0.1, 0.1, 0.1)
