@@ -30,6 +30,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.families.flexible.controllers",
     "benchmarks.families.flexible.metrics",
     "benchmarks.families.mrp.family",
+    "benchmarks.families.wheel.family",
     "benchmarks.families.wheel.plant",
     "benchmarks.mutation.operators",
     "benchmarks.reports.sections",
