@@ -17,7 +17,8 @@ from pathlib import Path
 # Document the checkout this file belongs to, also when an older copy is installed.
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-# The project's own directives (``status-table``: the status vocabulary's table).
+# The project's own directives (``status-table``: the status vocabulary's table; the example
+# gallery, ``example-figure`` and ``example-gallery``).
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 
 # -- Project -------------------------------------------------------------------------
@@ -37,6 +38,7 @@ extensions = [
     "sphinx.ext.doctest",
     "numpydoc",
     "status_table",
+    "gallery",
 ]
 exclude_patterns = ["_build", "_generated", "examples", "figures", "Thumbs.db", ".DS_Store"]
 root_doc = "index"

@@ -1,15 +1,14 @@
 """The documentation builds without warnings, and the examples it shows run and print what it says.
 
 The examples live in ``docs/examples/*.py``; the pages show them with ``literalinclude`` and
-quote their output in the literal block that follows (``It prints::``).
+quote their output in the literal block that follows (``It prints::``). The examples that import
+``matplotlib.pyplot`` draw figures; the build runs them and shows the figures on their pages and
+in the gallery (``docs/_ext/gallery.py``), which lists every example.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
-import runpy
 import subprocess
 import sys
 from decimal import Decimal
@@ -22,12 +21,28 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 EXAMPLES = sorted((DOCS / "examples").glob("*.py"))
+sys.path.insert(0, str(DOCS / "_ext"))
+from gallery import draws_figures  # noqa: E402  (docs/_ext is not a package)
+from gallery import run_example as run_example_script  # noqa: E402
+
+PLOTTING = [example for example in EXAMPLES if draws_figures(example)]
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
 def _pages() -> dict[str, str]:
-    return {page.name: page.read_text(encoding="utf-8") for page in sorted(DOCS.glob("*.rst"))}
+    """Every page's text by its path under docs/ (``quickstart.rst``, ``tutorial/install.rst``)."""
+    pages = {}
+    for page in sorted(DOCS.rglob("*.rst")):
+        if not {"_build", "_generated"} & set(page.relative_to(DOCS).parts):
+            pages[page.relative_to(DOCS).as_posix()] = page.read_text(encoding="utf-8")
+    return pages
+
+
+def _includes(line: str, example: str) -> bool:
+    """Whether a line is the ``literalinclude`` of an example (relative or from the docs root)."""
+    pattern = rf"\.\. literalinclude:: (?:/|\.\./)?examples/{re.escape(example)}"
+    return re.fullmatch(pattern, line.strip()) is not None
 
 
 def _documented_output(example: str) -> str | None:
@@ -35,7 +50,7 @@ def _documented_output(example: str) -> str | None:
     for text in _pages().values():
         lines = text.splitlines()
         for i, line in enumerate(lines):
-            if line.strip() != f".. literalinclude:: examples/{example}":
+            if not _includes(line, example):
                 continue
             j = i + 1
             while j < len(lines) and (not lines[j].strip() or lines[j].startswith(" ")):
@@ -110,29 +125,55 @@ def test_docs_build_without_warnings(tmp_path: Path) -> None:
     proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600, check=False)
     assert proc.returncode == 0, f"{' '.join(cmd)}\n{proc.stdout[-4000:]}\n{proc.stderr[-8000:]}"
     assert (tmp_path / "html" / "index.html").is_file()
+    _check_gallery(tmp_path / "html")
+
+
+def _check_gallery(html: Path) -> None:
+    """The built gallery: a section per example with its code, and the figures of those that plot."""
+    page = (html / "gallery.html").read_text(encoding="utf-8")
+    images = re.findall(r'<img alt="the figure of examples/([\w.]+)" src="_images/([\w.-]+)"', page)
+    for example in EXAMPLES:
+        assert f'id="{example.stem.replace("_", "-")}-py"' in page, f"{example.name} has no gallery section"
+    assert page.count('<div class="highlight-python') >= len(EXAMPLES), "an example's code is missing"
+    assert sorted({name for name, _ in images}) == sorted(e.name for e in PLOTTING)
+    for _, png in images:
+        assert (html / "_images" / png).stat().st_size > 1000, png
 
 
 def test_every_example_is_shown_in_the_docs() -> None:
-    text = "\n".join(_pages().values())
+    pages = _pages()
     assert EXAMPLES, "docs/examples/ holds no example"
     for example in EXAMPLES:
-        assert f".. literalinclude:: examples/{example.name}" in text, (
+        assert any(_includes(line, example.name) for text in pages.values() for line in text.splitlines()), (
             f"docs/examples/{example.name} is not included by any page"
         )
-    assert ".. literalinclude:: examples/quickstart.py" in _pages()["quickstart.rst"]
+    assert ".. literalinclude:: examples/quickstart.py" in pages["quickstart.rst"]
+    assert PLOTTING, "no example draws a figure"
+    for example in PLOTTING:  # a figure is shown where the example is explained
+        assert any(f".. example-figure:: {example.name}" in text for text in pages.values()), example.name
 
 
 @pytest.fixture(scope="module")
 def run_example() -> Any:
-    """Run an example once per test module; return its globals and what it printed."""
+    """Run an example once per test module; return its globals and what it printed.
+
+    As the documentation build runs it: ``matplotlib`` on Agg and ``plt.show`` a no-op. The
+    figures it draws are kept as ``namespace["__figures__"]``: for each one, for each of its
+    axes, the data of each line.
+    """
+    import matplotlib.pyplot as plt
+
     cache: dict[Path, tuple[dict[str, Any], str]] = {}
 
     def run(example: Path) -> tuple[dict[str, Any], str]:
         if example not in cache:
-            out = io.StringIO()
-            with contextlib.redirect_stdout(out):
-                namespace = runpy.run_path(str(example), run_name="__main__")
-            cache[example] = (namespace, out.getvalue().strip())
+            namespace, printed, figures = run_example_script(example)
+            namespace["__figures__"] = [
+                [[np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()] for ax in fig.axes]
+                for fig in figures
+            ]
+            plt.close("all")
+            cache[example] = (namespace, printed)
         return cache[example]
 
     return run
@@ -153,6 +194,18 @@ def test_example_runs_and_prints_what_the_docs_say(example: Path, run_example: A
     assert len(got_numbers) == len(doc_numbers), message
     bad = _disagreements(got_numbers, doc_numbers)
     assert not bad, f"{'; '.join(bad)}\n{message}"
+
+
+@pytest.mark.parametrize("example", PLOTTING, ids=lambda p: p.stem)
+def test_plotting_example_draws_its_figure(example: Path, run_example: Any) -> None:
+    figures = run_example(example)[0]["__figures__"]
+    assert figures, f"{example.name} imports matplotlib.pyplot but draws no figure"
+    for axes in figures:
+        assert axes, f"{example.name} draws an empty figure"
+        for lines in axes:
+            assert lines, f"{example.name} draws axes without a line"
+            for y in lines:  # a line has data: at least two finite points
+                assert np.count_nonzero(np.isfinite(y)) >= 2, f"{example.name} draws an empty line"
 
 
 def test_quickstart_regulates_the_attitude(run_example: Any) -> None:

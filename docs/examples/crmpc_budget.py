@@ -1,5 +1,6 @@
 """CRMPC: the Lyapunov rule and the torque budget on the heavy corner of a +-70 % polytope."""
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from models import PAPER_P_INERTIA, RigidSatellite
@@ -27,3 +28,17 @@ print(f"largest |u_i| = {np.max(np.abs(traj.u_applied)):.3f} N m, "
       f"smallest RMPC bound = {min(bounds):.3f} N m")
 print("statuses:", traj.status_counts(),
       "| budget-scaled steps:", sum(info.extra["budget_scaled"] for info in traj.info))
+
+fig, (ax_e, ax_u) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 4.4))
+for axis, name in enumerate(("roll", "pitch", "yaw")):
+    ax_e.plot(traj.t, np.degrees(traj.x[:, axis]), label=name)
+    ax_u.plot(traj.t[:-1], traj.u_applied[:, axis], label=f"u, {name}")
+ax_u.plot(traj.t[:-1], bounds, "k--", lw=0.8, label="RMPC bound")
+ax_e.axvline(onset, color="grey", lw=0.5)
+ax_e.set_ylabel("attitude (deg)")
+ax_e.legend(fontsize="small")
+ax_u.set_ylabel("torque (N m)")
+ax_u.set_xlabel("time (s)")
+ax_u.legend(fontsize="small", ncol=2)
+fig.tight_layout()
+plt.show()

@@ -1,5 +1,6 @@
 """Theory: example 1 of Kothare, Balakrishnan & Morari (1996), angular positioning."""
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from lmi import KothareProblem
@@ -22,8 +23,17 @@ print(f"u(0) = F x0 = {(sol.F @ x0)[0]:.4g}")
 # The realised cost on each vertex plant (30 steps, |u| <= 2) stays below gamma(x0).
 plant = PolytopicModel(vertices=list(zip(A, B, strict=True)), dt=0.1)
 ctrl = RMPC(plant, Q=Q1, R=R, u_max=2.0, input_constraint="peak")
+fig, (ax_x, ax_u) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 4.0))
 for vertex in (0, 1):
     traj = simulate(ctrl, plant, x0, n_steps=30, true_plant=vertex)
     x, u = traj.x[:-1], traj.u_applied
     cost = np.einsum("ki,ij,kj->", x, Q1, x) + np.einsum("ki,ij,kj->", u, R, u)
     print(f"vertex {vertex}: cost {cost:.4g}, max |u| {np.abs(u).max():.4g}")
+    ax_x.plot(traj.t, traj.x[:, 0], label=f"vertex {vertex} (alpha = {(0.1, 10.0)[vertex]})")
+    ax_u.step(traj.t[:-1], u[:, 0], where="post")
+ax_x.set_ylabel("angle (rad)")
+ax_x.legend()
+ax_u.set_ylabel("input u")
+ax_u.set_xlabel("time (s)")
+fig.tight_layout()
+plt.show()

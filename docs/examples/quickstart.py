@@ -1,5 +1,6 @@
 """Quickstart: LQR on the nonlinear rigid satellite of paper P."""
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from models import RigidSatellite
@@ -24,3 +25,15 @@ traj = simulate(lqr, sat, x0, duration=20.0, dt=0.01)
 print("final attitude (deg):", np.round(traj.attitude_deg[-1], 4))
 print("largest torque (N m):", round(float(np.abs(traj.u_applied).max()), 4))
 print("step statuses:", traj.status_counts())
+
+# The attitude and the torques over the run (plt.show() opens a window).
+fig, (ax_x, ax_u) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 4.4))
+for axis, name in enumerate(("roll", "pitch", "yaw")):
+    ax_x.plot(traj.t, traj.attitude_deg[:, axis], label=name)
+    ax_u.plot(traj.t[:-1], traj.u_applied[:, axis], label=name)
+ax_x.set_ylabel("attitude (deg)")
+ax_x.legend()
+ax_u.set_ylabel("torque (N m)")
+ax_u.set_xlabel("time (s)")
+fig.tight_layout()
+plt.show()
