@@ -31,7 +31,7 @@ forms (:mod:`lmi.ipm.kernels.schur`), the factorisations by BLAS/LAPACK
 (:mod:`lmi.ipm.kernels.step`) and the whole iteration (:mod:`lmi.ipm.kernels.iteration`); this
 package re-exports the public ones. Compiled on first use and
 cached next to their files (``cache=True``): the first process after an install pays the
-compilation (about 10-20 s here), later ones load it (well under 1 s).
+compilation (about 30 s here at load 2), later ones load it (well under 1 s).
 """
 
 from lmi.ipm.kernels.iteration import (
