@@ -22,6 +22,7 @@ __all__ = [
     "UNIT",
     "assert_readable",
     "capture",
+    "coincident_note",
     "curves",
     "hatched_spans",
     "hline_values",
@@ -89,10 +90,32 @@ def title_inside(fig: Figure) -> bool:
     return bool(box.x0 >= whole.x0 and box.x1 <= whole.x1 and box.y0 >= whole.y0 and box.y1 <= whole.y1)
 
 
-def _same_data(a: Line2D, b: Line2D) -> bool:
-    xa, ya = np.asarray(a.get_xdata(), float), np.asarray(a.get_ydata(), float)
-    xb, yb = np.asarray(b.get_xdata(), float), np.asarray(b.get_ydata(), float)
-    return xa.shape == xb.shape and ya.shape == yb.shape and np.allclose(xa, xb) and np.allclose(ya, yb)
+def _on_top(ax: Axes, a: Line2D, b: Line2D, height: float) -> bool:
+    """Whether ``a`` and ``b`` lie within 0.2 % of ``height`` (the panel's data range) everywhere
+    inside the panel's time range."""
+    xa, xb = np.asarray(a.get_xdata(), float), np.asarray(b.get_xdata(), float)
+    if xa.shape != xb.shape or not np.allclose(xa, xb):
+        return False
+    return bool(np.all(np.abs(_shown(ax, a) - _shown(ax, b)) <= 0.002 * height))
+
+
+def _shown(ax: Axes, line: Line2D) -> np.ndarray:
+    """The values of ``line`` inside the x range of ``ax`` (log10 on a log axis)."""
+    x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+    lo, hi = sorted(ax.get_xlim())
+    y = y[(x >= lo) & (x <= hi)]
+    return np.log10(y) if ax.get_yscale() == "log" else y
+
+
+def coincident_note(ax: Axes) -> list[set[str]]:
+    """The groups of runs the note of ``ax`` names as drawn on top of each other."""
+    legend = ax.get_legend()
+    notes = [] if legend is None else [legend.get_title().get_text()]
+    notes = [text for text in notes if legend.get_title().get_gid() == "coincident-runs"]
+    if not notes:
+        return []
+    body = " ".join(notes[0].split("\n")).split(": ", 1)[1]
+    return [set(group.split(" = ")) for group in body.split("; ")]
 
 
 def assert_readable(fig: Figure, names: list[str]) -> None:
@@ -100,8 +123,9 @@ def assert_readable(fig: Figure, names: list[str]) -> None:
 
     Every visible axes has data (a curve) and an x and a y label that carry a unit; the title
     lies inside the figure; in every axes, the runs' curves have pairwise different colours and
-    two runs drawing the same data differ in line style; each run keeps one (colour, line
-    style) in the whole figure, and no two runs share it.
+    two runs drawn on top of each other (closer than 0.2 % of the panel's range everywhere)
+    differ in line style or are named together in the panel's note; each run keeps one
+    (colour, line style) in the whole figure, and no two runs share it.
     """
     assert title_inside(fig), fig.get_suptitle()
     style_of: dict[str, tuple[Any, Any]] = {}
@@ -113,10 +137,17 @@ def assert_readable(fig: Figure, names: list[str]) -> None:
         runs = [line for line in curves(ax) if line.get_label() in names]
         colours = [str(line.get_color()) for line in runs]
         assert len(set(colours)) == len(colours), f"{where}: a colour repeats: {colours}"
-        for i, line in enumerate(runs):  # runs that lie on top of each other differ in line style
-            for other in runs[i + 1 :]:
-                if _same_data(line, other):
-                    assert line.get_linestyle() != other.get_linestyle(), f"{where}: overlapping runs"
+        if runs:
+            shown = np.concatenate([_shown(ax, line) for line in runs])
+            height = float(np.ptp(shown[np.isfinite(shown)])) if np.isfinite(shown).any() else 0.0
+            groups = coincident_note(ax)
+            for i, line in enumerate(runs):  # runs on top of each other: another style, or named
+                for other in runs[i + 1 :]:
+                    if _on_top(ax, line, other, height):
+                        named = any({line.get_label(), other.get_label()} <= g for g in groups)
+                        assert named or line.get_linestyle() != other.get_linestyle(), (
+                            f"{where}: {line.get_label()} and {other.get_label()} on top of each other"
+                        )
         for line in runs:
             style = (str(line.get_color()), str(line.get_linestyle()))
             assert style_of.setdefault(line.get_label(), style) == style, f"{line.get_label()} changes style"

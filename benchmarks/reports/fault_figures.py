@@ -112,8 +112,8 @@ def fault_case_group_figure(
         ax_u.set_ylabel("wheel torque (N m)\napplied, commanded dashed")
         ax_h.set_ylabel("wheel momentum (N m s)")
         if col == 0:
-            add_legend(ax_a)
-            add_legend(ax_u)
+            add_legend(ax_a, outside=False)
+            add_legend(ax_u, outside=False)
     note = (
         " (fault windows shaded, rank-deficient windows hatched; dotted: limits and recovery band; "
         "commands clipped at 3x for display)"

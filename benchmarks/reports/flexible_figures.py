@@ -22,6 +22,7 @@ from benchmarks.families.flexible.metrics import flexible_metrics
 from benchmarks.reports.figure_style import (
     add_legend,
     limit_lines,
+    note_coincident,
     run_styles,
     shade_window,
     steady_zoom,
@@ -62,7 +63,8 @@ def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], 
         line style: the rotation error on a log axis and ``max_i |u_i|`` with the residual
         window (the last :data:`RESIDUAL_TAIL` s) shaded and the torque limits dotted;
         ``max_i |u_i|`` again on the residual window alone; ``eta_1`` with the +-modal bounds
-        dotted; ``max_j |v_j|`` of the runs whose PZT commands are not all zero (the panel is
+        dotted (labelled with the runs that have them); runs drawn on top of each other named
+        in a note; ``max_j |v_j|`` of the runs whose PZT commands are not all zero (the panel is
         left out when no run drives them).
     """
     styles = run_styles(len(items))
@@ -100,9 +102,12 @@ def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], 
         limit_lines(ax_u, u_limit, f"limit {u_limit:g} N m", both=False)
         ax_u.set_ylim(top=max(ax_u.get_ylim()[1], 1.08 * u_limit))
     if ax_m is not None:
-        bounds = {_settings(rec).get("modal_bound") for _, rec, _ in items}
-        for bound in sorted(float(b) for b in bounds if b is not None):
-            limit_lines(ax_m, bound, f"modal bound |eta_i| <= {bound:g}")
+        bounds: dict[float, list[str]] = {}
+        for name, rec, _ in items:
+            if _settings(rec).get("modal_bound") is not None:
+                bounds.setdefault(float(_settings(rec)["modal_bound"]), []).append(name)
+        for bound, names_bounded in sorted(bounds.items()):
+            limit_lines(ax_m, bound, f"|eta_i| <= {bound:g} ({', '.join(names_bounded)})")
     residual = (max(0.0, t_end - RESIDUAL_TAIL), t_end)
     for ax in (ax_e, ax_u):
         shade_window(ax, residual, t_end, f"residual window (last {RESIDUAL_TAIL:g} s)")
@@ -115,11 +120,13 @@ def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], 
         ax_m.set_ylabel("eta_1 (kg^1/2 m)")
     if ax_v is not None:
         ax_v.set_ylabel(f"max_j |v_j| ({PZT_UNIT})")
-    for ax in (a for a in (ax_e, ax_u, ax_z, ax_m, ax_v) if a is not None):
+    names = [name for name, _, _ in items]
+    panels = [a for a in (ax_e, ax_u, ax_z, ax_m, ax_v) if a is not None]
+    for ax in panels:
         ax.set_xlabel(_TIME)
         ax.xaxis.set_tick_params(labelbottom=True)
         ax.grid(alpha=0.3)
-        add_legend(ax, ncols=2 if len(items) > 6 else 1)
+        add_legend(ax, note=note_coincident(ax, names, residual if ax is ax_z else None))
     wrapped_title(fig, title)
     return fig
 

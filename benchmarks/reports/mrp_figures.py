@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from benchmarks.reports.figure_style import (
     add_legend,
     limit_lines,
+    note_coincident,
     run_styles,
     shade_window,
     steady_zoom,
@@ -65,7 +66,8 @@ def mrp_group_figure(items: Sequence[tuple[dict, dict]], title: str) -> Figure:
         dotted; ``max_i |u_i|`` again, limited to the steady window (the initial transient left
         out). Right column, when the experiment has a disturbance torque or an estimate: one
         panel per axis with the true torque (black) and each estimating run's estimate, the
-        late window (where the estimate's error is measured) shaded.
+        late window (where the estimate's error is measured) shaded. Runs drawn on top of each
+        other are named in a note of the panel.
     """
     fig = Figure(figsize=(13.0, 9.5), layout="constrained")
     FigureCanvasAgg(fig)
@@ -118,11 +120,15 @@ def mrp_group_figure(items: Sequence[tuple[dict, dict]], title: str) -> Figure:
     ax_z.set_ylabel("max_i |u_i| (N m)")
     for i, ax in enumerate(ax_d):
         ax.set_ylabel(f"disturbance torque, {'xyz'[i]} (N m)")
+    names = [rec["controller"] for rec, _ in items]
+    notes = {ax: note_coincident(ax, names) for ax in (ax_e, ax_u)}
+    notes[ax_z] = note_coincident(ax_z, names, steady)
+    notes.update({ax: note_coincident(ax, [f"{name} estimate" for name in names]) for ax in ax_d})
     for ax in (ax_e, ax_u, ax_z, *ax_d):
         ax.set_xlabel(_TIME)
         ax.xaxis.set_tick_params(labelbottom=True)
         ax.grid(alpha=0.3)
-        add_legend(ax)
+        add_legend(ax, note=notes[ax])
     wrapped_title(fig, title)
     return fig
 
