@@ -14,6 +14,7 @@ import numpy as np
 from figure_checks import (
     UNIT,
     assert_readable,
+    coincident_note,
     curves,
     hatched_spans,
     hline_values,
@@ -310,6 +311,28 @@ def test_mrp_figure_without_disturbance_or_estimates_leaves_the_torque_panels_ou
     assert [ax.get_ylabel() for ax in visible_axes(fig)] == ["error angle (deg)", "max_i |u_i| (N m)",
                                                             "max_i |u_i| (N m)"]
     assert_readable(fig, ["BS"])
+
+
+def test_runs_on_top_of_each_other_are_named_in_the_legend():
+    """Four runs with one error curve (F2's boundary layers early in a slew): the three line
+    styles cannot keep them apart, the legend's head names them; a run 1 % of the panel's range
+    away is not among them."""
+    rng = np.random.default_rng(7)
+    same = _flex_trace(rng, avc=False)
+    apart = {**same, "error_deg": same["error_deg"] + 0.01 * np.ptp(np.log10(same["error_deg"])),
+             "u": same["u"] + 0.01 * np.ptp(same["u"])}
+    items = [(f"CSMC_eps{i}", _flex_rec(), same) for i in range(4)] + [("MTSMC", _flex_rec(), apart)]
+    names = [name for name, _, _ in items]
+    fig = flexible_group_figure(items, "F2")
+    err = visible_axes(fig)[0]
+    assert coincident_note(err) == [set(names[:4])]
+    assert_readable(fig, names)
+    head = err.get_legend().get_title().get_text().replace("\n", " ")
+    assert head.startswith("on top of each other: CSMC_eps0 = ")
+    solo = flexible_group_figure(items[3:], "F2")  # CSMC_eps3 and MTSMC: apart but for eta_1
+    err, tor, zoom, mode = visible_axes(solo)
+    assert coincident_note(err) == coincident_note(tor) == coincident_note(zoom) == []
+    assert coincident_note(mode) == [{"CSMC_eps3", "MTSMC"}]
 
 
 def test_run_styles_never_repeat_a_colour_and_cycle_the_line_styles():
