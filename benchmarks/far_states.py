@@ -24,6 +24,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from benchmarks.core.jsonable import write_json
 from benchmarks.stress import StressProblem, make_problem
 
 __all__ = ["FAR_DISTANCES", "far_problems", "feasible_radius", "format_far", "run_far"]
@@ -137,7 +138,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``python -m benchmarks.far_states [--sizes 2 3 4 5 6] [--seeds 0 1 2 3]
     [--distances 10 1e3 1e6] [--vertices 2] [--repeats 5] [--out FILE]``."""
     import argparse
-    import json
     import os
 
     parser = argparse.ArgumentParser(
@@ -153,8 +153,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(format_far(records))
     print(f"{os.cpu_count()} CPUs, load average {os.getloadavg()}")
     if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            json.dump(records, fh, indent=2)
+        write_json(args.out, records)
     return 0
 
 

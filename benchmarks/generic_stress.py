@@ -45,6 +45,7 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from scipy.linalg import expm
 
+from benchmarks.core.jsonable import write_json
 from benchmarks.stress import SAMPLE_TIME, StressProblem, lqr_contraction, lqr_witness, witness_bound
 from toolkit_common.errors import InvalidArgumentError
 
@@ -331,8 +332,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     for prob in generic_set(args.sizes, args.vertices, args.seeds):
         records += run_generic([prob], references=args.references, ipm=not args.no_ipm)
         if args.out:  # written as it goes: the large problems take minutes
-            with open(args.out, "w", encoding="utf-8") as fh:
-                json.dump(records, fh, indent=2)
+            write_json(args.out, records)
     print(format_generic(merge_records(records)))
     print(f"load average {os.getloadavg()}")
     return 0

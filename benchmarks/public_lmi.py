@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.core.jsonable import write_json
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["DATA_DIR", "PUBLISHED_OPTIMA", "format_public", "load_case", "run_public"]
@@ -133,7 +134,6 @@ def format_public(records: Sequence[dict]) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m benchmarks.public_lmi [--cases control2 control3 control4] [--repeats 3] [--out DIR]``."""
     import argparse
-    import json
     import os
     import platform
 
@@ -157,7 +157,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
         (out / "results.md").write_text(text, encoding="utf-8")
-        (out / "results.json").write_text(json.dumps(records, indent=2), encoding="utf-8")
+        write_json(out / "results.json", records)
     return 0
 
 

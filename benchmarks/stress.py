@@ -40,6 +40,7 @@ from typing import Literal
 import numpy as np
 from scipy.linalg import expm, solve_discrete_are
 
+from benchmarks.core.jsonable import write_json
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["StressProblem", "make_problem", "stress_set"]
@@ -322,7 +323,6 @@ def format_stress(records: Sequence[dict]) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m benchmarks.stress [--sizes 6 10 14] [--vertices 2 8] [--seeds 0 1 2] [--out FILE]``."""
     import argparse
-    import json
     import os
 
     parser = argparse.ArgumentParser(description="the seeded stress set: IPM against cvxpy + Clarabel")
@@ -335,8 +335,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(format_stress(records))
     print(f"load average {os.getloadavg()}")
     if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            json.dump(records, fh, indent=2)
+        write_json(args.out, records)
     return 0
 
 

@@ -29,7 +29,7 @@ def test_wheel_scenarios_take_the_paper_scenario_and_controller_defaults():
     kinds = [(f.wheel, f.kind) for f in case_faults(sc)]
     assert kinds == [(4, "outage"), (1, "sinusoidal"), (2, "stuck")]
     assert sc.to_dict()["family"] == "wheel"
-    assert len(fault_cases()) == 20
+    assert len(fault_cases(experiments=["W1", "W2", "W3", "W4"])) == 20 and len(fault_cases()) == 52
 
 
 @pytest.mark.parametrize(

@@ -1,60 +1,101 @@
-"""The factor of the IPM's Schur complement (:func:`lmi.ipm.solver._factor`): ``R`` with
-``R'R = P P'``, by Cholesky of ``H = P P'`` or by QR of ``P'``, and a ``LinAlgError`` (which the
-solver turns into the status ``numerical_error``) when ``H`` is singular or not finite; and
-:func:`lmi.ipm.solver._cholesky`, which factors a well-conditioned ``H`` and hands a singular one
-to QR."""
+"""The factors of the IPM's Newton systems, computed by BLAS and LAPACK from compiled code
+(:mod:`lmi.ipm.kernels.lapack`): ``H = P'P`` (``dsyrk``), its upper Cholesky factor
+(``dpotrf``) with the pivot test that switches to QR (:func:`lmi.ipm.kernels.iteration._factor_ok`),
+and the QR factorisation of ``P`` (``dgeqrf``) with its Householder reflectors. Each is the
+same, bit for bit, as the numpy / scipy call the solver made from Python before (the solver's
+iterates on paper P were measured bitwise equal), and each reproduces what it factors."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.linalg.lapack import dpotrf
 
+from lmi.ipm.kernels.iteration import _factor_ok
+from lmi.ipm.kernels.lapack import cholesky_upper, householder_qr, schur_complement
 from lmi.ipm.kernels.step import _householder, _newton_qr
-from lmi.ipm.solver import _cholesky, _factor
+from lmi.ipm.solver import QR_SWITCH
 
 RNG = np.random.default_rng(7)
-P_GOOD = RNG.standard_normal((5, 12))
+P_GOOD = RNG.standard_normal((5, 12))  # P' (n = 5 variables, packed size 12)
 
 
-@pytest.mark.parametrize("use_qr", [False, True])
-def test_the_factor_reproduces_the_schur_complement(use_qr: bool) -> None:
-    r_fac, qr_used, _householder = _factor(P_GOOD, use_qr)
-    assert qr_used == use_qr  # a well-conditioned H keeps Cholesky, and QR stays once chosen
-    assert np.allclose(np.tril(r_fac, -1), 0.0)
-    h = P_GOOD @ P_GOOD.T
-    # measured 1.3e-16 (Cholesky) and 2.6e-16 (QR) relative to max |H|; bound with a margin of ~40
+def _schur(pt: np.ndarray) -> np.ndarray:
+    h = np.full((pt.shape[0], pt.shape[0]), np.nan)
+    schur_complement(np.ascontiguousarray(pt), h)
+    return h
+
+
+def _cholesky(h: np.ndarray) -> tuple[int, np.ndarray]:
+    r_fac = np.full_like(h, np.nan)
+    info = cholesky_upper(h, np.empty_like(h), r_fac)
+    return int(info), r_fac
+
+
+def _qr(pt: np.ndarray) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    n, m = pt.shape
+    qr_h, qr_tau, r_fac = np.full((n, m), np.nan), np.full(n, np.nan), np.full((n, n), np.nan)
+    info = householder_qr(np.ascontiguousarray(pt), qr_h, qr_tau, r_fac)
+    return int(info), qr_h, qr_tau, r_fac
+
+
+@pytest.mark.parametrize("shape", [(5, 12), (61, 349), (3, 3)])
+def test_the_schur_complement_is_numpys_product(shape: tuple[int, int]) -> None:
+    pt = np.random.default_rng(shape[0]).standard_normal(shape)
+    h = _schur(pt)
+    assert np.array_equal(h, h.T)
+    assert np.array_equal(h, pt @ pt.T)  # numpy forms P'P by the same dsyrk
+
+
+@pytest.mark.parametrize("shape", [(5, 12), (61, 349)])
+def test_the_cholesky_factor_is_lapacks_and_reproduces_h(shape: tuple[int, int]) -> None:
+    pt = np.random.default_rng(shape[0]).standard_normal(shape)
+    h = pt @ pt.T
+    h_before = h.copy()
+    info, r_fac = _cholesky(h)
+    assert info == 0 and np.array_equal(h, h_before)  # h itself is left as it was
+    assert np.array_equal(r_fac, dpotrf(h, lower=0, clean=1)[0])
+    assert np.all(np.tril(r_fac, -1) == 0.0)
+    # measured 1.3e-16 relative to max |H| (5 x 12); bound with a margin of ~40
     assert np.max(np.abs(r_fac.T @ r_fac - h)) <= 1e-14 * np.max(np.abs(h))
-
-
-@pytest.mark.parametrize("use_qr", [False, True])
-def test_a_variable_without_coefficients_makes_a_singular_complement(use_qr: bool) -> None:
-    p = P_GOOD.copy()
-    p[2] = 0.0  # a zero row of P: an exactly zero pivot, every entry finite
-    with pytest.raises(np.linalg.LinAlgError, match="singular Schur complement"):
-        _factor(p, use_qr)
-
-
-@pytest.mark.parametrize("use_qr", [False, True])
-def test_a_non_finite_complement_is_refused(use_qr: bool) -> None:
-    p = P_GOOD.copy()
-    p[1, 3] = np.nan  # non-finite entries, no zero pivot
-    with pytest.raises(np.linalg.LinAlgError, match="singular Schur complement"):
-        _factor(p, use_qr)
-
-
-def test_cholesky_factors_a_well_conditioned_complement() -> None:
-    h = P_GOOD @ P_GOOD.T
-    r_fac, to_qr = _cholesky(h)
-    assert to_qr is False and r_fac is not None
-    # measured 1.3e-16 relative to max |H| (as above); bound with a margin of ~40
-    assert np.max(np.abs(r_fac.T @ r_fac - h)) <= 1e-14 * np.max(np.abs(h))
+    assert _factor_ok(h, r_fac, QR_SWITCH)
 
 
 @pytest.mark.parametrize("row", [0, 2, 4])
-def test_cholesky_hands_a_singular_complement_to_qr(row: int) -> None:
+def test_a_singular_complement_goes_to_qr(row: int) -> None:
+    """A zero row of ``P'`` (a variable without coefficients at this iterate): Cholesky fails or
+    leaves a zero pivot, and the pivot test says "QR"."""
     p = P_GOOD.copy()
     p[row] = 0.0
-    assert _cholesky(p @ p.T) == (None, True)
+    h = p @ p.T
+    info, r_fac = _cholesky(h)
+    assert info != 0 or not _factor_ok(h, r_fac, QR_SWITCH)
+
+
+def test_the_pivot_test_measures_relative_pivots() -> None:
+    """Two nearly parallel rows of ``P'``: the second pivot relative to ``sqrt(H_22)`` is the
+    sine of their angle, so the test passes above the switch and fails below it."""
+    p = P_GOOD[:2].copy()
+    for sine, ok in ((1e-3, True), (1e-9, False)):
+        p[1] = p[0] + sine * np.linalg.norm(p[0]) * P_GOOD[2] / np.linalg.norm(P_GOOD[2])
+        h = p @ p.T
+        info, r_fac = _cholesky(h)
+        assert info == 0 and bool(_factor_ok(h, r_fac, QR_SWITCH)) is ok
+    h = P_GOOD @ P_GOOD.T
+    _, r_fac = _cholesky(h)
+    r_fac[1, 3] = np.nan  # a non-finite factor is never accepted
+    assert not _factor_ok(h, r_fac, QR_SWITCH)
+
+
+def test_the_qr_factors_are_numpys() -> None:
+    info, qr_h, qr_tau, r_fac = _qr(P_GOOD)
+    h_raw, tau = np.linalg.qr(P_GOOD.T, mode="raw")
+    assert info == 0
+    assert np.array_equal(qr_h, h_raw) and np.array_equal(qr_tau, tau)
+    assert np.array_equal(r_fac, np.triu(h_raw[:, :5].T))
+    # R'R = P'P: measured 2.6e-16 relative to max |H|; bound with a margin of ~40
+    h = P_GOOD @ P_GOOD.T
+    assert np.max(np.abs(r_fac.T @ r_fac - h)) <= 1e-14 * np.max(np.abs(h))
 
 
 def _apply_q(h: np.ndarray, tau: np.ndarray, y: np.ndarray, transpose: bool) -> np.ndarray:
@@ -64,17 +105,13 @@ def _apply_q(h: np.ndarray, tau: np.ndarray, y: np.ndarray, transpose: bool) -> 
 
 
 def test_the_householder_factors_reproduce_p_and_are_orthogonal() -> None:
-    r_fac, qr_used, householder = _factor(P_GOOD, True)
-    assert qr_used and householder is not None
-    h, tau = householder
+    _, h, tau, r_fac = _qr(P_GOOD)
     m, n = P_GOOD.shape[1], P_GOOD.shape[0]
     # Q [R; 0] = P' column by column, and Q'Q = I (measured 4.4e-16 and 3.3e-16)
     cols = [_apply_q(h, tau, np.concatenate([r_fac[:, i], np.zeros(m - n)]), False) for i in range(n)]
     assert np.max(np.abs(np.array(cols).T - P_GOOD.T)) <= 1e-14 * np.max(np.abs(P_GOOD))
     eye = np.array([_apply_q(h, tau, _apply_q(h, tau, e, False), True) for e in np.eye(m)])
     assert np.max(np.abs(eye - np.eye(m))) <= 1e-14
-    # Cholesky leaves no Householder factors
-    assert _factor(P_GOOD, False)[2] is None
 
 
 @pytest.mark.parametrize("cond", [1e6, 1e12])
@@ -90,7 +127,7 @@ def test_the_qr_phase_newton_solve_meets_the_dual_equation_on_ill_conditioned_p(
     p = u_mat @ np.diag(np.logspace(0.5 * np.log10(cond), -0.5 * np.log10(cond), n)) @ v_mat.T
     pt = np.ascontiguousarray(p.T)
     rd, v = 1e-6 * rng.normal(size=n), rng.normal(size=m)
-    r_fac, _, (h, tau) = _factor(pt, True)
+    _, h, tau, r_fac = _qr(pt)
     dx, ds, dz = _newton_qr(pt, h, tau, r_fac, rd, np.zeros(m), v, 1.0)
     assert np.linalg.norm(pt @ dz + rd) <= 1e-3 * np.linalg.norm(rd)
     assert np.array_equal(ds, v - dz)

@@ -255,3 +255,49 @@ def test_a_run_that_converges_again_after_a_stall_is_not_cut(problems, monkeypat
     res = BlockLMISolver(c, blocks).solve()
     assert res.status == "optimal"
     assert abs(res.primal_objective - PUBLISHED["control3"]) <= 1e-6 * PUBLISHED["control3"]
+
+
+# -- blocks of very different scale ---------------------------------------------------------------
+def _scaled_control2(problems, exponent: int):
+    """control2 with its second block (constant and coefficients) multiplied by ``10**exponent``:
+    the same feasible set and optimum, 8.3."""
+    c, blocks = problems["control2"]
+    scale = 10.0**exponent
+    return c, [blocks[0], (blocks[1][0] * scale, blocks[1][1] * scale)]
+
+
+def _right(blocks, c, res) -> bool:
+    """The published optimum (to its 7 digits) and every recomputed LMI to -1e-7 relative."""
+    margins = [_rel_min_eig(s) for s in _slacks(blocks, res.x)]
+    optimum = PUBLISHED["control2"]
+    return abs(float(c @ res.x) - optimum) <= 1e-6 * optimum and min(margins) >= -1e-7
+
+
+@pytest.mark.parametrize("exponent", [-200, -170, -50, 20, 50, 150])
+def test_a_block_far_out_of_scale_never_gives_a_wrong_optimal(problems, exponent):
+    """Measured before the per-block and objective tests: "optimal" at c'x = 7.1e12 for 1e50 (the
+    residuals and gap relative to norms over all blocks, a dual objective of 2.5e23) and at
+    c'x = 1.3e-9 with the small block violated entirely (relative eigenvalue -1) from 1e-170
+    down. Now each ends with a failure status or at the optimum."""
+    c, blocks = _scaled_control2(problems, exponent)
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status != "optimal" or _right(blocks, c, res)
+
+
+@pytest.mark.parametrize("exponent", [-20, 20])
+def test_without_block_weights_a_block_out_of_scale_never_gives_a_wrong_optimal(problems, monkeypatch,
+                                                                                 exponent):
+    """Unweighted, "optimal" came wrong from 1e-12 down and at 1e20 and above (measured)."""
+    monkeypatch.setattr(ipm_blocks, "BLOCK_WEIGHT_SPREAD", np.inf)
+    c, blocks = _scaled_control2(problems, exponent)
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status != "optimal" or _right(blocks, c, res)
+
+
+@pytest.mark.parametrize("exponent", [-12, 0, 8])
+def test_the_block_tests_keep_the_optimum_where_it_was_found(problems, exponent):
+    """The same data within the weights' reach still end "optimal" at the optimum (measured
+    25-47 iterations for 1e-12 to 1e8)."""
+    c, blocks = _scaled_control2(problems, exponent)
+    res = BlockLMISolver(c, blocks).solve()
+    assert res.status == "optimal" and _right(blocks, c, res)

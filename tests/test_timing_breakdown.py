@@ -21,7 +21,7 @@ def result():
 def test_the_parts_are_one_call_per_iteration_and_sum_within_the_solver(result):
     iterations = result["iterations_per_solve"]
     assert iterations >= 1
-    assert result["parts"]["newton_step"]["calls_per_solve"] == pytest.approx(iterations)
+    assert result["parts"]["rows_iteration"]["calls_per_solve"] == pytest.approx(iterations)
     assert result["parts"]["residuals"]["calls_per_solve"] == pytest.approx(iterations + 1)
     kernels = sum(part["per_solve_us"] for part in result["parts"].values())
     assert kernels <= result["solver_us"] <= result["kothare_solve_us"]
@@ -29,8 +29,23 @@ def test_the_parts_are_one_call_per_iteration_and_sum_within_the_solver(result):
 
 
 def test_the_wrappers_are_removed(result):
-    assert solver_module._kernels.newton_step.__name__ == "newton_step"
-    assert solver_module._factor.__name__ == "_factor"
+    assert solver_module._kernels.rows_iteration.__name__ == "rows_iteration"
+    assert solver_module._kernels.residuals.__name__ == "residuals"
+    assert solver_module.BlockLMISolver.solve.__name__ == "solve"
+
+
+def test_every_replayed_iteration_has_a_scaling_a_factor_and_a_step(result):
+    """Each iterate of the first solves is replayed part by part: the scaling and the step
+    always, ``H`` and its Cholesky factor in the Cholesky phase, QR in the QR phase (both on
+    the iterate where Cholesky fails), so the two phases' shares add up to at least one."""
+    parts = result["iteration_parts"]
+    assert result["replayed_iterations"] >= 1
+    assert parts["NT scaling and P"]["share_of_iterations"] == 1.0
+    assert parts["Newton step (2 solves, step lengths, update)"]["share_of_iterations"] == 1.0
+    cholesky = parts.get("Cholesky of H (dpotrf)", {"share_of_iterations": 0.0})["share_of_iterations"]
+    qr = parts.get("QR of P (dgeqrf), QR phase", {"share_of_iterations": 0.0})["share_of_iterations"]
+    assert cholesky + qr >= 1.0
+    assert all(part["per_iteration_us"] > 0.0 for part in parts.values())
 
 
 def test_the_flop_count_of_the_floor():
@@ -42,7 +57,8 @@ def test_the_flop_count_of_the_floor():
 
 def test_the_report_names_every_part(result):
     text = bd.format_breakdown([result], {"empty_cache_s": 12.0, "filled_cache_s": 0.5})
-    for name in ("newton_step", "Python around the kernels", "Floor, arithmetic", "12.0 s with an empty"):
+    for name in ("rows_iteration", "Python around the kernels", "Inside the iteration", "NT scaling and P",
+                 "Floor, arithmetic", "12.0 s with an empty"):
         assert name in text
 
 

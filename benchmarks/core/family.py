@@ -63,11 +63,15 @@ class Field:
     """One scenario field of a family: its default and the check of a value on its own.
 
     ``check(value, where) -> normalised value`` raises :class:`ConfigError` naming ``where``.
+    ``written_at_default=False`` leaves the field out of :meth:`Scenario.to_dict` (records, case
+    ids) while it holds its default: a field added to a family later keeps the records and case
+    ids of the cases that do not set it.
     """
 
     default: Any
     check: Callable[[Any, str], Any]
     doc: str = ""
+    written_at_default: bool = True
 
 
 @dataclass(frozen=True)

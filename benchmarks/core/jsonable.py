@@ -2,6 +2,7 @@
 
 Records (``results.json``, the sweep store) and the timing report (``timing.json``) are written
 with ``allow_nan=False``; :func:`json_safe` is the one conversion both go through.
+:func:`write_json` is the one way the stand-alone benchmark scripts write their records.
 
 Examples
 --------
@@ -13,12 +14,15 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
+import os
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["json_safe"]
+__all__ = ["json_safe", "write_json"]
 
 
 def json_safe(value: Any) -> Any:
@@ -35,3 +39,15 @@ def json_safe(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
+
+
+def write_json(path: str | os.PathLike[str], value: Any, indent: int = 2) -> None:
+    """Write ``value`` as JSON to ``path`` (its directory created), atomically: a run interrupted
+    while writing leaves the previous file whole. NaN and inf are written as JSON's
+    ``NaN``/``Infinity`` extension, which Python's ``json`` reads back (strict files go through
+    :func:`json_safe`)."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    partial = target.with_name(target.name + ".partial")
+    partial.write_text(json.dumps(value, indent=indent), encoding="utf-8")
+    os.replace(partial, target)

@@ -209,10 +209,17 @@ class Scenario:
         """Plain JSON-ready values of every field (the inverse of :meth:`from_dict`).
 
         The default family is not written, so the records of paper P's satellite keep the
-        fields (and the case ids) they had before families existed.
+        fields (and the case ids) they had before families existed; nor is a field declared
+        with ``written_at_default=False`` (:class:`benchmarks.core.family.Field`) while it
+        holds its default.
         """
         out: dict[str, Any] = {} if self._family == DEFAULT_FAMILY else {"family": self._family}
-        items = list(self._values.items())
+        fields = get_family(self._family).fields
+        items = [
+            (key, value)
+            for key, value in self._values.items()
+            if fields[key].written_at_default or value != fields[key].default
+        ]
         first, rest = items[:1], items[1:]
         settings = {k: list(v) if isinstance(v, tuple) else v for k, v in sorted(self._settings.items())}
         for key, value in [*first, ("controller", self._controller), ("settings", settings), *rest]:

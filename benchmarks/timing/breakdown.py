@@ -4,12 +4,15 @@
 
 For each polytope (paper P's satellite, 2 or 8 vertices, the default ``ipm`` path of
 :class:`lmi.KothareProblem`, warm-started along the closed loop of
-:func:`benchmarks.timing.rmpc.closed_loop_states`) every compiled kernel of an iteration and the
-factorisation of the Schur complement are timed by wrapping them, in CPU time of this thread
-(``time.thread_time``: a shared machine's other processes inflate wall time, much less the CPU
-time of this one). The table gives, per solve and per iteration, the time of each part, of the
-solver (:meth:`lmi.BlockLMISolver.solve`) and of the whole ``KothareProblem.solve`` (scaling,
-solver, certificate, gain); what the kernels leave of the solver's time is the Python around them.
+:func:`benchmarks.timing.rmpc.closed_loop_states`) every compiled kernel the solver calls (the
+residuals and the iteration itself, :mod:`lmi.ipm.kernels.iteration`) is timed by wrapping it,
+in CPU time of this thread (``time.thread_time``: a shared machine's other processes inflate
+wall time, much less the CPU time of this one). The table gives, per solve and per iteration,
+the time of each call, of the solver (:meth:`lmi.BlockLMISolver.solve`) and of the whole
+``KothareProblem.solve`` (scaling, solver, certificate, gain); what the kernels leave of the
+solver's time is the Python around them. Inside the iteration, the parts (the NT scaling with
+``P``, ``H = P'P``, its Cholesky factor, the QR factorisation in the QR phase, the Newton step)
+are replayed one by one, each timed alone, on the iterates of the first solves of the loop.
 
 The floor, two ways, for the dense linear algebra one iteration of this method cannot avoid at the
 problem's dimensions (``n`` variables, packed size ``m``, blocks of order ``k_j``): the Schur
@@ -43,16 +46,19 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.machine import machine_info
+from lmi.threads import SingleThreadBlas
 
 __all__ = [
     "breakdown", "breakdown_sections", "compile_cost", "floor_per_iteration", "format_breakdown", "main",
+    "replay_iteration",
 ]
 
-#: The parts of an iteration that are timed: the compiled kernels (module ``lmi.ipm.kernels``)
-#: and the factorisations of the Schur complement (module ``lmi.ipm.solver``).
-KERNELS = ("residuals", "scaling_and_schur_rows", "scaling_and_schur_grouped", "newton_step",
-           "cholesky_blocks", "pack")
-FACTORS = ("_factor", "_cholesky")
+#: The compiled kernels the solver calls (module ``lmi.ipm.kernels``), timed by wrapping them.
+KERNELS = ("residuals", "rows_iteration", "grouped_iteration", "cholesky_blocks", "pack")
+#: The iterations of this many solves (the first of the loop) are replayed part by part, each
+#: part ``REPEATS`` times (the median counts).
+REPLAYED_SOLVES = 3
+REPEATS = 5
 
 
 def _median_time(fn: Callable[[], Any], repeats: int = 400) -> float:
@@ -96,6 +102,35 @@ def floor_per_iteration(n: int, size: int, orders: Sequence[int], seed: int = 0)
     return parts
 
 
+def replay_iteration(args: tuple) -> dict[str, float]:
+    """The parts of one :func:`lmi.ipm.kernels.rows_iteration` call (its arguments ``args``, copied
+    when it was made), each timed alone: seconds per part, the parts this iterate's phase runs."""
+    from lmi.ipm.kernels import newton_step, scaling_and_schur_rows
+    from lmi.ipm.kernels.iteration import _factor_ok
+    from lmi.ipm.kernels.lapack import cholesky_upper, householder_qr, schur_complement
+
+    (s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+     pair_row, pair_col, kk, lam, pt, h, work, r_fac, qr_h, qr_tau, no_qr_h, no_qr_tau, use_qr, x, theta,
+     r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_out, z_out, chol_out) = args
+    layout = (orders, offsets, ent_row, ent_col, ent_w)
+    sparse = (sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)
+    parts = {"NT scaling and P": _median_time(
+        lambda: scaling_and_schur_rows(s_chol, z, *layout, *sparse, kk, lam, pt))}
+    householder = (no_qr_h, no_qr_tau)
+    if not use_qr:
+        parts["H = P'P (dsyrk)"] = _median_time(lambda: schur_complement(pt, h), REPEATS)
+        parts["Cholesky of H (dpotrf)"] = _median_time(lambda: cholesky_upper(h, work, r_fac), REPEATS)
+        use_qr = not _factor_ok(h, r_fac, qr_switch)
+    if use_qr:
+        parts["QR of P (dgeqrf), QR phase"] = _median_time(lambda: householder_qr(pt, qr_h, qr_tau, r_fac),
+                                                                   REPEATS)
+        householder = (qr_h, qr_tau)
+    parts["Newton step (2 solves, step lengths, update)"] = _median_time(lambda: newton_step(
+        pt, r_fac, *householder, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, *layout,
+        *sparse, s_out, z_out, chol_out), REPEATS)
+    return parts
+
+
 def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
     """Time the parts of the warm solves along the closed loop; see the module notes."""
     import lmi.ipm.solver as solver_module
@@ -111,9 +146,16 @@ def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
     solver = prob._backend._solver
     spent: dict[str, float] = defaultdict(float)
     calls: dict[str, int] = defaultdict(int)
+    captured: list[tuple] = []
+    capture = [True]
+    copying = [0.0]  # CPU time spent copying the captured arguments, taken out of the totals
 
     def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
         def wrapper(*args: Any, **kwargs: Any) -> Any:
+            if name == "rows_iteration" and capture[0]:
+                start = time.thread_time()
+                captured.append(tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args))
+                copying[0] += time.thread_time() - start
             start = time.thread_time()
             out = fn(*args, **kwargs)
             spent[name] += time.thread_time() - start
@@ -122,35 +164,38 @@ def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
         return wrapper
 
     originals = {name: getattr(solver_module._kernels, name) for name in KERNELS}
-    originals_f = {name: getattr(solver_module, name) for name in FACTORS}
     solve = solver.solve
     iterations = 0
     totals = []
     try:
         for name, fn in originals.items():
             setattr(solver_module._kernels, name, timed(name, fn))
-        for name, fn in originals_f.items():
-            setattr(solver_module, name, timed(name, fn))
         solver.solve = timed("BlockLMISolver.solve", solve)
-        for x in states:
-            start = time.thread_time()
+        for count, x in enumerate(states):
+            capture[0] = count < REPLAYED_SOLVES
+            start, copied = time.thread_time(), copying[0]
             sol = prob.solve(x)
-            totals.append(time.thread_time() - start)
+            totals.append(time.thread_time() - start - (copying[0] - copied))
             iterations += sol.iterations or 0
     finally:
         for name, fn in originals.items():
             setattr(solver_module._kernels, name, fn)
-        for name, fn in originals_f.items():
-            setattr(solver_module, name, fn)
         del solver.solve
     count = len(states)
     per_iteration = iterations / count
-    solver_time = spent.pop("BlockLMISolver.solve")
+    solver_time = spent.pop("BlockLMISolver.solve") - copying[0]
     calls.pop("BlockLMISolver.solve")
     parts = {name: {"per_solve_us": 1e6 * t / count, "per_iteration_us": 1e6 * t / iterations,
                     "calls_per_solve": calls[name] / count} for name, t in spent.items()}
     kernels = sum(spent.values())
-    floor = floor_per_iteration(solver.n, solver._layout.size, solver.block_orders)
+    replayed: dict[str, list[float]] = defaultdict(list)
+    with SingleThreadBlas().limit():  # as inside a solve
+        for args in captured:
+            for name, seconds in replay_iteration(args).items():
+                replayed[name].append(seconds)
+        floor = floor_per_iteration(solver.n, solver._layout.size, solver.block_orders)
+    inside = {name: {"per_iteration_us": 1e6 * float(np.sum(t)) / max(len(captured), 1),
+                     "share_of_iterations": len(t) / max(len(captured), 1)} for name, t in replayed.items()}
     rate, flops = floor.pop("flops_per_s"), floor.pop("flops")
     arithmetic = floor.pop("arithmetic")
     return {
@@ -162,6 +207,7 @@ def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
         "python_around_kernels_us": 1e6 * (solver_time - kernels) / count,
         "outside_solver_us": 1e6 * (float(np.sum(totals)) - solver_time) / count,
         "parts": parts,
+        "iteration_parts": inside, "replayed_iterations": len(captured),
         "floor_per_iteration_us": {k: 1e6 * v for k, v in floor.items()},
         "floor_per_solve_us": 1e6 * floor["total"] * per_iteration,
         "flops_per_iteration": flops, "gflops_per_s": 1e-9 * rate,
@@ -221,6 +267,15 @@ def breakdown_sections(results: Sequence[dict[str, Any]], level: str = "##") -> 
                      "| | |")
         lines.append(f"| **KothareProblem.solve** (mean; p50 {res['kothare_solve_p50_us']:.0f}) | "
                      f"{res['kothare_solve_us']:.0f} | | |")
+        if res.get("iteration_parts"):
+            replayed = res["replayed_iterations"]
+            lines += ["", f"Inside the iteration (each part replayed alone on the {replayed} "
+                      "iterates of the first solves; a part that runs in one phase only is averaged over "
+                      "all iterations):", "", "| part | us per iteration | share of iterations |",
+                      "| --- | ---: | ---: |"]
+            for name, part in res["iteration_parts"].items():
+                lines.append(f"| {name} | {part['per_iteration_us']:.1f} | "
+                             f"{part['share_of_iterations']:.2f} |")
         lines += ["", "Floor, calls (the dense linear algebra of one iteration, each call timed alone):", "",
                   "| part | us per iteration |", "| --- | ---: |"]
         for name, value in res["floor_per_iteration_us"].items():

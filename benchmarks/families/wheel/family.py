@@ -45,6 +45,22 @@ time_scale : float
     so such runs are no measurement).
 dt : float
     Control period (s, default 0.04).
+wheel_limits : bool
+    Apply every wheel's torque and momentum limits in the plant (default ``true``; ``false``
+    removes both, for the adaptation-gain study W5; the controllers keep their own bounds).
+viscous_friction, coulomb_friction : float
+    Bearing friction of every wheel in the plant, ``b`` (N m s/rad) and ``c`` (N m), see
+    :class:`models.WheelSatellite` (default 0: off; the controllers do not model it).
+angle_noise : float
+    Standard deviation of the noise on the three measured angles, deg (default 0: off; paper W's
+    sensors are accurate to 0.2 deg), drawn by :class:`models.AttitudeNoiseSensor` with ``seed``.
+d_misalignment : float
+    Error in the distribution matrix, deg (default 0): the plant's wheel axes are the nominal
+    ones, each tilted by this angle in a direction drawn with ``seed``; the controllers keep the
+    nominal ``D``. A tilt of ``a`` deg moves a unit column by ``2 sin(a/2)`` (5 deg: 8.7 %).
+
+The last five fields are written into records and case ids only when they differ from their
+defaults, so the cases that leave them alone keep their records and case ids.
 """
 
 from __future__ import annotations
@@ -59,6 +75,7 @@ from benchmarks.core.family import (
     CaseResult,
     Field,
     PlantFamily,
+    check_bool,
     check_choice,
     check_real,
     check_run_length,
@@ -69,7 +86,7 @@ from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
 
-__all__ = ["WHEEL", "case_faults", "simulate_case"]
+__all__ = ["WHEEL", "case_faults", "misaligned_axes", "simulate_case"]
 
 SCENARIOS = ("S1", "S2", "S3", "S4")
 FAULT_KINDS = ("scenario", "none", "stuck", "sinusoidal", "outage", "effectiveness", "bias")
@@ -123,6 +140,13 @@ FIELDS: Mapping[str, Field] = {
     "duration": Field(None, _optional_positive),
     "time_scale": Field(1.0, lambda v, w: check_real(v, w, low=0.0, high=1.0, low_open=True)),
     "dt": Field(defaults.DT, _positive),
+    "wheel_limits": Field(True, check_bool, written_at_default=False),
+    "viscous_friction": Field(0.0, lambda v, w: check_real(v, w, low=0.0), written_at_default=False),
+    "coulomb_friction": Field(0.0, lambda v, w: check_real(v, w, low=0.0), written_at_default=False),
+    "angle_noise": Field(0.0, lambda v, w: check_real(v, w, low=0.0, high=5.0), written_at_default=False),
+    "d_misalignment": Field(
+        0.0, lambda v, w: check_real(v, w, low=0.0, high=30.0), written_at_default=False
+    ),
 }
 
 
@@ -203,6 +227,35 @@ def case_faults(scenario: Any) -> list[Any]:
     return [WheelFault(scenario.fault_wheel, kind, t_on, t_off, value=value)]
 
 
+def misaligned_axes(D: Any, angle_deg: float, seed: int) -> np.ndarray:
+    """``D`` with every column tilted by ``angle_deg`` toward a direction drawn with ``seed``.
+
+    Each column ``d_j`` turns by exactly ``angle_deg`` about an axis perpendicular to it (the
+    direction of the tilt drawn uniformly from ``numpy.random.default_rng(seed)``); the columns
+    stay unit vectors.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from models import WheelArray
+    >>> d = WheelArray.paper_w().D
+    >>> tilted = misaligned_axes(d, 5.0, 0)
+    >>> np.degrees(np.arccos(np.sum(d * tilted, axis=0))).round(6).tolist()
+    [5.0, 5.0, 5.0, 5.0]
+    """
+    d = np.array(D, dtype=float)
+    rng = np.random.default_rng(seed)
+    angle = math.radians(angle_deg)
+    out = np.empty_like(d)
+    for j in range(d.shape[1]):
+        axis = d[:, j] / np.linalg.norm(d[:, j])
+        v = rng.normal(size=3)
+        v -= axis * float(axis @ v)
+        v /= np.linalg.norm(v)
+        out[:, j] = math.cos(angle) * axis + math.sin(angle) * v
+    return out
+
+
 def _label(scenario: Any) -> str:
     parts = [scenario.controller, scenario.scenario]
     if scenario.fault_kind != "scenario":
@@ -215,6 +268,21 @@ def _label(scenario: Any) -> str:
         parts.append(f"J x{scenario.inertia_scale:g}")
     if scenario.gravity != "pendulous":
         parts.append(scenario.gravity)
+    s, base = scenario.settings, defaults.CONTROLLER_DEFAULTS[scenario.controller]
+    if scenario.controller == "ABFTC":
+        if (s["gamma_g"], s["gamma_theta"]) != (base["gamma_g"], base["gamma_theta"]):
+            g0, gj = s["gamma_g"], s["gamma_theta"]
+            parts.append(f"Gamma {g0:g} I" if g0 == gj else f"Gamma_0 {g0:g} I, Gamma_j {gj:g} I")
+        if s["freeze"]:
+            parts.append("freeze")
+    if not scenario.wheel_limits:
+        parts.append("no wheel limits")
+    if scenario.viscous_friction or scenario.coulomb_friction:
+        parts.append("friction")
+    if scenario.angle_noise:
+        parts.append(f"noise {scenario.angle_noise:g} deg")
+    if scenario.d_misalignment:
+        parts.append(f"D tilted {scenario.d_misalignment:g} deg")
     return " ".join(parts)
 
 
@@ -222,7 +290,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     """Build paper W's satellite, the faults, the controller's polytope and the controller; run; measure."""
     from benchmarks.families.wheel.metrics import fault_metrics
     from benchmarks.families.wheel.plant import wheel_plant
-    from models import FaultSchedule, WheelSatellite
+    from models import AttitudeNoiseSensor, FaultSchedule, WheelArray, WheelSatellite
     from rmpc import simulate
 
     paper = _paper_scenario({"scenario": scenario.scenario})
@@ -232,6 +300,16 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     nominal = WheelSatellite.paper_w(gravity=scenario.gravity)
     scale = scenario.inertia_scale if scenario.inertia_scale is not None else paper.inertia_scales[0]
     plant_sat = nominal if scale == 1.0 else nominal.replace(inertia=scale * nominal.inertia)
+    plant_changes: dict[str, Any] = {}
+    if scenario.viscous_friction or scenario.coulomb_friction:
+        plant_changes["viscous_friction"] = scenario.viscous_friction
+        plant_changes["coulomb_friction"] = scenario.coulomb_friction
+    if scenario.d_misalignment:
+        w = nominal.wheels
+        tilted = misaligned_axes(w.D, scenario.d_misalignment, scenario.seed)
+        plant_changes["wheels"] = WheelArray(tilted, w.torque_max, w.momentum_max, w.wheel_inertia)
+    if plant_changes:
+        plant_sat = plant_sat.replace(**plant_changes)
     spread = scenario.inertia_spread
     if spread is None and scale != 1.0:
         spread = 0.2
@@ -240,11 +318,21 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     n = nominal.n_wheels
     schedule = FaultSchedule(case_faults(scenario), n, duration)
     disturbance = paper.disturbance(scenario.seed, n)
+    limits = scenario.wheel_limits
     plant = wheel_plant(
-        plant_sat, schedule, dt=scenario.dt, substep=defaults.SUBSTEP, wheel_disturbance=disturbance
+        plant_sat,
+        schedule,
+        dt=scenario.dt,
+        substep=defaults.SUBSTEP,
+        wheel_disturbance=disturbance,
+        torque_limit=limits,
+        momentum_limit=limits,
     )
     x0 = paper.initial_state(n)
-    traj = simulate(built.controller, plant, x0, duration=duration)
+    sensor = None
+    if scenario.angle_noise:
+        sensor = AttitudeNoiseSensor(math.radians(scenario.angle_noise), seed=scenario.seed)
+    traj = simulate(built.controller, plant, x0, duration=duration, sensor=sensor)
     metrics = compute_metrics(traj, scenario.u_max, 0.02)
     faults = fault_metrics(traj, schedule, nominal.wheels, threshold=math.radians(defaults.RECOVERY_DEG))
     metrics["faults"] = faults
@@ -256,8 +344,10 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "n_vertices": poly.n_vertices,
         "faults_used": [repr(f) for f in schedule.faults],
         "wheel_disturbance": disturbance is not None,
-        "limits_in_plant": True,
+        "limits_in_plant": limits,
     }
+    if scenario.d_misalignment:
+        extra["plant_D"] = plant_sat.wheels.D.tolist()
     trace: dict[str, np.ndarray] = {}
     if keep_trace:
         trace = {"t": traj.t, "x": traj.x, "u_cmd": traj.u_cmd, "u_applied": traj.u_applied}

@@ -5,7 +5,10 @@ input stage's per-sample log (:class:`models.WheelInputStage`, ``Trajectory.stag
 The record fields of seed section 8 are :func:`recovery_times` (``recovery_time`` per fault
 event), :func:`peak_abs_error` (``peak_abs_err`` per window), :func:`saturated_fraction`
 (``sat_fraction``), :func:`max_abs_momentum` (``max_abs_h``), :func:`momentum_limit_events`
-(``momentum_limit_events``) and :func:`torque_summary` (commanded vs applied torque);
+(``momentum_limit_events``) and :func:`torque_summary` (commanded vs applied torque); beyond
+them, :func:`null_momentum` (``null_momentum``: the wheel momentum the body does not feel, at
+the last fault event and at the end) and :func:`torque_variation_rate` (``torque_tv_rate``: how
+much the applied torques chatter late in the run);
 :func:`fault_metrics` gathers them all (with the rank-deficient windows of the schedule).
 
 Angles are errors from the target ``eta_d = 0``; the yaw error is wrapped to ``(-pi, pi]``.
@@ -31,10 +34,12 @@ __all__ = [
     "fault_metrics",
     "max_abs_momentum",
     "momentum_limit_events",
+    "null_momentum",
     "peak_abs_error",
     "recovery_times",
     "saturated_fraction",
     "torque_summary",
+    "torque_variation_rate",
 ]
 
 #: Recovery threshold: ``max_i |eta_i| <= 2 deg`` (seed 6.10, **assumed**), in rad.
@@ -184,6 +189,58 @@ def torque_summary(traj: Trajectory) -> dict[str, Any]:
     }
 
 
+def null_momentum(traj: Trajectory, wheels: WheelArray, t_from: float) -> dict[str, Any]:
+    """The wheel momentum in the null space of ``D`` (N m s), at ``t_from`` and at the end.
+
+    ``h`` splits into ``D^+ D h`` (the momentum the body exchanges with the wheels) and its
+    null-space part ``P h``, ``P = I - D^+ D``, which no body torque reveals: a controller that
+    keeps a null-space torque after the faults winds the wheels up while the attitude stays put.
+
+    Returns
+    -------
+    dict
+        ``t_from`` (s; the sample at or after it), ``at_t_from`` and ``final`` (``|P h|``) and
+        ``drift`` (``final - at_t_from``).
+
+    For paper W's array ``P h`` is ``(n' h) n`` with ``n = (1, 1, 1, -sqrt 3)/sqrt 6``.
+    """
+    traj = check_trajectory(traj)
+    if not isinstance(wheels, WheelArray):
+        raise ArgumentTypeError("wheels", "a models.WheelArray", type(wheels).__name__)
+    h = np.asarray(traj.x[:, 6:], dtype=float)
+    if h.shape[1] != wheels.n_wheels:
+        raise InvalidArgumentError(
+            "traj", f"a run with {wheels.n_wheels} wheel momenta in the state", f"{h.shape[1]}"
+        )
+    d = wheels.D
+    proj = np.eye(d.shape[1]) - np.linalg.pinv(d) @ d
+    size = np.linalg.norm(h @ proj.T, axis=1)
+    k = min(int(np.searchsorted(traj.t, t_from - 1e-12)), len(traj.t) - 1)
+    return {
+        "t_from": float(traj.t[k]),
+        "at_t_from": float(size[k]),
+        "final": float(size[-1]),
+        "drift": float(size[-1] - size[k]),
+    }
+
+
+def torque_variation_rate(traj: Trajectory, t_from: float) -> float:
+    """Total variation of the applied wheel torques per second from ``t_from`` on (N m/s).
+
+    ``sum_j sum_k |u_j[k+1] - u_j[k]| / (t_end - t_from)`` over the held samples at or after
+    ``t_from`` (as paper M's chattering metric): near zero for torques that settle, large for
+    torques that chatter.
+    """
+    traj = check_trajectory(traj)
+    t_samples = traj.t[: len(traj.u_applied)]
+    mask = t_samples >= t_from - 1e-12
+    u = np.asarray(traj.u_applied, dtype=float)[mask]
+    span = float(traj.t[-1] - t_from)
+    if len(u) < 2 or span <= 0.0:
+        return 0.0
+    return float(np.abs(np.diff(u, axis=0)).sum() / span)
+
+
 def fault_metrics(
     traj: Trajectory,
     faults: FaultSchedule,
@@ -197,7 +254,10 @@ def fault_metrics(
     (per fault window and per rank-deficient window, :func:`peak_abs_error`),
     ``sat_fraction``, ``max_abs_h``, ``momentum_limit_events``, ``rank_deficient_windows``
     (``[t_start, t_end, rank, wheels]``), ``max_abs_angle_deg`` (per axis, for the +-40 deg
-    range of the platform) and ``status_counts``.
+    range of the platform), ``status_counts``, ``final_h`` (per wheel, N m s),
+    ``null_momentum`` (from the last fault event inside the run, or from the start when there
+    is none; :func:`null_momentum`) and ``torque_tv_rate`` (over the second half of the run;
+    :func:`torque_variation_rate`).
     """
     traj = check_trajectory(traj)
     if not isinstance(wheels, WheelArray):
@@ -221,7 +281,11 @@ def fault_metrics(
         "rank_deficient_windows": [[w.t_start, w.t_end, w.rank, list(w.wheels)] for w in rank_windows],
         "max_abs_angle_deg": {ax: float(np.degrees(err[:, a].max())) for a, ax in enumerate(AXES)},
         "status_counts": traj.status_counts(),
+        "final_h": np.asarray(traj.x[-1, 6:], dtype=float).tolist(),
     }
+    events = [t for f in faults.faults for t in (f.t_on, f.t_off) if math.isfinite(t) and t < t_end]
+    out["null_momentum"] = null_momentum(traj, wheels, max(events, default=0.0))
+    out["torque_tv_rate"] = torque_variation_rate(traj, 0.5 * t_end)
     if "momentum_limited" in traj.stage_log:
         out["momentum_limit_events"] = momentum_limit_events(traj)
     return out

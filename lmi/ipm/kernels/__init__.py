@@ -2,12 +2,14 @@
 
 The blocks of the Kothare problems are small (orders 7-15) and few (5-11), so a numpy
 implementation of an iteration is dominated by the fixed cost of its ~250 array calls, not by
-arithmetic (measured on paper P at 2 vertices: 0.55 of 0.8 ms per iteration). These kernels do
-one iteration's work in three calls: :func:`residuals`, :func:`scaling_and_schur_rows` and
-:func:`newton_step`; the Schur complement itself is factored by LAPACK from Python (in
-:mod:`lmi.ipm`). Matrix products and eigen-decompositions are BLAS/LAPACK calls made from
-compiled code; the Cholesky factorisations of the blocks and the smallest eigenvalues of the
-step-length test are plain loops.
+arithmetic (measured on paper P at 2 vertices: 0.55 of 0.8 ms per iteration). An iteration is
+two calls: :func:`residuals`, then :func:`rows_iteration` (or :func:`grouped_iteration` when
+``H`` is formed from factored coefficients), which scales, forms and factors the Schur
+complement and takes the predictor-corrector step (:mod:`lmi.ipm.kernels.iteration`). Matrix
+products and eigen-decompositions are BLAS/LAPACK calls made from compiled code (the Schur
+complement's ``dsyrk``, ``dpotrf`` and ``dgeqrf`` through :mod:`lmi.ipm.kernels.lapack`); the
+Cholesky factorisations of the blocks and the smallest eigenvalues of the step-length test are
+plain loops.
 
 Layout shared by every kernel. ``nb`` blocks of orders ``orders[j]``; block matrices are held
 in ``(nb, kmax, kmax)`` arrays, only ``[:k, :k]`` used. A packed vector holds, block after
@@ -24,13 +26,22 @@ the rows the kernels write are contiguous.
 
 The kernels are grouped by stage: the packed layout, the block Cholesky factors and the
 residuals (:mod:`lmi.ipm.kernels.packed`), the NT scaling and the Schur complement in its three
-forms (:mod:`lmi.ipm.kernels.schur`), and the Newton step with its refinement and step lengths
-(:mod:`lmi.ipm.kernels.step`); this package re-exports the public ones. Compiled on first use and
+forms (:mod:`lmi.ipm.kernels.schur`), the factorisations by BLAS/LAPACK
+(:mod:`lmi.ipm.kernels.lapack`), the Newton step with its refinement and step lengths
+(:mod:`lmi.ipm.kernels.step`) and the whole iteration (:mod:`lmi.ipm.kernels.iteration`); this
+package re-exports the public ones. Compiled on first use and
 cached next to their files (``cache=True``): the first process after an install pays the
 compilation (about 10-20 s here), later ones load it (well under 1 s).
 """
 
-from lmi.ipm.kernels.packed import cholesky_blocks, pack, residuals, unpack
+from lmi.ipm.kernels.iteration import (
+    STEP_LOST_DEFINITENESS,
+    STEP_OK,
+    STEP_SINGULAR,
+    grouped_iteration,
+    rows_iteration,
+)
+from lmi.ipm.kernels.packed import blocks_within, cholesky_blocks, pack, residuals, unpack
 from lmi.ipm.kernels.schur import (
     scaling_and_schur_direct,
     scaling_and_schur_grouped,
@@ -39,6 +50,7 @@ from lmi.ipm.kernels.schur import (
 from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
 
 __all__ = [
-    "REFINE_STEPS", "cholesky_blocks", "newton_step", "pack", "residuals", "scaling_and_schur_direct",
+    "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blocks_within", "cholesky_blocks",
+    "grouped_iteration", "newton_step", "pack", "residuals", "rows_iteration", "scaling_and_schur_direct",
     "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
 ]

@@ -6,8 +6,8 @@ import numpy as np
 from numba import njit
 
 __all__ = [
-    "JIT", "cholesky_blocks", "cholesky_into", "diagonal_entry", "pack", "pack_block", "residuals", "unpack",
-    "unpack_block",
+    "JIT", "blocks_within", "cholesky_blocks", "cholesky_into", "diagonal_entry", "pack", "pack_block",
+    "residuals", "unpack", "unpack_block",
 ]
 
 #: numba's options for every kernel: compiled once and cached on disk, released from the GIL.
@@ -105,3 +105,25 @@ def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, en
 def diagonal_entry(offsets, j, k, a):
     """Packed position of entry ``(a, a)`` of block ``j`` (upper triangle, row by row)."""
     return offsets[j] + a * k - (a * (a - 1)) // 2
+
+
+@njit(**JIT)
+def blocks_within(s, x, rp, g_mat, h_vec, tol, orders, offsets, ent_row, ent_col, ent_w):
+    """Whether every block's primal residual is within ``tol`` of that block's size:
+    ``max |rp_j| <= tol max(max |h_j|, max (|G_j| |x|), max |s_j|)`` (max-norms, so no squares
+    underflow for tiny blocks; ``|G_j| |x|``, the magnitudes of the terms of ``G_j x``, so a block
+    whose terms cancel keeps its size). See :meth:`lmi.ipm.BlockLMISolver.solve`."""
+    sp = pack(s, orders, offsets, ent_row, ent_col, ent_w)
+    n = x.shape[0]
+    for j in range(orders.shape[0]):
+        size = 0.0
+        worst = 0.0
+        for t in range(offsets[j], offsets[j + 1]):
+            terms = 0.0
+            for i in range(n):
+                terms += abs(g_mat[t, i]) * abs(x[i])
+            size = max(size, abs(h_vec[t]), terms, abs(sp[t]))
+            worst = max(worst, abs(rp[t]))
+        if not worst <= tol * size:
+            return False
+    return True

@@ -35,6 +35,34 @@ def _nt_block(s_chol, z, j, k, kk_out, lam_out):
     return True
 
 
+#: The packing weight of an off-diagonal entry (:class:`lmi.ipm.blocks.PackedLayout`).
+_SQRT2 = float(np.sqrt(2.0))
+
+
+@njit(**JIT)
+def _pair_basis(ka, kb, same, k, out):
+    """The packed ``K (e_a e_b' + e_b e_a') K'`` (halved for ``a = b``, ``same``) into ``out``,
+    from ``ka = K[:, a]`` and ``kb = K[:, b]``: row ``p`` of the upper triangle is
+    ``w (ka[p] kb[p:] + kb[p] ka[p:])`` (``w`` 1 on the diagonal, sqrt(2) off it), contiguous,
+    so the inner loop vectorises; each entry is computed as the packed layout's entry-by-entry
+    formula ``w (K[p, a] K[r, b] + K[p, b] K[r, a])`` (``w K[p, a] K[r, a]`` when ``same``)
+    computes it, in the same order."""
+    t = 0
+    for p in range(k):
+        kap = ka[p]
+        if same:
+            out[t] = 1.0 * kap * ka[p]
+            wap = _SQRT2 * kap
+            for r in range(p + 1, k):
+                out[t + r - p] = wap * ka[r]
+        else:
+            kbp = kb[p]
+            out[t] = 1.0 * (kap * kb[p] + kbp * ka[p])
+            for r in range(p + 1, k):
+                out[t + r - p] = _SQRT2 * (kap * kb[r] + kbp * ka[r])
+        t += k - p
+
+
 @njit(**JIT)
 def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
                            sp_pair, sp_val, pair_off, pair_row, pair_col, kk_out, lam_out, pt_out):
@@ -66,14 +94,7 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
         first = pair_off[j]
         basis = np.empty((pair_off[j + 1] - first, size))
         for q in range(first, pair_off[j + 1]):
-            a, b = pair_row[q], pair_col[q]
-            out = basis[q - first]
-            for t in range(size):
-                p, r = ent_row[lo + t], ent_col[lo + t]
-                if a == b:
-                    out[t] = ent_w[lo + t] * kt[a, p] * kt[a, r]
-                else:
-                    out[t] = ent_w[lo + t] * (kt[a, p] * kt[b, r] + kt[b, p] * kt[a, r])
+            _pair_basis(kt[pair_row[q]], kt[pair_col[q]], pair_row[q] == pair_col[q], k, basis[q - first])
         for i in range(n):
             for t in range(lo, hi):
                 pt_out[i, t] = 0.0

@@ -1,0 +1,120 @@
+"""BLAS and LAPACK called from compiled code (:mod:`lmi.ipm.kernels`): the Schur complement and
+its Cholesky factor without a return to Python.
+
+numba's own linear algebra allocates its results and has no symmetric rank-k update, and a
+call through scipy from Python costs several microseconds of wrapping per call. Here the
+routines of scipy's Cython BLAS/LAPACK (``scipy.linalg.cython_blas``, ``cython_lapack``, the
+library scipy itself calls) are registered with LLVM under fixed names
+(:func:`llvmlite.binding.add_symbol`, at import) and declared to numba as external functions,
+so a kernel calls them like any C function; the compiled kernels refer to the names, not to
+addresses, and therefore stay cacheable across processes (the registration is repeated by
+every import). Arrays are passed as pointers to their data: C-ordered arrays are their
+transposes for the Fortran routines.
+
+The results are those of the calls the solver made from Python before (measured bitwise on
+paper P's iterates): :func:`schur_complement` equals numpy's ``pt @ pt.T`` (numpy forms it by
+the same ``dsyrk`` and mirrors the triangle) and :func:`cholesky_upper` equals
+``scipy.linalg.lapack.dpotrf(h, lower=0, clean=1)`` and :func:`householder_qr` equals numpy's
+``qr(pt.T, mode="raw")`` (the same ``dgeqrf`` with the workspace it asks for).
+"""
+
+from __future__ import annotations
+
+import llvmlite.binding as llvm
+import numpy as np
+from numba import njit, types
+from numba.extending import get_cython_function_address
+
+from lmi.ipm.kernels.packed import JIT
+
+__all__ = ["cholesky_upper", "householder_qr", "schur_complement"]
+
+
+def _register(name: str, module: str, routine: str) -> None:
+    """Make ``module.routine`` callable from compiled code as the external symbol ``name``."""
+    llvm.add_symbol(name, get_cython_function_address(module, routine))
+
+
+_register("lmi_ipm_dsyrk", "scipy.linalg.cython_blas", "dsyrk")
+_register("lmi_ipm_dpotrf", "scipy.linalg.cython_lapack", "dpotrf")
+_register("lmi_ipm_dgeqrf", "scipy.linalg.cython_lapack", "dgeqrf")
+_PTR = types.voidptr
+# dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc); dpotrf(uplo, n, a, lda, info)
+_dsyrk = types.ExternalFunction("lmi_ipm_dsyrk", types.void(*([_PTR] * 10)))
+_dpotrf = types.ExternalFunction("lmi_ipm_dpotrf", types.void(*([_PTR] * 5)))
+# dgeqrf(m, n, a, lda, tau, work, lwork, info)
+_dgeqrf = types.ExternalFunction("lmi_ipm_dgeqrf", types.void(*([_PTR] * 8)))
+_LOWER, _UPPER, _TRANS = ord("L"), ord("U"), ord("T")
+
+
+@njit(**JIT)
+def schur_complement(pt, h_out):
+    """``h_out = pt @ pt.T`` (``pt`` C-ordered ``(n, m)``, ``h_out`` ``(n, n)``), symmetric.
+
+    One ``dsyrk`` on the Fortran view (``pt`` is the ``(m, n)`` matrix ``P``, ``H = P'P``, its
+    lower triangle the C upper one), then the upper triangle mirrored, as numpy does.
+    """
+    n, m = pt.shape
+    chars = np.array([_LOWER, _TRANS], dtype=np.uint8)
+    ints = np.array([n, m], dtype=np.int32)
+    scalars = np.array([1.0, 0.0])
+    _dsyrk(chars[0:].ctypes, chars[1:].ctypes, ints[0:].ctypes, ints[1:].ctypes, scalars[0:].ctypes,
+           pt.ctypes, ints[1:].ctypes, scalars[1:].ctypes, h_out.ctypes, ints[0:].ctypes)
+    for i in range(n):
+        for j in range(i):
+            h_out[i, j] = h_out[j, i]
+
+
+@njit(**JIT)
+def cholesky_upper(h, work, r_out):
+    """Upper Cholesky factor ``R`` of the symmetric ``h`` (``R'R = h``) into ``r_out``, zeros
+    below the diagonal; ``h`` is left as it is, ``work`` (``n x n``) is overwritten. Returns
+    LAPACK's ``info`` (0 on success, else the order of the first non-positive minor).
+
+    ``dpotrf`` with ``uplo = 'U'`` on the Fortran view of ``work`` (a copy of ``h``) leaves
+    ``R'`` in the C lower triangle, which is transposed into ``r_out``.
+    """
+    n = h.shape[0]
+    for i in range(n):
+        for j in range(n):
+            work[i, j] = h[i, j]
+    chars = np.array([_UPPER], dtype=np.uint8)
+    ints = np.array([n, 0], dtype=np.int32)
+    _dpotrf(chars.ctypes, ints[0:].ctypes, work.ctypes, ints[0:].ctypes, ints[1:].ctypes)
+    for i in range(n):
+        for j in range(i):
+            r_out[i, j] = 0.0
+        for j in range(i, n):
+            r_out[i, j] = work[j, i]
+    return ints[1]
+
+
+@njit(**JIT)
+def householder_qr(pt, qr_h, qr_tau, r_out):
+    """QR factorisation of ``P`` (``pt`` C-ordered ``(n, m)``, ``m >= n``, is ``P'``) by
+    ``dgeqrf``: the reflectors into ``qr_h`` (``(n, m)``, as numpy's ``qr(pt.T, mode="raw")``
+    returns them) and ``qr_tau`` (``n``), the upper factor ``R`` (``P = Q [R; 0]``) into ``r_out``
+    (``(n, n)``, zeros below the diagonal). Returns LAPACK's ``info`` (0 on success).
+
+    The Fortran view of ``qr_h`` (a copy of ``pt``) is ``P`` itself; ``R[t, i]`` is then
+    ``qr_h[i, t]`` for ``t <= i``. The workspace is the optimal one ``dgeqrf`` reports.
+    """
+    n, m = pt.shape
+    for i in range(n):
+        for t in range(m):
+            qr_h[i, t] = pt[i, t]
+    ints = np.array([m, n, -1, 0], dtype=np.int32)
+    query = np.zeros(1)
+    _dgeqrf(ints[0:].ctypes, ints[1:].ctypes, qr_h.ctypes, ints[0:].ctypes, qr_tau.ctypes, query.ctypes,
+            ints[2:].ctypes, ints[3:].ctypes)
+    lwork = max(1, int(query[0]))
+    work = np.empty(lwork)
+    ints[2] = lwork
+    _dgeqrf(ints[0:].ctypes, ints[1:].ctypes, qr_h.ctypes, ints[0:].ctypes, qr_tau.ctypes, work.ctypes,
+            ints[2:].ctypes, ints[3:].ctypes)
+    for t in range(n):
+        for i in range(t):
+            r_out[t, i] = 0.0
+        for i in range(t, n):
+            r_out[t, i] = qr_h[i, t]
+    return ints[3]
