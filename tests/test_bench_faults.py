@@ -7,13 +7,15 @@ import math
 
 import numpy as np
 import pytest
-from figure_checks import capture, curves, hline_values, spans, visible_axes
+from figure_checks import assert_readable, capture, curves, hatched_spans, hline_values, spans, visible_axes
 
 import benchmarks.reports.fault_figures as fault_figures
+import benchmarks.suites.faults as faults_suite
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import expand, load_sweep
+from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.family import case_faults
 from benchmarks.suites.faults import fault_cases
 from models import WheelArray
@@ -115,6 +117,33 @@ def test_bench_faults_short_writes_every_file(tmp_path, capsys, monkeypatch):
         assert spans(att) == [(t0, min(t1, t_end)) for t0, t1 in windows] and len(windows) == 1
     assert grid[1, 0].get_ylabel().startswith("wheel torque (N m)")
     assert grid[2, 0].get_ylabel() == "wheel momentum (N m s)"
+    assert_readable(fig, [])
+    for col in range(len(items)):  # the recovery band; one wheel lost: no rank-deficient window
+        assert hline_values(grid[0, col]) == [-defaults.RECOVERY_DEG, defaults.RECOVERY_DEG]
+        assert items[col][0]["metrics"]["faults"]["rank_deficient_windows"] == []
+        assert hatched_spans(grid[0, col]) == []
+
+
+def test_bench_faults_short_w3_hatches_the_rank_deficient_windows(tmp_path, capsys, monkeypatch):
+    """W3 (two wheels lost at once) with ABFTC and GIPC, the cheap controllers."""
+    monkeypatch.setattr(faults_suite, "CONTROLLERS", ("ABFTC", "GIPC"))
+    built = capture(monkeypatch, fault_figures, "fault_case_group_figure")
+    out = tmp_path / "faults"
+    status = main(["bench", "faults", "--out", str(out), "--short", "--workers", "0", "--experiments", "W3",
+                   "--no-progress"])
+    assert status == 0, capsys.readouterr().out
+    ((items, _, title, _, _), fig) = built[0]
+    assert len(built) == 1 and title.startswith("W3: ")
+    assert_readable(fig, [])
+    grid = np.array(visible_axes(fig)).reshape(3, len(items))
+    for col, (rec, trace) in enumerate(items):
+        rank = rec["metrics"]["faults"]["rank_deficient_windows"]
+        t_end = float(trace["t"][-1])
+        expected = [(w[0], min(w[1], t_end)) for w in rank if w[0] < t_end]
+        assert len(expected) == 2  # wheel 4 out with wheel 1, then with wheel 2 (the short run's times)
+        for ax in grid[:, col]:
+            assert hatched_spans(ax) == expected
+        assert hline_values(grid[0, col]) == [-defaults.RECOVERY_DEG, defaults.RECOVERY_DEG]
 
 
 def test_a_run_shorter_than_the_scenario_faults_is_refused():

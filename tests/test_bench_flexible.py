@@ -6,9 +6,10 @@ import json
 
 import numpy as np
 import pytest
-from figure_checks import capture, curves, visible_axes
+from figure_checks import assert_readable, capture, curves, hline_values, hlines, run_curves, visible_axes
 
 import benchmarks.reports.flexible_figures as flexible_figures
+import benchmarks.suites.flexible as flexible_suite
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
@@ -205,21 +206,62 @@ def test_bench_flexible_short_writes_every_file(tmp_path, capsys, monkeypatch):
     for section in ("## F1", "## Paper V's reported results", "## Inconsistencies", "## Settings", "**V4**"):
         assert section in md
     assert (out / "figures" / "F1.png").stat().st_size > 0
-    # the figure: the four closed loops in each panel; the PZT commands are zero without AVC
+    # the figure: the four closed loops in each panel, each in its colour and line style; the
+    # PZT panel holds the runs with AVC (the others' commands are zero)
     ((items, title), fig) = built[0]
-    assert len(built) == 1 and title.startswith("F1: ")
-    err, tor, mode, pzt = visible_axes(fig)
-    names = [name for name, _ in items]
+    assert len(built) == 1 and title == f"F1: {flexible_suite.EXPERIMENTS['F1']}"  # the whole title
+    err, tor, zoom, mode, pzt = visible_axes(fig)
+    names = [name for name, _, _ in items]
     assert len(names) == 4 and err.get_yscale() == "log"
-    for ax in (err, tor, mode, pzt):
-        assert [line.get_label() for line in curves(ax)] == names
-    assert tor.get_ylabel() == "max_i |u_i| (N m)" and pzt.get_ylabel() == "max_j |v_j| (PZT)"
-    for line, (name, trace) in zip(curves(pzt), items, strict=True):  # the suite's tags: CSMC_AVC, ...
+    assert_readable(fig, names)
+    for ax in (err, tor, zoom, mode):
+        assert [line.get_label() for line in run_curves(ax, names)] == names
+    assert tor.get_ylabel() == "max_i |u_i| (N m)" and pzt.get_ylabel().startswith("max_j |v_j| (kg")
+    avc = [(name, trace) for name, _, trace in items if name.endswith("_AVC")]  # the suite's tags
+    assert [line.get_label() for line in curves(pzt)] == [name for name, _ in avc] and len(avc) == 2
+    for line, (_, trace) in zip(curves(pzt), avc, strict=True):
         np.testing.assert_allclose(line.get_ydata(), np.abs(trace["v"]).max(axis=1))
-        assert (np.max(line.get_ydata()) > 0.0) == name.endswith("_AVC"), name
+        assert np.max(line.get_ydata()) > 0.0
+    # AVC on and off of one law: different line styles; the records' torque limit dotted
+    styles = {line.get_label(): line.get_linestyle() for line in curves(err)}
+    assert styles["MTSMC"] != styles["MTSMC_AVC"] and styles["CSMC"] != styles["CSMC_AVC"]
+    assert hline_values(tor) == sorted({r["settings"]["u_max"] for r in records}) == [2.0]
+    assert hlines(mode) == []  # no modal bound in F1
     assert len(list((out / "traces").glob("F1_*.npz"))) == 4
     assert len((out / "results.csv").read_text().strip().splitlines()) == 5
     assert json.loads((out / "run.json").read_text())["done"] == 4
+
+
+def test_bench_flexible_short_figures_f2_and_f4(tmp_path, capsys, monkeypatch):
+    """F2's eleven runs and F4's modal bound (F4 cut to its cheap cases: MTSMC, LQR and RMPC with
+    the bound on the 2-vertex polytope) as the suite draws them."""
+    full = flexible_suite.flexible_cases
+    cheap = {"MTSMC", "LQR", "RMPC_effectiveness_modal_bound"}
+    monkeypatch.setattr(
+        flexible_suite,
+        "flexible_cases",
+        lambda *a, **k: [c for c in full(*a, **k) if c.experiment != "F4" or c.tag in cheap],
+    )
+    built = capture(monkeypatch, flexible_figures, "flexible_group_figure")
+    out = tmp_path / "flex"
+    status = main(["bench", "flexible", "--out", str(out), "--short", "--workers", "0", "--experiments",
+                   "F2,F4", "--no-progress"])
+    assert status == 0, capsys.readouterr().out
+    records = json.loads((out / "results.json").read_text())
+    figures = {title.split(":")[0]: (items, title, fig) for (items, title), fig in built}
+    assert sorted(figures) == ["F2", "F4"]
+    for exp, (items, title, fig) in figures.items():
+        names = [name for name, _, _ in items]
+        assert_readable(fig, names)  # F2: eleven runs, eleven colours; F4: its long title inside
+        assert title == f"{exp}: {flexible_suite.EXPERIMENTS[exp]}"
+        axes = visible_axes(fig)
+        assert len(axes) == 4  # error, torque, torque on the residual window, eta_1: no run drives a PZT
+        assert not any("v_j" in ax.get_ylabel() for ax in axes)
+        bounds = sorted({r["settings"]["modal_bound"] for r in records if r["experiment"] == exp} - {None})
+        assert hline_values(axes[3]) == sorted([-b for b in bounds] + bounds)
+    assert len(figures["F2"][0]) == 11
+    assert hline_values(visible_axes(figures["F4"][2])[3]) == [-flexible_suite.F4_MODAL_BOUND,
+                                                              flexible_suite.F4_MODAL_BOUND]
 
 
 def test_shipped_gain_sweep_expands():

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
-from figure_checks import capture, curves, visible_axes
+from figure_checks import assert_readable, capture, curves, hline_values, hlines, spans, visible_axes
 from regression import check
 
 import benchmarks.reports.mrp_figures as mrp_figures
+import benchmarks.suites.mrp as mrp_suite
 from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
@@ -95,16 +97,48 @@ def test_bench_mrp_short_writes_every_file(tmp_path, capsys, monkeypatch):
     for section in ("## M1", "## Paper M's reported results", "## Settings", "(a) paper M's disk"):
         assert section in md
     assert (out / "figures" / "M1.png").stat().st_size > 0
-    # the figure: one error-angle curve (log axis) and one torque curve per controller; M1 has
-    # no disturbance torque, so the third panel holds only the estimates of MAB and TF-AB
+    # the figure: one error-angle curve (log axis) and one torque curve per controller, the
+    # torque again on the steady window; M1 has no disturbance torque (zero), the three panels
+    # of the disturbance's axes hold the estimates of MAB and TF-AB next to it
     ((items, title), fig) = built[0]
-    assert len(built) == 1 and title.startswith("M1: ")
-    err, tor, dist = visible_axes(fig)
+    assert len(built) == 1 and title == f"M1: {mrp_suite.EXPERIMENTS['M1']}"  # the whole title
+    err, tor, zoom, *dist = visible_axes(fig)
     names = [rec["controller"] for rec, _ in items]
     assert sorted(names) == sorted(r["controller"] for r in records)
+    assert_readable(fig, names)
     assert err.get_yscale() == "log" and [line.get_label() for line in curves(err)] == names
     assert tor.get_ylabel() == "max_i |u_i| (N m)" and [line.get_label() for line in curves(tor)] == names
     estimating = [name for name, (_, trace) in zip(names, items, strict=True) if "torque_estimate" in trace]
-    assert {"MAB", "TFAB"} <= set(estimating)
-    assert [line.get_label() for line in curves(dist)][: len(estimating)] == [
-        f"{name} estimate (x)" for name in estimating]
+    assert {"MAB", "TFAB"} <= set(estimating) and len(dist) == 3
+    for ax in dist:
+        labels = [line.get_label() for line in curves(ax)]
+        assert labels == [*(f"{name} estimate" for name in estimating), "true"]
+        assert not np.any(curves(ax)[-1].get_ydata())
+    # M1 runs without a torque limit; its steady window (the records') shaded and zoomed on
+    assert hlines(tor) == []
+    steady = tuple(records[0]["settings"]["steady_window"])
+    assert spans(err) == [steady] and zoom.get_xlim() == steady
+
+
+def test_bench_mrp_short_figures_draw_the_torque_limit(tmp_path, capsys, monkeypatch):
+    """M2 and M3 with the backstepping laws only (the robust MPC's figure lines are M1's)."""
+    monkeypatch.setattr(mrp_suite, "CONTROLLERS", ("BS", "MAB", "TFAB"))
+    built = capture(monkeypatch, mrp_figures, "mrp_group_figure")
+    out = tmp_path / "mrp"
+    status = main(["bench", "mrp", "--out", str(out), "--short", "--workers", "0", "--experiments", "M2,M3",
+                   "--no-progress"])
+    assert status == 0, capsys.readouterr().out
+    records = json.loads((out / "results.json").read_text())
+    assert len(records) == 9 and len(built) == 3  # M2, M3 at 1.3 J0 and at 0.7 J0
+    for (items, title), fig in built:
+        names = [rec["controller"] for rec, _ in items]
+        assert_readable(fig, names)
+        _, tor, _, *dist = visible_axes(fig)
+        limits = sorted({rec["settings"]["u_max"] for rec, _ in items if rec["saturation"] != "none"})
+        assert hline_values(tor) == limits  # M3: the records' 1 N m; M2: no limit
+        assert limits == ([1.0] if title.startswith("M3") else [])
+        for i, ax in enumerate(dist):  # the disk's torque per axis (black) and each estimate of it
+            true = [line for line in curves(ax) if line.get_label() == "true"]
+            assert len(true) == 1 and true[0].get_color() == "k"
+            disk = next(trace["d"] for _, trace in items)
+            np.testing.assert_allclose(true[0].get_ydata(), disk[:, i])

@@ -1,5 +1,7 @@
-"""Figures of the flexible-satellite suite: the rotation error (log axis), the hub torques, the
-first modal coordinate and the PZT voltages, one line per closed loop.
+"""Figures of the flexible-satellite suite: the rotation error (log axis), the hub torques (with
+the torque limit and a panel zoomed on the residual window), the first modal coordinate (with
+the modal bound of the runs that have one) and, when a run drives them, the PZT commands; one
+colour and line style per closed loop.
 
 :func:`flexible_group_figure` builds the :class:`matplotlib.figure.Figure` (matplotlib's object
 API on an Agg canvas, no pyplot state); :func:`plot_flexible_group` writes it as a PNG.
@@ -7,67 +9,134 @@ API on an Agg canvas, no pyplot state); :func:`plot_flexible_group` writes it as
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import inspect
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-__all__ = ["flexible_group_figure", "plot_flexible_group"]
+from benchmarks.families.flexible.metrics import flexible_metrics
+from benchmarks.reports.figure_style import (
+    add_legend,
+    limit_lines,
+    note_coincident,
+    run_styles,
+    shade_window,
+    steady_zoom,
+    wrapped_title,
+)
+
+__all__ = ["PZT_UNIT", "RESIDUAL_TAIL", "flexible_group_figure", "plot_flexible_group"]
+
+#: Length (s) of the residual window at the end of a run: the ``tail`` of the residual metrics
+#: (``rms_error_tail``, ``eta_residual``) of :func:`benchmarks.families.flexible.metrics.flexible_metrics`.
+RESIDUAL_TAIL: float = float(inspect.signature(flexible_metrics).parameters["tail"].default)
+
+_TIME = "t (s)"
+#: The PZT commands enter the modal equations as forces ``Gamma_a v`` (``Gamma_a = I``, ``M = I``).
+PZT_UNIT = "kg^1/2 m/s^2"
 
 
-def flexible_group_figure(items: Sequence[tuple[str, dict]], title: str) -> Figure:
-    """Four panels for the runs of one experiment.
+def _settings(rec: Mapping[str, Any]) -> Mapping[str, Any]:
+    return rec.get("settings", {})
+
+
+def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], title: str) -> Figure:
+    """The panels of one experiment's runs.
 
     Parameters
     ----------
-    items : sequence of (name, trace)
-        The line's name and the run's trace: ``t``, ``error_deg`` (rotation error), ``u`` (applied
-        hub torques, N m), ``eta`` (modal coordinates) and ``v`` (applied PZT commands).
+    items : sequence of (name, record, trace)
+        The line's name, the run's record (``saturation``; ``settings`` with ``u_max`` and
+        ``modal_bound``) and its trace: ``t``, ``error_deg`` (rotation error), ``u`` (applied hub
+        torques, N m), ``eta`` (modal coordinates) and ``v`` (applied PZT commands).
     title : str
-        The figure's title.
+        The figure's title (wrapped to the figure's width).
 
     Returns
     -------
     matplotlib.figure.Figure
-        Four panels sharing the time axis (rotation error on a log axis, ``max_i |u_i|``, ``eta_1``,
-        ``max_j |v_j|``), one line per run in each panel where the run has that signal.
+        Panels sharing the time axis, one line per run in each, each run in its own colour and
+        line style: the rotation error on a log axis and ``max_i |u_i|`` with the residual
+        window (the last :data:`RESIDUAL_TAIL` s) shaded and the torque limits dotted;
+        ``max_i |u_i|`` again on the residual window alone; ``eta_1`` with the +-modal bounds
+        dotted (labelled with the runs that have them); runs drawn on top of each other named
+        in a note; ``max_j |v_j|`` of the runs whose PZT commands are not all zero (the panel is
+        left out when no run drives them).
     """
-    fig = Figure(figsize=(9.0, 11.0))
+    styles = run_styles(len(items))
+    pzt = [bool(np.any(np.asarray(trace["v"]) != 0.0)) for _, _, trace in items]
+    has_eta = any(np.asarray(trace["eta"]).size for _, _, trace in items)
+    rows = 3 + int(has_eta) + int(any(pzt))
+    fig = Figure(figsize=(9.0, 2.7 * rows + 0.8), layout="constrained")
     FigureCanvasAgg(fig)
-    ax_e, ax_u, ax_m, ax_v = fig.subplots(4, 1, sharex=True)
-    for name, trace in items:
+    ax_e = fig.add_subplot(rows, 1, 1)
+    ax_u = fig.add_subplot(rows, 1, 2, sharex=ax_e)
+    ax_z = fig.add_subplot(rows, 1, 3)
+    ax_m = fig.add_subplot(rows, 1, 4, sharex=ax_e) if has_eta else None
+    ax_v = fig.add_subplot(rows, 1, rows, sharex=ax_e) if any(pzt) else None
+    t_end = 0.0
+    torque_series = []
+    for (name, _rec, trace), style, drives_pzt in zip(items, styles, pzt, strict=True):
         t = np.asarray(trace["t"])
-        ax_e.semilogy(t, np.maximum(np.asarray(trace["error_deg"]), 1e-6), label=name, lw=1.0)
+        t_end = max(t_end, float(t[-1]))
+        ax_e.semilogy(t, np.maximum(np.asarray(trace["error_deg"]), 1e-6), label=name, **style)
         u = np.asarray(trace["u"])
         if u.size:
-            ax_u.plot(t[: u.shape[0]], np.abs(u).max(axis=1), label=name, lw=0.8)
+            u_max = np.abs(u).max(axis=1)
+            ax_u.plot(t[: u.shape[0]], u_max, label=name, **style)
+            ax_z.plot(t[: u.shape[0]], u_max, label=name, **style)
+            torque_series.append((t[: u.shape[0]], u_max))
         eta = np.asarray(trace["eta"])
-        if eta.size:
-            ax_m.plot(t, eta[:, 0], label=name, lw=0.8)
-        v = np.asarray(trace["v"])
-        if v.size:
-            ax_v.plot(t[: v.shape[0]], np.abs(v).max(axis=1), label=name, lw=0.8)
+        if ax_m is not None and eta.size:
+            ax_m.plot(t, eta[:, 0], label=name, **style)
+        if ax_v is not None and drives_pzt:
+            v = np.asarray(trace["v"])
+            ax_v.plot(t[: v.shape[0]], np.abs(v).max(axis=1), label=name, **style)
+    limited = [rec for _, rec, _ in items if rec.get("saturation") != "none"]
+    limits = sorted({float(_settings(rec)["u_max"]) for rec in limited})
+    for u_limit in limits:
+        limit_lines(ax_u, u_limit, f"limit {u_limit:g} N m", both=False)
+        ax_u.set_ylim(top=max(ax_u.get_ylim()[1], 1.08 * u_limit))
+    if ax_m is not None:
+        bounds: dict[float, list[str]] = {}
+        for name, rec, _ in items:
+            if _settings(rec).get("modal_bound") is not None:
+                bounds.setdefault(float(_settings(rec)["modal_bound"]), []).append(name)
+        for bound, names_bounded in sorted(bounds.items()):
+            limit_lines(ax_m, bound, f"|eta_i| <= {bound:g} ({', '.join(names_bounded)})")
+    residual = (max(0.0, t_end - RESIDUAL_TAIL), t_end)
+    for ax in (ax_e, ax_u):
+        shade_window(ax, residual, t_end, f"residual window (last {RESIDUAL_TAIL:g} s)")
+    steady_zoom(ax_z, residual, torque_series)
+    ax_z.set_title(f"max_i |u_i| on the residual window [{residual[0]:g}, {residual[1]:g}] s", fontsize=9)
     ax_e.set_ylabel("rotation error (deg)")
     ax_u.set_ylabel("max_i |u_i| (N m)")
-    ax_m.set_ylabel("eta_1 (kg^1/2 m)")
-    ax_v.set_ylabel("max_j |v_j| (PZT)")
-    ax_v.set_xlabel("t (s)")
-    for ax in (ax_e, ax_u, ax_m, ax_v):
+    ax_z.set_ylabel("max_i |u_i| (N m)")
+    if ax_m is not None:
+        ax_m.set_ylabel("eta_1 (kg^1/2 m)")
+    if ax_v is not None:
+        ax_v.set_ylabel(f"max_j |v_j| ({PZT_UNIT})")
+    names = [name for name, _, _ in items]
+    panels = [a for a in (ax_e, ax_u, ax_z, ax_m, ax_v) if a is not None]
+    for ax in panels:
+        ax.set_xlabel(_TIME)
+        ax.xaxis.set_tick_params(labelbottom=True)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+        add_legend(ax, note=note_coincident(ax, names, residual if ax is ax_z else None))
+    wrapped_title(fig, title)
     return fig
 
 
-def plot_flexible_group(items: Sequence[tuple[str, dict]], path: Path, title: str) -> Path:
+def plot_flexible_group(items: Sequence[tuple[str, Mapping[str, Any], dict]], path: Path, title: str) -> Path:
     """Write :func:`flexible_group_figure` as a PNG at ``path`` (80 dpi) and return ``path``.
 
     Parameters
     ----------
-    items : sequence of (name, trace)
+    items : sequence of (name, record, trace)
         As for :func:`flexible_group_figure`.
     path : Path
         The PNG to write.

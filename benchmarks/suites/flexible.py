@@ -187,16 +187,14 @@ def _write(
     from benchmarks.reports.flexible_figures import plot_flexible_group
 
     files: list[Path] = write_traces(out, runs)
-    groups: dict[str, list[tuple[str, dict]]] = {}
-    for case, _rec, trace in runs:
-        groups.setdefault(case.experiment, []).append((case.tag, trace))
+    groups: dict[str, list[tuple[str, dict, dict]]] = {}
+    for case, rec, trace in runs:
+        groups.setdefault(case.experiment, []).append((case.tag, rec, trace))
     figures: dict[str, Path] = {}
     for exp in EXPERIMENTS:
         if exp in groups:
             items = sorted(groups[exp], key=lambda item: item[0])
-            path = plot_flexible_group(
-                items, out / "figures" / f"{exp}.png", f"{exp}: {EXPERIMENTS[exp]}"[:110]
-            )
+            path = plot_flexible_group(items, out / "figures" / f"{exp}.png", f"{exp}: {EXPERIMENTS[exp]}")
             figures[exp] = path
             files.append(path)
     records = sorted(outcome.records, key=lambda r: (r["experiment"], r["label"]))

@@ -199,7 +199,7 @@ def _write(
     figures: dict[str, list[Path]] = {}
     for (exp, scale), items in groups.items():
         name = exp if exp != "M3" else f"M3_J{scale:g}"
-        path = plot_mrp_group(items, out / "figures" / f"{name}.png", f"{name}: {EXPERIMENTS[exp]}"[:110])
+        path = plot_mrp_group(items, out / "figures" / f"{name}.png", f"{name}: {EXPERIMENTS[exp]}")
         figures.setdefault(exp, []).append(path)
         files.append(path)
     records = outcome.records
