@@ -181,7 +181,7 @@ _SUITES: dict[str, tuple[str, str, str, str, str, str]] = {
         "Run F1-F4 (paper V's flexible satellite: MTSMC and CSMC with and without PZT vibration control on "
         "the V-slew, the boundary-layer sweep, steady error with the integral term, OfflineRMPC and RMPC on "
         "the 14-state model on a small slew) and write results.json, results.md (tables, paper V's reported "
-        "results next to the measured ones, the seed's inconsistencies, every setting chosen), results.csv, "
+        "results next to the measured ones, the papers' inconsistencies, every setting chosen), results.csv, "
         "run.json, figures/F*.png and traces/*.npz into DIR.",
         "a smoke run (run lengths x 0.02); no measurement",
         "F1,...",

@@ -1,7 +1,8 @@
 """The benchmark suite "flexible": paper V's study on the flexible satellite (F1-F4).
 
 Every run uses the published 4-mode plant with the PZT channel (:class:`models.FlexibleSatellite`,
-seed 2.5), the 2 N m per-axis hub-torque limit and paper V's hub disturbance (seed 3); the
+the published 4-mode set), the 2 N m per-axis hub-torque limit and the hub disturbance the toolkit
+assumes for paper V (its values were lost); the
 plant is integrated by DOP853 between samples.
 
 ====  =====================================================================================
@@ -86,7 +87,7 @@ F4_MODAL_BOUND = 0.02
 #: 2-vertex torque-effectiveness polytope, whose re-solves cost a tenth as much.
 MODAL_BOUND_POLYTOPE = "effectiveness"
 #: F4's hand-over on the V-slew: MTSMC until the rotation error is below this angle (deg), then
-#: OfflineRMPC (seed 9: "inside ~20 deg").
+#: OfflineRMPC (assumed: inside about 20 deg, where the linear model is taken to hold).
 HANDOVER_DEG = 20.0
 
 def _case(exp: str, tag: str, data: dict[str, Any]) -> SuiteCase:

@@ -2,7 +2,7 @@
 
 :mod:`benchmarks.suites.flexible` defines and runs the experiments F1-F4 and writes the files;
 this module turns the records into words: :func:`case_row` (one table row), the F3 steady error
-against the seed's prediction, what the robust MPC costs in F4 (with its modal bound and, measured
+against the boundary-layer prediction, what the robust MPC costs in F4 (with its modal bound and, measured
 when the report is written, how far along the slew axis the LMIs reach),
 :func:`paper_v_comparison` (paper V's reported directions next to the measured numbers),
 :func:`inconsistencies` and :func:`results_markdown`.
@@ -39,7 +39,8 @@ IPM_REACH_ANGLES = (12.5, 15.0)
 #: LMIs reach (:func:`benchmarks.families.flexible.region.slew_reach`).
 REACH_GAMMAS = (100.0, 1000.0)
 
-#: Paper V's reported results (seed 6; "certain" / "likely" as the seed tags them).
+#: Paper V's reported results, each tagged "certain" or "likely" by how surely it was read from
+#: paper V's damaged text.
 PAPER_V_RESULTS = (
     ("V1", "MTSMC's torque is smaller, with a gentler slope and smoother shape than CSMC's (certain)."),
     ("V2", "MTSMC reaches the target slightly later (certain), by ~10 or 20 s (likely)."),
@@ -120,7 +121,7 @@ def _ratio_drop(a: float | None, b: float | None) -> str:
 
 
 def paper_v_comparison(records: list[dict[str, Any]]) -> list[str]:
-    """Paper V's reported directions next to this run's numbers, then the seed's inconsistencies."""
+    """Paper V's reported directions next to this run's numbers, then the inconsistencies."""
     lines = ["## Paper V's reported results and what this toolkit measures", ""]
     mt, cs = _find(records, "F1", "MTSMC"), _find(records, "F1", "CSMC")
     mta, csa = _find(records, "F1", "MTSMC+AVC"), _find(records, "F1", "CSMC+AVC")
@@ -137,8 +138,8 @@ def paper_v_comparison(records: list[dict[str, Any]]) -> list[str]:
         f"{val(mt, 'saturated_fraction', '.2%')} vs {val(cs, 'saturated_fraction', '.2%')} of the samples; "
         f"torque power above Lambda_1 {val(mt, 'hf_power_fraction', '.2%')} vs "
         f"{val(cs, 'hf_power_fraction', '.2%')}",
-        "V2": f"t_s (1 deg) MTSMC {val(mt, 't_s')} s vs CSMC {val(cs, 't_s')} s: MTSMC {lag} (seed 7.12 "
-        "expects a lag in [0, 30] s)",
+        "V2": f"t_s (1 deg) MTSMC {val(mt, 't_s')} s vs CSMC {val(cs, 't_s')} s: MTSMC {lag} (the toolkit's "
+        "check accepts a lag in [0, 30] s)",
         "V3": f"peak |eta_1| without / with AVC: MTSMC {val(mt, 'eta_peak', index=0)} / "
         f"{val(mta, 'eta_peak', index=0)}, CSMC {val(cs, 'eta_peak', index=0)} / "
         f"{val(csa, 'eta_peak', index=0)}; "
@@ -161,14 +162,14 @@ def paper_v_comparison(records: list[dict[str, Any]]) -> list[str]:
     }
     for key, text in PAPER_V_RESULTS:
         lines.append(f"- **{key}** {text} Measured: {measured[key]}.")
-    lines += ["", "## Inconsistencies (seed sections 6-7), with this run's numbers", ""]
+    lines += ["", "## Inconsistencies, with this run's numbers", ""]
     lines += inconsistencies(records)
     lines.append("")
     return lines
 
 
 def inconsistencies(records: list[dict[str, Any]]) -> list[str]:
-    """The seed's inconsistencies, each measured on this run."""
+    """Paper V's claims the toolkit's plant contradicts, and the boundary-layer check, on this run."""
     from models import FlexibleSatellite
 
     sat = FlexibleSatellite.di_gennaro()
@@ -207,7 +208,7 @@ def inconsistencies(records: list[dict[str, Any]]) -> list[str]:
     if len(eps_ci) >= 2:
         falls = all(b[1] < a[1] for a, b in itertools.pairwise(eps_ci))
         out.append(
-            "- Seed 7.8: CI(CSMC tanh) falls as eps grows. Measured CI by eps: "
+            "- Boundary layer (the toolkit's check): CI(CSMC tanh) falls as eps grows. Measured CI by eps: "
             + ", ".join(f"{e:g}: {c:.4g}" for e, c in eps_ci)
             + (" N m/s: monotone here." if falls else " N m/s: not monotone.")
         )
@@ -232,12 +233,13 @@ def _steady_lines(records: list[dict[str, Any]]) -> list[str]:
             f"- {r['settings']['controller_name']} k_I = {k_i:g}: final error "
             f"{r['metrics']['final_error_deg']:.3g} deg after {r['settings']['duration_used']:g} s"
             + (
-                f" (seed 4.4 predicts {pred:.3g} deg without the integral term)"
+                f" (the boundary-layer estimate 2 |d| / (alpha (W_0/eps + K_s)) predicts {pred:.3g} deg "
+                "without the integral term)"
                 if k_i == 0
-                else " (seed 7.10 expects below 0.1 deg at 250 s)"
+                else " (the toolkit's check expects below 0.1 deg at 250 s)"
             )
         )
-    return ["Steady error against the seed's prediction:", "", *rows, ""]
+    return ["Steady error against the boundary-layer prediction:", "", *rows, ""]
 
 
 def _status_summary(counts: dict[str, int]) -> str:

@@ -1,4 +1,4 @@
-"""The benchmark suite "paper": experiments E1-E6 of paper P (SPEC section 3).
+"""The benchmark suite "paper": experiments E1-E6 of paper P.
 
 All experiments regulate paper P's satellite to zero attitude from its initial attitude.
 

@@ -1,4 +1,4 @@
-"""Paper P's comparative claims (SPEC section 3), checked against the records of a paper run.
+"""Paper P's comparative claims, checked against the records of a paper run.
 
 Paper P states its comparisons in words; :func:`assess_claims` turns each into a test on the
 metrics of ``rmpc bench paper`` and says whether this toolkit reproduces it, with the numbers.
@@ -50,7 +50,7 @@ class Claim:
     experiment : str
         "E1" .. "E6".
     claim : str
-        Paper P's claim in words (SPEC section 3).
+        Paper P's claim in words.
     verdict : str
         "reproduced", "reproduced with GIPC behind the limiter" (E5), "partly reproduced",
         "not reproduced" or "not run" (the run lacks the records the claim needs).
@@ -301,7 +301,7 @@ def claims_markdown(claims: Sequence[Claim]) -> list[str]:
     lines = [
         "## Paper P's claims",
         "",
-        "Each comparative claim of paper P (SPEC section 3), tested on this run's records "
+        "Each comparative claim of paper P, tested on this run's records "
         "(`benchmarks/suites/paper_claims.py` holds the thresholds). The sweep "
         "`rmpc bench sweep --config paper_claims` repeats E4/E5 over the true inertia from 0.3 to "
         "1.7 x paper P's and over the disturbance axes.",

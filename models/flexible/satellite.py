@@ -1,7 +1,7 @@
 """The flexible satellite in hybrid coordinates: a rigid hub with N flexible modes.
 
-Model (paper S eq. 1; modal mass ``M``, PZT forces ``Gamma_a v`` from paper V; seeds
-``papers-S-V-flexible.md`` section 2)::
+Model (paper S eq. 1; modal mass ``M``, PZT forces ``Gamma_a v`` from paper V;
+a reconstruction of paper V's eq. 10, **likely**)::
 
     J w' + delta' eta'' = -w x (J w + delta' eta') + u + d
     M eta'' + C eta' + K eta + delta w' = Gamma_a v + d_f
@@ -17,8 +17,8 @@ The class holds the states and sizes and delegates each concern to its own modul
 :mod:`models.flexible`: the parameters and their checks (:mod:`~models.flexible.parameters`),
 the nonlinear model with a unit-quaternion attitude (``7 + 2N`` states: the large slews of
 paper V cross the 3-2-1 Euler singularity; :mod:`~models.flexible.dynamics`), its energy and
-angular momentum (:mod:`~models.flexible.energy`), the linearised ``6 + 2N`` model (seed section
-2.2) with Euler or quaternion attitude (:mod:`~models.flexible.linear`), the uncertainty
+angular momentum (:mod:`~models.flexible.energy`), the linearised ``6 + 2N`` model
+with Euler or quaternion attitude (:mod:`~models.flexible.linear`), the uncertainty
 polytope (:mod:`~models.flexible.polytope`), the single-axis transfer function and paper S's
 regime label (:mod:`~models.flexible.single_axis`).
 
@@ -70,14 +70,14 @@ _NO_LIMIT = 1e300
 class FlexibleSatellite:
     """A rigid hub with ``N`` flexible modes (hybrid coordinates), modal mass ``M``.
 
-    Nonlinear model (seed 2.1; :meth:`dynamics`): state ``x = [q0, q1, q2, q3, wx, wy, wz,
+    Nonlinear model (:meth:`dynamics`): state ``x = [q0, q1, q2, q3, wx, wy, wz,
     eta_1..eta_N, eta_1'..eta_N']`` (``7 + 2N``; scalar-first unit quaternion of the body
     relative to the inertial frame, body rates in rad/s, modal coordinates in kg^1/2 m and
     their rates), input ``u = [Mx, My, Mz, v_1..v_na]`` (three hub torques in N m, then the
     ``n_a`` PZT commands in modal-force units; ``n_inputs = 3 + n_a``), disturbance ``d`` = hub
     torque (3; with ``panel_disturbance=True`` also the modal forces ``d_f``, ``3 + N``).
 
-    Linear model (seed 2.2; :meth:`linearize`): ``6 + 2N`` states ``[att (3), w, eta, eta']``
+    Linear model (:meth:`linearize`): ``6 + 2N`` states ``[att (3), w, eta, eta']``
     with the attitude as 3-2-1 Euler angles (default) or the quaternion's vector part.
 
     Parameters
@@ -98,7 +98,8 @@ class FlexibleSatellite:
         (``n_a = N``, ``v`` in modal-force units; **assumed**).
     panel_disturbance : bool
         Whether ``d`` also carries the panel (modal) disturbance forces ``d_f`` (then
-        ``n_disturbances = 3 + N``); default ``False`` (``d_f = 0``, seed section 3).
+        ``n_disturbances = 3 + N``); default ``False`` (``d_f = 0``,
+        **assumed**: paper V's disturbance values were lost).
 
     Raises
     ------
@@ -140,7 +141,7 @@ class FlexibleSatellite:
 
     @classmethod
     def di_gennaro(cls, n_modes: int = 4, *, panel_disturbance: bool = False) -> FlexibleSatellite:
-        """The published 4-mode set (seed section 2.5), or its first ``n_modes`` modes.
+        """Di Gennaro's published 4-mode set (as re-used by Hu & Ma), or its first ``n_modes`` modes.
 
         Modes: S. Di Gennaro, "Output stabilization of flexible spacecraft with active
         vibration suppression", IEEE Trans. Aerospace and Electronic Systems 39(3), 2003,
@@ -363,7 +364,7 @@ class FlexibleSatellite:
 
     # -- nonlinear model (models.flexible.dynamics, models.flexible.energy) ------------------
     def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
-        """``x'`` of the nonlinear model (seed 2.1, solved form; :mod:`models.flexible.dynamics`).
+        """``x'`` of the nonlinear model (solved form; :mod:`models.flexible.dynamics`).
 
         Parameters
         ----------
@@ -441,7 +442,7 @@ class FlexibleSatellite:
         -------
         A : (6 + 2N, 6 + 2N) ndarray
         B : (6 + 2N, 3) or (6 + 2N, 3 + n_a) ndarray
-            The matrices of seed section 2.2, written out in
+            The matrices of the linear model, written out in
             :func:`models.flexible.linear.linear_matrices`.
         """
         return _linear.linearize(self._p, x_op, pzt=pzt, attitude=attitude, parameters=parameters)
@@ -481,7 +482,7 @@ class FlexibleSatellite:
         attitude: AttitudeForm = "euler",
         pzt: bool = False,
     ) -> PolytopicModel:
-        """The discrete-time polytope of linear models over the parameter uncertainty (seed 9).
+        """The discrete-time polytope of linear models over the parameter uncertainty (ranges **assumed**).
 
         Parameters
         ----------
@@ -528,7 +529,7 @@ class FlexibleSatellite:
 
     # -- single axis, regime (models.flexible.single_axis) --------------------------------------
     def single_axis_tf(self, axis: int = 0, *, cancel_uncoupled: bool = True) -> Any:
-        """The python-control ``TransferFunction`` ``theta_a / u_a`` about body axis ``axis`` (seed 2.3).
+        """The python-control ``TransferFunction`` ``theta_a / u_a`` about body axis ``axis``.
 
         The other axes are locked; zeros are the constrained modes (``Lambda_i``, ``xi_i``),
         poles the unconstrained (free-free) modes and a double integrator. A mode that does not

@@ -5,8 +5,8 @@ gives no equations for it. This module implements the standard velocity-form sta
 MPC of L. Wang, *Model Predictive Control System Design and Implementation Using MATLAB*,
 Springer 2009, chapters 1-2 (augmented model with embedded integrator, condensed
 prediction, input-increment constraints), generalised to weighted outputs and per-input
-bounds. That this is what paper P used is an **assumption** (SPEC 2.3); see
-``docs/gipc.rst``.
+bounds. That this is what paper P used is an **assumption** (paper P gives no equations for it);
+see ``docs/gipc.rst``.
 
 Model (nominal ``(A, B)`` of the plant, outputs ``y = C_y x``)::
 

@@ -19,8 +19,8 @@
   PZT commands are zero (or AVC's). With ``modal_bound`` set, both bound the modal coordinates
   through Kothare's output constraint (:func:`modal_output`). With ``handover_deg`` set,
   ``OfflineRMPC`` takes over from MTSMC once the rotation error first falls below that angle
-  (:class:`HandOver`, seed 9's hand-over for the large slew); its table is then designed from the
-  state at the hand-over.
+  (:class:`HandOver`, the hand-over for the large slew, which the linear model does not cover); its
+  table is then designed from the state at the hand-over.
 """
 
 from __future__ import annotations

@@ -5,11 +5,11 @@ and V leave out):
 
 plant : {"flexible"}
     The plant family's name (API.md): the hub with four flexible modes and the PZT channel
-    (:class:`models.FlexibleSatellite`, the published set of seed 2.5), quaternion attitude,
+    (:class:`models.FlexibleSatellite`, Di Gennaro's published 4-mode set), quaternion attitude,
     integrated by DOP853 (rtol 1e-8) between samples.
 experiment : {"vslew", "steady", "small"}
     The run: paper V's V-slew (:func:`models.flexible.scenario.paper_v_scenario`, 160 deg,
-    150 s, ``d(t)`` of seed 3), the steady-error study
+    150 s, the assumed hub disturbance ``d(t)``), the steady-error study
     (:func:`models.flexible.scenario.steady_error_scenario`: at the target under a constant
     0.05 N m per axis, 250 s) or the small-angle slew (10 deg, 200 s, where the linear model
     of the robust MPC holds).

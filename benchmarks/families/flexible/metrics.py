@@ -1,7 +1,6 @@
 """The metrics of paper V's study, computed from a closed-loop run on the flexible satellite.
 
-Seed ``papers-S-V-flexible.md`` sections 4.4 and 6 (definitions where paper V gives none are the
-toolkit's, **assumed**):
+Definitions where paper V gives none are the toolkit's (**assumed**):
 
 - ``t_s``: the last time the rotation error exceeds ``threshold`` (default 1 deg; 0 if it never
   does, ``inf`` if the final error exceeds it): :func:`benchmarks.core.metrics.last_time_above`,
@@ -14,7 +13,7 @@ toolkit's, **assumed**):
   :func:`benchmarks.core.metrics.total_variation_rate` over the run);
 - ``effort``: ``int ||u||_1 dt`` of the applied hub torque (N m s);
 - ``hf_power_fraction``: the share of the applied hub torque's power (mean removed, all axes)
-  at frequencies above the first modal frequency ``Lambda_1`` (seed 4.4; 0 without modes or
+  at frequencies above the first modal frequency ``Lambda_1`` (0 without modes or
   torque variation);
 - ``eta_peak`` / ``eta_residual``: per mode, the largest ``|eta_i|`` over the run / over the tail;
 - ``modal_energy_residual``: the largest modal energy ``eta'' M eta'/2 + eta' K eta/2`` over the tail;

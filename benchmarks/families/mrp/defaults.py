@@ -1,4 +1,4 @@
-"""Every value of paper M's benchmarks that paper M leaves out (seed sections 6 and 9).
+"""Every value of paper M's benchmarks that paper M leaves out.
 
 All are **assumed** and printed in every report by :func:`settings_rows`.
 """
@@ -11,7 +11,7 @@ from typing import Any
 
 __all__ = ["CONTROLLER_DEFAULTS", "SETTING_CHOICES", "U_MAX", "rationale", "settings_rows"]
 
-#: Per-axis torque limit of M3 (N m): paper P's, since paper M gives none (seed 8(e)).
+#: Per-axis torque limit of M3 (N m): paper P's, since paper M promises input limits but gives no value.
 U_MAX: float = 1.0
 
 _Q_DIAG = (10.0, 10.0, 10.0, 10.0, 10.0, 10.0)
@@ -62,30 +62,39 @@ def settings_rows() -> list[tuple[str, str, str]]:
         (
             "initial attitude / target (3-2-1, deg, relative to LVLH)",
             "(40, -30, 20) / (10, 5, -10)",
-            "assumed (seed 6)",
+            "assumed: lost from paper M",
         ),
-        ("run length, steady window", "100 s, [50, 100] s", "assumed (seed 6)"),
+        ("run length, steady window", "100 s, [50, 100] s", "assumed: lost from paper M"),
         (
             "control period / plant RK4 step in rmpc bench mrp",
             "0.05 s / 0.01 s for every controller",
-            "seed 9 (backstepping within 5 % of 0.01 s)",
+            "assumed (paper M's step was lost; the backstepping results are the same at 0.01 s and 0.05 s)",
         ),
         ("orbit", "circular, 650 km; gravity gradient off", "paper M / assumed"),
-        ("inertia J0", "diag(3, 3, 2) kg m^2 (J2 and J3 may be swapped, seed 8(f))", "paper M, likely"),
+        ("inertia J0", "diag(3, 3, 2) kg m^2 (J2 and J3 may be swapped in paper M)", "paper M, likely"),
         (
             "M3",
             "spinning disk, true inertia 1.3 J0 and 0.7 J0, 1 N m per-axis limit",
-            "assumed (seed 6, 8(e))",
+            "assumed: paper M's scenario values were lost; it promises input limits, gives no value",
         ),
-        ("BS, MAB, TFAB c1, c2", "0.5, 2", "assumed (seed 6)"),
-        ("MAB kappa, observer", "3; NESO matched to a double pole at -10 rad/s", "assumed (seed 6)"),
-        ("TFAB Gamma", "10 I", "assumed (seed 6); 100 beats MAB (seed 8(c))"),
-        ("RMPC / CRMPC Q, R", "10 I6, I3; per-axis peak bound in M3", "seed 9 (assumed)"),
+        ("BS, MAB, TFAB c1, c2", "0.5, 2", "assumed: paper M's gains were lost"),
+        (
+            "MAB kappa, observer",
+            "3; NESO matched to a double pole at -10 rad/s",
+            "assumed: paper M's values were lost",
+        ),
+        (
+            "TFAB Gamma",
+            "10 I",
+            "assumed: lost from paper M; with Gamma = 100 TFAB beats MAB on M2, so paper M's ranking "
+            "depends on tuning",
+        ),
+        ("RMPC / CRMPC Q, R", "10 I6, I3; per-axis peak bound in M3", "assumed (paper M has no robust MPC)"),
         (
             "RMPC / CRMPC polytope",
             "rigid satellite at the target: inertia +-30 % x the kinematics over the "
-            "initial error's box (SPEC 1, covering polytope)",
-            "toolkit (seed 9)",
+            "initial error's box (the toolkit's covering polytope)",
+            "toolkit",
         ),
         (
             "CRMPC adaptation",
@@ -98,7 +107,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
 def rationale() -> str:
     """Why the values paper M leaves out are what they are (for the report)."""
     return (
-        "Paper M's initial state, target, run length and step were lost; the seed's choices are used "
+        "Paper M's initial state, target, run length and step were lost; the toolkit's choices are used "
         "(an initial error of 57.8 deg). The robust MPC runs on the error attitude in 3-2-1 angles and "
         "the rates relative to the orbital frame (models.mrp.tracking.RMPCStateMap), designed on the rigid "
         "satellite linearised at the target; its polytope also covers the kinematics over the box of "

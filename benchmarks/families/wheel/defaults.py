@@ -116,7 +116,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
         ),
         (
             "S4 wheel disturbance",
-            "0.001 + 0.05 sin(2 pi t/800) + noise of variance 0.0052, every 40 ms, seed 0",
+            "0.001 + 0.05 sin(2 pi t/800) + noise of variance 0.0052, every 40 ms, random seed 0",
             "paper W / assumed placement",
         ),
         ("gravity", "pendulous, known to ABFTC", "assumed: paper W's signs conflict; inverted topples S1"),
@@ -148,12 +148,13 @@ def settings_rows() -> list[tuple[str, str, str]]:
         (
             "W6 wheel friction, angle noise",
             f"b = {VISCOUS_FRICTION:g} N m s/rad, c = {COULOMB_FRICTION:g} N m; {ANGLE_NOISE_DEG:g} deg "
-            "(1 sigma, seed 0)",
+            "(1 sigma, random seed 0)",
             "friction assumed (paper W gives none); noise: paper W's sensor accuracy",
         ),
         (
             "W7 error in D",
-            f"every plant wheel axis tilted {D_TILT_DEG:g} deg (seed 0); controllers keep the nominal D",
+            f"every plant wheel axis tilted {D_TILT_DEG:g} deg (random seed 0); controllers keep the "
+            "nominal D",
             "assumed (paper W claims robustness to it, gives no size)",
         ),
     ]

@@ -32,7 +32,7 @@ inertia_spread : float or None
     Relative inertia error the robust MPC's polytope covers (product with the effectiveness
     polytope); ``None``: 0.2 when the plant's inertia differs from the nominal one, else none.
 gravity : {"pendulous", "inverted"}
-    The imbalance torque's sign (seed 2.3; the controllers' model follows it).
+    The imbalance torque's sign (paper W's signs conflict; the controllers' model follows it).
 seed : int
     Seed of S4's wheel disturbance.
 u_max : float

@@ -2,7 +2,7 @@
 
 The wheel satellite's state is ``[phi, theta, psi, p, q, r, h_1..h_m]`` and its runs carry the
 input stage's per-sample log (:class:`models.WheelInputStage`, ``Trajectory.stage_log``).
-The record fields of seed section 8 are :func:`recovery_times` (``recovery_time`` per fault
+The record fields are :func:`recovery_times` (``recovery_time`` per fault
 event), :func:`peak_abs_error` (``peak_abs_err`` per window), :func:`saturated_fraction`
 (``sat_fraction``), :func:`max_abs_momentum` (``max_abs_h``), :func:`momentum_limit_events`
 (``momentum_limit_events``) and :func:`torque_summary` (commanded vs applied torque); beyond
@@ -42,7 +42,7 @@ __all__ = [
     "torque_variation_rate",
 ]
 
-#: Recovery threshold: ``max_i |eta_i| <= 2 deg`` (seed 6.10, **assumed**), in rad.
+#: Recovery threshold: ``max_i |eta_i| <= 2 deg`` (**assumed**: paper W gives none), in rad.
 RECOVERY_THRESHOLD: float = math.radians(2.0)
 
 def attitude_error(traj: Trajectory) -> np.ndarray:
@@ -247,7 +247,7 @@ def fault_metrics(
     wheels: WheelArray,
     threshold: float = RECOVERY_THRESHOLD,
 ) -> dict[str, Any]:
-    """Every metric of paper W's scenarios for one run (seed section 8's record fields).
+    """Every metric of paper W's scenarios for one run (the record fields).
 
     Returns a dict with ``final_abs_err`` (per axis, rad), ``max_abs_u`` (applied, N m),
     ``max_abs_u_cmd``, ``recovery_time`` (per event, :func:`recovery_times`), ``peak_abs_err``

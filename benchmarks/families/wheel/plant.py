@@ -1,6 +1,6 @@
 """The simulation plant of paper W's runs: the wheel satellite behind its input stage, RK4 at 5 ms.
 
-Seed ``paper-W-wheel-faults.md`` section 2.5 (**assumed**): the controller runs with a 40 ms
+Paper W's control period is 40 ms; the rest is the toolkit's (**assumed**): the controller runs with a 40 ms
 zero-order hold and the plant is integrated with classical RK4 at 5 ms, the input stage
 (wheel disturbance, faults, torque and momentum limits; :class:`models.WheelInputStage`)
 acting inside the integration. :func:`wheel_plant` builds exactly that
@@ -44,7 +44,7 @@ def wheel_plant(
     substep : float
         RK4 step (default 0.005 s).
     integrator : {"RK4", "DOP853"}
-        The integrator (default RK4, the seed's choice; the input stage switches inside a
+        The integrator (default RK4, the toolkit's choice; the input stage switches inside a
         sample when a momentum limit is reached). See :mod:`rmpc.sim.integrators`.
     wheel_disturbance : WheelDisturbance, optional
         S4's wheel-level disturbance.

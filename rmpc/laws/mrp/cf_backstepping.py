@@ -1,8 +1,8 @@
 """Static command-filtered backstepping ("BS") for the MRP satellite of paper M.
 
 Farrell, Polycarpou, Sharma & Dong, "Command filtered backstepping", IEEE Trans. Automatic
-Control 54(6), 2009, applied as in paper M (seed ``paper-M-mrp-backstepping.md``, section 5.1;
-structure **certain**, paper M's equations 51, 52 and 56 survive; details **likely**).
+Control 54(6), 2009, applied as in paper M
+(structure **certain**, paper M's equations 51, 52 and 56 survive; details **likely**).
 
 Strict-feedback form: ``x1 = se`` (the MRP error, :func:`models.attitude.mrp.mrp_error`), ``x2 = w``,
 ``u = Tc``; ``x1' = f1 + g1 x2`` with ``g1 = N(se)``, ``f1 = n N(se) c2(sigma)``, and
@@ -68,7 +68,7 @@ class CFBackstepping(ContinuousTimeController):
         ``wn = 2`` rad/s and ``zeta = 0.5``, no clips). Only its :meth:`~CommandFilter.derivative`
         is used; the controller integrates it with its own ``dt``.
     dt : float
-        Sample time (s) of :meth:`step` (seed: 0.01).
+        Sample time (s) of :meth:`step` (paper M's was lost; **assumed**).
     u_max : float, (3,) array_like or None
         Per-axis torque limit (N m); the clipped torque enters ``chi2``. Default none.
 
@@ -80,7 +80,7 @@ class CFBackstepping(ContinuousTimeController):
     (rad), ``"filter_input"`` (``x0``), ``"filter_output"`` (``x_c``), ``"filter_rate"``
     (``x_c'``), ``"chi1"``, ``"chi2"`` and ``"u_unclipped"`` (``u0``).
 
-    Shadow sets (seed 8 (d); paper M never mentions them): ``se`` is always the short set, so
+    Shadow sets (paper M never mentions them): ``se`` is always the short set, so
     at an error of 180 deg ``se``, ``alpha1`` and the filter input jump while the filter
     output stays continuous; ``chi1`` is not remapped.
 

@@ -1,8 +1,8 @@
 """The second-order command filter of command-filtered backstepping, with magnitude and rate clips.
 
 Farrell, Polycarpou, Sharma & Dong, "Command filtered backstepping", IEEE Trans. Automatic
-Control 54(6), 2009; the form paper M cites (seed ``paper-M-mrp-backstepping.md``, section 3;
-paper M's own equations were lost, this standard form is **likely**)::
+Control 54(6), 2009; the form paper M cites
+(paper M's own equations were lost, this standard form is **likely**)::
 
     q1' = q2
     q2' = 2 zeta wn [ S_R( wn / (2 zeta) (S_M(x0) - q1) ) - q2 ]

@@ -1,6 +1,6 @@
 """Modular adaptive backstepping ("MAB"): command-filtered backstepping with nonlinear damping
-and a separately designed disturbance estimator (paper M, seed ``paper-M-mrp-backstepping.md``,
-section 5.2; structure **certain**).
+and a separately designed disturbance estimator (paper M; structure
+**certain**).
 
 Krstic, Kanellakopoulos & Kokotovic, "Nonlinear and Adaptive Control Design", Wiley 1995
 (modular design: an input-to-state stabilising controller plus any estimator with bounded

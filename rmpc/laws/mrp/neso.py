@@ -1,8 +1,8 @@
 """The reduced-order nonlinear extended state observer (NESO) of paper M, with Han's ``fal``.
 
 J. Han, "From PID to active disturbance rejection control", IEEE Trans. Industrial Electronics
-56(3), 2009 (the form is **likely**: paper M's equations were lost; seed
-``paper-M-mrp-backstepping.md``, section 4). It estimates the lumped unknown acceleration ``d``
+56(3), 2009 (the form is **likely**: paper M's equations were lost).
+It estimates the lumped unknown acceleration ``d``
 of the rate equation ``w' = f2(w) + J0^-1 Tc + d`` (reduced order, **certain**: the disturbance
 does not enter the kinematics)::
 
@@ -149,7 +149,7 @@ class NESO:
         """Gains matching the linear observer with a double pole at ``-bandwidth`` for ``|e| <= delta``.
 
         ``beta1 = 2 w_o delta^(1 - alpha1)``, ``beta2 = w_o^2 delta^(1 - alpha2)`` (**assumed**
-        rule; defaults **assumed**, seed section 2).
+        rule; defaults **assumed**: paper M's values were lost).
         """
         w_o = check_positive(bandwidth, "bandwidth")
         a1, a2 = _exponent(alpha1, "alpha1"), _exponent(alpha2, "alpha2")

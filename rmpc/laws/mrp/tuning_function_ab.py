@@ -2,8 +2,8 @@
 
 Krstic, Kanellakopoulos & Kokotovic, "Nonlinear and Adaptive Control Design", Wiley 1995
 (integral adaptation with tuning functions). Paper M compares against it (**certain**; its
-gains were lost). The toolkit's form (**likely**; seed ``paper-M-mrp-backstepping.md``,
-section 5.3) has no command filter: ``alpha1'`` is computed analytically::
+gains were lost). The toolkit's form (**likely**) has no command
+filter: ``alpha1'`` is computed analytically::
 
     z1 = se;   alpha1 = -4 c1 se / (1 + s) - n c2(sigma);   z2 = w - alpha1      (s = |se|^2)
     alpha1' = -c1 [4 se' / (1 + s) - 8 se (se' se) / (1 + s)^2] + n w_BO x c2,   se' = N(se) w_BO
@@ -13,7 +13,7 @@ The unknown torque appears only in the last step, so the tuning functions reduce
 ``tau1 = 0``, ``tau2 = J0^-T z2``. With ``V = (|z1|^2 + |z2|^2 + Tt' Gamma^-1 Tt) / 2``,
 ``Tt = Td - Tdhat``, a constant ``Td`` and ``J = J0``: ``V' = -c1 |z1|^2 - c2 |z2|^2``.
 ``Gamma = 10`` (**assumed**). Under a torque limit TF-AB clips plainly: the estimate keeps
-integrating (no anti-windup), as the seed prescribes.
+integrating (no anti-windup), the toolkit's choice (paper M shows no torque limit).
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ class TuningFunctionAB(ContinuousTimeController):
     >>> m1 = paper_m_scenario("M1")
     >>> tfab = TuningFunctionAB(m1.model(), target=m1.sigma_ref)
     >>> u = tfab.step(m1.initial_state())
-    >>> round(float(np.abs(u).max()), 2)       # seed section 6: 1.88 N m at t = 0
+    >>> round(float(np.abs(u).max()), 2)       # 1.88 N m at t = 0
     1.88
     """
 
