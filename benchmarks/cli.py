@@ -358,7 +358,7 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 
 
 def _add_timing(sub: argparse._SubParsersAction) -> None:
-    """``rmpc timing --out DIR`` (the solver timing report of API.md), owned by :mod:`benchmarks.timing`."""
+    """``rmpc timing --out DIR`` (the solver timing report), owned by :mod:`benchmarks.timing`."""
     try:
         from benchmarks.timing import add_timing_parser
     except ModuleNotFoundError as err:

@@ -18,7 +18,7 @@ constant diagonal; no coordinate is enlarged (``t_i <= 1``). It is applied only 
 diagonal of ``P`` spans more than :data:`MIN_SPREAD`: on paper P's satellite it spans a factor
 7.6, and scaling anyway cost one more iteration per warm solve at 2 vertices (measured: 9
 instead of 8, median of 30 states) and two more cold at 8; on the flexible satellite it spans
-4200. The rigid hub of the flexible model (hub inertia of seed ``papers-S-V-flexible.md``,
+4200. The rigid hub of the flexible model (its hub inertia,
 ``Ts = 0.05`` s, ``Q1 = 100 I``, ``R = I``, peak bound 2 N m, 10 deg off) spans 47 and needs it
 too: without it the cold solve ended ``"inaccurate"`` after 41 (2 vertices) and 50 (8)
 iterations, the dual residual growing from 5e-9 to 3e-5 as the gap closed; with it, optimal

@@ -1,6 +1,6 @@
 """What the sections of ``rmpc timing`` share: paper P's timing problem, its polytopes, record helpers.
 
-The problem (SPEC 2.1): paper P's satellite, ``Ts = 0.01`` s, inertia spread :data:`SPREAD`,
+The problem: paper P's satellite, ``Ts = 0.01`` s, inertia spread :data:`SPREAD`,
 ``Q1 = diag(1, 1, 1, 0.1, 0.1, 0.1)``, ``R = I``, ``||u|| <= 1``. :func:`polytope` gives its
 2-, 4- and 8-vertex polytopes; the small helpers below make the records (``finite``, ``rel_err``,
 ...) and the report's numbers (``ms``, ``us``, ...). Light on purpose: nothing here imports a

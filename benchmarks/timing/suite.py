@@ -1,4 +1,4 @@
-"""``rmpc timing --out DIR``: the solver timing report (SPEC 2.1, 2.3, 2.4 and 5; API.md).
+"""``rmpc timing --out DIR``: the solver timing report.
 
 On paper P's satellite (``Ts = 0.01`` s, inertia spread 0.3, ``Q1 = diag(1, 1, 1, 0.1, 0.1, 0.1)``,
 ``R = I``, ``||u|| <= 1``) it times, in one run:
@@ -11,11 +11,11 @@ On paper P's satellite (``Ts = 0.01`` s, inertia spread 0.3, ``Q1 = diag(1, 1, 1
   the slow path, for the rebuild/fast ratio) and cvxpy with SCS (a few states). The states are
   those of the closed loop driven by the default path (``ipm``, ``delta_shared``) on vertex 0.
   Accuracy: ``gamma`` against a high-accuracy reference (cvxpy + Clarabel at tolerances 1e-10)
-  and the smallest recomputed LMI margin. ``F`` is never compared: it is not unique at the optimum (SPEC 2.1).
+  and the smallest recomputed LMI margin. ``F`` is never compared: it is not unique at the optimum.
 - **OfflineRMPC** (Wan & Kothare 2003): the per-step lookup, with and without interpolation, at
   the states of its own closed loop; its design time; ``gamma_1`` (the outermost ellipsoid,
   designed at ``x0``) against the online reference ``gamma(x0)``.
-- **GIPC** (velocity-form MPC, SPEC 2.3): the per-step QP (``update`` + ``solve``) of each QP
+- **GIPC** (velocity-form MPC): the per-step QP (``update`` + ``solve``) of each QP
   back-end on the QPs of one closed loop (with experiment E4's step disturbance half-way), the
   objective against a high-accuracy reference (cvxpy + Clarabel at 1e-10) and the KKT residual.
 

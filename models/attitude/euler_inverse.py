@@ -11,7 +11,7 @@ inverse maps Euler-angle rates to body rates, ``w = K^-1 eta'``, and is regular 
         0 & -\\sin\\phi & \\cos\\phi \\cos\\theta
     \\end{bmatrix}, \\qquad \\det K^{-1} = \\cos\\theta.
 
-Paper W (seed ``paper-W-wheel-faults.md``, sections 2.1 and 4.3) writes ``R`` for ``K`` and
+Paper W writes ``R`` for ``K`` and
 needs ``d(K^-1)/dt`` in closed form for the derivative of its virtual control.
 """
 
@@ -43,7 +43,7 @@ def inverse_kinematics_matrix(phi: float, theta: float) -> np.ndarray:
 
 
 def inverse_kinematics_partials(phi: float, theta: float) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(dK^-1/dphi, dK^-1/dtheta)`` (seed section 4.3); ``K^-1`` does not depend on psi."""
+    """Return ``(dK^-1/dphi, dK^-1/dtheta)``; ``K^-1`` does not depend on psi."""
     s_p, c_p = np.sin(phi), np.cos(phi)
     s_t, c_t = np.sin(theta), np.cos(theta)
     d_phi = np.array([[0.0, 0.0, 0.0], [0.0, -s_p, c_p * c_t], [0.0, -c_p, -s_p * c_t]])

@@ -1,7 +1,7 @@
 """Modified Rodrigues parameters (MRP): rotation matrices, kinematics, shadow sets and errors.
 
 Conventions of Schaub & Junkins ("Analytical Mechanics of Space Systems"), as paper M uses
-them (seed ``paper-M-mrp-backstepping.md``, section 2):
+them:
 
 - ``sigma`` is the MRP of a frame B relative to a frame O, ``sigma = e tan(Phi/4)`` for the
   principal axis ``e`` and angle ``Phi``; from the quaternion ``(q_v, q_4)`` (scalar last),

@@ -1,4 +1,4 @@
-"""The nonlinear hybrid-coordinate model of the flexible satellite, in solved form (seed 2.1).
+"""The nonlinear hybrid-coordinate model of the flexible satellite, in solved form.
 
 ::
 

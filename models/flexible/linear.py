@@ -1,4 +1,4 @@
-"""The linear ``6 + 2N`` model of the flexible satellite (seed section 2.2).
+"""The linear ``6 + 2N`` model of the flexible satellite.
 
 :func:`linearize` is the body of :meth:`models.FlexibleSatellite.linearize`; it and the
 uncertainty polytope (:mod:`models.flexible.polytope`) both build their matrices with
@@ -36,7 +36,7 @@ POLYTOPIC_ATTITUDE: dict[str, str] = {"euler": "euler321", "quaternion": "quater
 
 @dataclass(frozen=True)
 class ParameterPoint:
-    """Parameters of the linear model that the uncertainty polytope varies (seed section 9).
+    """Parameters of the linear model that the uncertainty polytope varies.
 
     Attributes
     ----------
@@ -85,7 +85,7 @@ def linear_matrices(
     pzt: bool,
     effectiveness: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous-time ``(A, B)`` of seed 2.2 from its ingredients (no argument checks).
+    """Continuous-time ``(A, B)`` of the linear model from its ingredients (no argument checks).
 
     With ``P`` = ``hub_inertia_inv``, ``G = M^-1 + M^-1 delta P delta' M^-1``, ``K = diag(k)``,
     ``C = diag(c)`` and ``Kin`` = ``kinematics``::

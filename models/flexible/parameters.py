@@ -6,7 +6,7 @@
 inverse, ``delta' M^-1``, ``k_i = Lambda_i^2`` and ``c_i = 2 xi_i Lambda_i``. The dynamics, the
 energy, the linear model and the single-axis transfer function all read this one object.
 
-The published 4-mode set (seed section 2.5) is here too (``DI_GENNARO_*``).
+The published 4-mode set is here too (``DI_GENNARO_*``).
 """
 
 from __future__ import annotations

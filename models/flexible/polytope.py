@@ -1,4 +1,4 @@
-"""The uncertainty polytope of the flexible satellite's linear model (seed section 9).
+"""The uncertainty polytope of the flexible satellite's linear model.
 
 Uncertain parameters: ``kappa`` scaling the inverse hub inertia ``J_mb^-1``, the modal
 stiffnesses ``k_i = Lambda_i^2`` (through a scale ``f`` on the frequencies, ``k_i -> f^2 k_i``)
@@ -16,7 +16,7 @@ value, an argument ending in ``_range``: ``inverse_inertia_range`` (``kappa``),
 multiplier, a point, is a ``*_scale`` elsewhere in the toolkit; an inertia uncertainty symmetric
 about ``J``, ``J in [(1 - s) J, (1 + s) J]``, is a ``spread``.)
 
-Modes (all ranges **assumed**, seed section 9):
+Modes (all ranges **assumed**, the toolkit's choice):
 
 - ``"groups"`` (default): one scale each for ``kappa``, all ``k_i`` and all ``c_i``: 8 vertices;
 - ``"box"``: ``kappa`` and every ``k_i``, ``c_i`` independently: ``2^(1 + 2N)`` vertices (512
@@ -59,7 +59,7 @@ PolytopeMode = Literal["groups", "box", "effectiveness"]
 DEFAULT_INVERSE_INERTIA_RANGE: tuple[float, float] = (0.8, 1.2)
 #: Range of the multiplier of the modal frequencies (**assumed**; +-10 %).
 DEFAULT_FREQUENCY_RANGE: tuple[float, float] = (0.9, 1.1)
-#: Range of the multiplier of the damping ratios, the least known parameter (**assumed**, seed 9).
+#: Range of the multiplier of the damping ratios, the least known parameter (**assumed**).
 DEFAULT_DAMPING_RANGE: tuple[float, float] = (0.5, 2.0)
 #: Range of the hub-torque effectiveness of the ``"effectiveness"`` mode (**assumed**).
 DEFAULT_EFFECTIVENESS_RANGE: tuple[float, float] = (0.8, 1.2)

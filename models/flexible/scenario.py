@@ -1,7 +1,7 @@
 """Paper V's scenario on the flexible satellite as data: the V-slew and its disturbance.
 
-Seed ``papers-S-V-flexible.md`` sections 3 and 6. Paper V's initial state, disturbance values and
-torque bound were lost in extraction; the toolkit's choices (all **assumed** unless tagged):
+Paper V's initial state, disturbance values and torque bound were lost in extraction; the toolkit's
+choices (all **assumed** unless tagged):
 
 - slew: rest to rest, to ``q = [1, 0, 0, 0]`` from a rotation of 160 deg (**likely**; printed
   "134" in a garbled digit font, 169, 260, 269 also possible: a parameter) about
@@ -37,13 +37,13 @@ __all__ = [
 
 #: F2: the boundary-layer widths ``eps`` (rad/s) of the chattering sweep (**assumed**).
 F2_EPSILONS: tuple[float, ...] = (0.002, 0.005, 0.01, 0.02, 0.05)
-#: F3: the integral gains ``k_I`` (1/s^2) of the steady-error study (seed 4.2/7.10, **assumed**).
+#: F3: the integral gains ``k_I`` (1/s^2) of the steady-error study (**assumed**).
 F3_INTEGRAL_GAINS: tuple[float, ...] = (0.0, 0.01)
 
 
 @dataclass(frozen=True)
 class PaperVDisturbance:
-    """``d(t) = a [sin(r t), cos(r t), sin(r t + pi/4)]`` (N m), the hub disturbance of seed 3.
+    """``d(t) = a [sin(r t), cos(r t), sin(r t + pi/4)]`` (N m), paper V's hub disturbance.
 
     Parameters
     ----------
@@ -95,7 +95,7 @@ class ConstantHubTorque:
 
 @dataclass(frozen=True)
 class VSlewScenario:
-    """Paper V's rest-to-rest slew (seed section 6) as data.
+    """Paper V's rest-to-rest slew as data.
 
     Attributes
     ----------
@@ -160,7 +160,7 @@ def paper_v_scenario(**overrides: Any) -> VSlewScenario:
 
 
 def steady_error_scenario(**overrides: Any) -> VSlewScenario:
-    """F3: at the target at rest under a constant 0.05 N m per axis, 250 s (seed 7.10).
+    """F3: at the target at rest under a constant 0.05 N m per axis, 250 s.
 
     Without integral action the error settles at ``2 ||d|| / (alpha_f (W_0/eps + K_s))``
     (0.83 deg with the MTSMC defaults); with ``k_I = 0.01`` it falls below 0.1 deg by 250 s.

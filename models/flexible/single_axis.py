@@ -1,4 +1,4 @@
-"""The single-axis picture of a flexible satellite (seed section 2.3) and paper S's regime label.
+"""The single-axis picture of a flexible satellite and paper S's regime label.
 
 Rotation ``theta`` about one body axis ``a``, the other axes locked, modal mass ``M`` diagonal::
 
@@ -81,7 +81,7 @@ def flexible_factor(
 ) -> control.TransferFunction:
     """Paper S's flexible factor ``G_pf = prod ((s/w_c)^2 + 2 zeta_c s/w_c + 1) / prod (... w_u ...)``.
 
-    ``G_pf(0) = 1`` and ``|G_pf(j inf)| = prod (w_u / w_c)^2`` (seed 2.3, **certain**).
+    ``G_pf(0) = 1`` and ``|G_pf(j inf)| = prod (w_u / w_c)^2`` (**certain**).
 
     Parameters
     ----------

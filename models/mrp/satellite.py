@@ -2,7 +2,7 @@
 
 State ``x = [sigma, w]``: ``sigma`` the MRP of the body B relative to the orbital frame O,
 ``w`` the body rate relative to inertial space (rad/s, B components). Input ``u`` = control
-torque, ``d`` = external body torque (N m). Seed ``paper-M-mrp-backstepping.md``, section 2:
+torque, ``d`` = external body torque (N m). Paper M's model:
 
 .. math::
 
@@ -44,7 +44,7 @@ EARTH_MU: float = 3.986004418e14
 EARTH_RADIUS: float = 6378137.0
 #: Orbit altitude of paper M (m; **certain**).
 PAPER_M_ALTITUDE: float = 650e3
-#: Principal inertias of paper M, kg m^2 (**likely**; J2 and J3 may be swapped, seed 8 (f)).
+#: Principal inertias of paper M, kg m^2 (**likely**; J2 and J3 may be swapped).
 PAPER_M_INERTIA: tuple[float, float, float] = (3.0, 3.0, 2.0)
 
 

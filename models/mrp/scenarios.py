@@ -1,7 +1,7 @@
-"""Paper M's scenarios M1-M3 as data (seed ``paper-M-mrp-backstepping.md``, section 6).
+"""Paper M's scenarios M1-M3 as data.
 
 Paper M's initial state, target, duration and step were lost; the toolkit's scenarios are
-**assumed** (seed section 6):
+**assumed**:
 
 - initial attitude of B relative to O: 3-2-1 ``(roll, pitch, yaw) = (40, -30, 20)`` deg, at rest
   in O (``w_BO(0) = 0``, so ``w(0) = -n c2(sigma0)``);
@@ -37,7 +37,7 @@ from toolkit_common.validation import as_vector, check_positive
 
 __all__ = ["PAPER_M_NOTES", "PAPER_M_SCENARIOS", "PaperMScenario", "paper_m_scenario"]
 
-#: What a report on paper M must say: the inconsistencies of seed section 8 and how the toolkit
+#: What a report on paper M must say: paper M's inconsistencies and how the toolkit
 #: resolved them.
 PAPER_M_NOTES: tuple[str, ...] = (
     "(a) paper M's disk inertia in body axes carries a parallel-axis term -m S(R)^2 multiplying the "
@@ -56,7 +56,7 @@ PAPER_M_NOTES: tuple[str, ...] = (
 
 @dataclass(frozen=True)
 class PaperMScenario:
-    """One of paper M's scenarios (every value **assumed**, seed section 6).
+    """One of paper M's scenarios (every value **assumed**).
 
     Attributes
     ----------

@@ -2,12 +2,12 @@
 
 The disk spins at ``wb(t)`` about its own symmetry axis ``a`` (unit, body components) and its
 centre of mass; its spin momentum ``Jb wb(t) a`` is constant in direction in the body, so the
-bus feels (seed ``paper-M-mrp-backstepping.md``, section 2; structure **certain**)::
+bus feels (structure **certain**)::
 
     Td = -( w x (Jb wb a) + Jb wb' a ) = -Is ( wb(t) w x a + wb'(t) a )     (axisymmetric disk)
     Jb = C_BA' diag(m (3 r^2 + h^2)/12, m (3 r^2 + h^2)/12, m r^2/2) C_BA   (solid cylinder, likely)
 
-Two inconsistencies of paper M are resolved here (seed section 8):
+Two inconsistencies of paper M are resolved here:
 
 - (a) paper M's ``Jb`` in body axes carries a parallel-axis term ``-m S(R)^2`` that multiplies
   the spin rate, which contradicts its own premise that the disk spins about its centre of
@@ -17,7 +17,7 @@ Two inconsistencies of paper M are resolved here (seed section 8):
 - (b) the printed ``Td = -w x Jb wb + Jb wb'`` lost its grouping; the toolkit uses
   ``-(w x Jb wb + Jb wb')``, which follows from ``dH/dt`` with ``H = J w + Jb wb``.
 
-All disk numbers of paper M were lost; every default here is **assumed** (seed section 2).
+All disk numbers of paper M were lost; every default here is **assumed**.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ __all__ = ["PAPER_M_DISK", "SpinningDisk", "spin_axis_from_angles"]
 
 _RPM = 2.0 * np.pi / 60.0
 
-#: Paper M's disk as the toolkit assumes it (every value **assumed**; seed section 2): mass (kg),
+#: Paper M's disk as the toolkit assumes it (every value **assumed**): mass (kg),
 #: radius (m), height (m), spin-axis yaw and pitch (rad), mean speed, speed amplitude (rad/s)
 #: and the frequency of the speed variation (rad/s).
 PAPER_M_DISK: dict[str, float] = {

@@ -4,8 +4,7 @@ A target attitude fixed in the rotating orbital frame O and the orbit rate ``n``
 plant state ``x = [sigma, w]`` of :class:`models.MRPSatellite` into
 
 - :func:`rmpc_state` / :class:`RMPCStateMap`: the 3-2-1 Euler error angles and the rate
-  relative to O, the state a robust MPC designed on ``[roll, pitch, yaw, p, q, r]`` works on
-  (seed section 9);
+  relative to O, the state a robust MPC designed on ``[roll, pitch, yaw, p, q, r]`` works on;
 - :func:`tracking_error`: the MRP error, its kinematics matrix and the relative rate, what
   backstepping needs.
 """
@@ -25,7 +24,7 @@ __all__ = ["MRPTrackingError", "RMPCStateMap", "rmpc_state", "tracking_error"]
 
 
 def rmpc_state(x: Any, sigma_ref: Any, mean_motion: float) -> np.ndarray:
-    """The robust-MPC state ``X = [roll_e, pitch_e, yaw_e, w_BO]`` of an MRP state (seed section 9).
+    """The robust-MPC state ``X = [roll_e, pitch_e, yaw_e, w_BO]`` of an MRP state.
 
     Parameters
     ----------
@@ -78,7 +77,7 @@ class RMPCStateMap:
     """:func:`rmpc_state` as a callable ``map(x) -> X`` for a fixed target and orbit rate.
 
     Use it as the ``measure`` of :class:`rmpc.MappedController` to run a robust MPC designed
-    on ``[roll, pitch, yaw, p, q, r]`` on the MRP satellite (seed section 9).
+    on ``[roll, pitch, yaw, p, q, r]`` on the MRP satellite.
 
     Parameters
     ----------

@@ -279,7 +279,7 @@ class RigidSatellite:
         attitude_range : (3,) array_like, optional
             Half-widths (rad, >= 0) of a box of attitudes around ``x_op``'s: the polytope then
             also covers the kinematics ``eta' = K(phi, theta) w`` at every attitude in the box
-            (SPEC section 1, going beyond paper P), so the LMIs' guarantees hold along a
+            (going beyond paper P), so the LMIs' guarantees hold along a
             manoeuvre through it and not only at ``x_op``. Yaw does not enter ``K``. ``x_op``
             must have zero rates. The box must keep the pitch inside ``(-90, 90)`` deg.
 

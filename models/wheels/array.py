@@ -6,7 +6,7 @@ puts the body torque ``D u`` on the platform. The array spans three axes when
 ``rank(D) = 3``; with wheel effectiveness ``Lambda = diag(lambda_j)`` (``0`` = outage) the
 condition of paper W (eq. 17) is ``rank(D Lambda) = 3``.
 
-Paper W's array (seed ``paper-W-wheel-faults.md``, section 2.3, **certain**): wheels 1-3 on
+Paper W's array (**certain**): wheels 1-3 on
 the body axes and wheel 4 along ``(1, 1, 1)/sqrt(3)``, 54.7356 deg from every axis;
 ``|u_j| <= 0.123`` N m, ``|h_j| <= 0.625`` N m s, wheel inertia 0.0123 kg m^2.
 
@@ -121,7 +121,7 @@ class WheelArray:
         """Paper W's array: three wheels on the body axes and one along ``(1, 1, 1)/sqrt(3)``.
 
         ``D = [I3 | 1/sqrt(3) (1, 1, 1)']``, limits 0.123 N m and 0.625 N m s, wheel inertia
-        0.0123 kg m^2 (all **certain**; seed section 2.3 and 2.6).
+        0.0123 kg m^2 (all **certain**).
         """
         skew_axis = np.full((3, 1), 1.0 / np.sqrt(3.0))
         return cls(np.hstack((np.eye(3), skew_axis)))

@@ -1,7 +1,7 @@
-"""Reaction-wheel faults, fault schedules and the redundancy checker (paper W, seed section 3).
+"""Reaction-wheel faults, fault schedules and the redundancy checker (paper W).
 
-Each fault acts on one wheel in the per-wheel form ``u_j = lambda_j(t) nu_j + b_j(t)`` (seed
-3.2), ``nu_j`` the command reaching the wheel and ``u_j`` its torque before the limits:
+Each fault acts on one wheel in the per-wheel form ``u_j = lambda_j(t) nu_j + b_j(t)``,
+``nu_j`` the command reaching the wheel and ``u_j`` its torque before the limits:
 
 ===================  ===========================  =================================================
 kind                 final ``(lambda, b(t))``     paper W

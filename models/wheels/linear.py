@@ -1,4 +1,4 @@
-"""The linear model of paper W's satellite at level attitude and its effectiveness polytope (seed section 8).
+"""The linear model of paper W's satellite at level attitude and its effectiveness polytope.
 
 The attitude and the rates about the level attitude at rest (the wheel momenta do not enter:
 ``h' = -u`` is left out, the plant's business through the momentum limit)::

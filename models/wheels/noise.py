@@ -34,7 +34,7 @@ class WheelDisturbance:
     """Paper W's S4 disturbance, added to each wheel's command before faults and limits.
 
     ``d_j(t) = bias + amplitude sin(2 pi t / period) + v_j``, ``v_j`` zero-mean Gaussian with
-    ``variance``, drawn once per control sample (40 ms) and held (seed section 5: the
+    ``variance``, drawn once per control sample (40 ms) and held (the
     formula is **certain** as printed; the variance 0.0052 may be a flattened ``0.005^2 =
     2.5e-5``; where it enters and the redraw are **assumed**).
 

@@ -3,8 +3,7 @@
 State ``x = [phi, theta, psi, p, q, r, h_1..h_m]`` (3-2-1 Euler angles in rad, body rates in
 rad/s, wheel momenta along their own axes in N m s), input ``u`` = the torques the ``m`` wheels
 actually apply to the platform (N m; faults and limits act before, in
-:class:`~models.WheelInputStage`), disturbance ``d`` = a body torque (3, N m). Seed
-``paper-W-wheel-faults.md`` section 2.2::
+:class:`~models.WheelInputStage`), disturbance ``d`` = a body torque (3, N m). Paper W's model::
 
     eta' = K(phi, theta) w                                   (models.attitude.euler)
     J w' = -w x (J w) [- w x (D h)] + D (u - f) + d_g(eta) + d
@@ -162,7 +161,7 @@ class WheelSatellite:
 
     @classmethod
     def paper_w(cls, gravity: GravityMode = "pendulous", **options: Any) -> WheelSatellite:
-        """Paper W's platform: ``J`` of seed 2.6, :meth:`WheelArray.paper_w`, ``m g r_z = 0.326`` N m.
+        """Paper W's platform: paper W's ``J``, :meth:`WheelArray.paper_w`, ``m g r_z = 0.326`` N m.
 
         ``gravity`` and the keyword options of the constructor (``wheel_gyroscopic``,
         ``viscous_friction``, ``coulomb_friction``) may be changed.
@@ -342,7 +341,7 @@ class WheelSatellite:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Continuous ``(A, B)`` of the attitude and rates at level attitude, zero rates and momenta.
 
-        Seed section 8: ``A = [[0, I3], [-J^-1 K_g, 0]]``, ``B = [0; J^-1 D Lambda]`` with
+        ``A = [[0, I3], [-J^-1 K_g, 0]]``, ``B = [0; J^-1 D Lambda]`` with
         ``Lambda = diag(effectiveness)`` (default all wheels healthy) and ``J`` scaled by
         ``inertia_scale`` (one multiplier, a point). The wheel momenta do not enter the attitude
         (``h' = -u`` is left out; it is the plant's business, through the momentum limit).
@@ -380,9 +379,9 @@ class WheelSatellite:
         ----------
         effectiveness : {"single_outage", "box"} or (k, m) array_like
             ``"single_outage"`` (default): the healthy array and each single outage,
-            ``conv{1, 1 - e_j}`` (``m + 1`` vertices; seed 8(a)). ``"box"``:
-            ``[lambda_min, 1]^m`` (``2^m`` vertices, healthy first; 8(b), 8(c) with
-            ``lambda_min = 0``). Or explicit vertices, each in ``[0, 1]^m``.
+            ``conv{1, 1 - e_j}`` (``m + 1`` vertices). ``"box"``:
+            ``[lambda_min, 1]^m`` (``2^m`` vertices, healthy first). Or explicit vertices, each in
+            ``[0, 1]^m``.
         lambda_min : float
             Lower corner of the box, in ``[0, 1)`` (default 0.2, **assumed**).
         """
@@ -398,7 +397,7 @@ class WheelSatellite:
         lambda_min: float = 0.2,
         spread: float | None = None,
     ) -> PolytopicModel:
-        """The wheel-effectiveness polytope of the linear model (seed section 8).
+        """The wheel-effectiveness polytope of the linear model.
 
         Parameters
         ----------
@@ -425,7 +424,7 @@ class WheelSatellite:
         ------
         InvalidArgumentError
             Naming ``effectiveness`` and the vertex when a vertex has ``B = 0`` or
-            ``rank(D Lambda) < 3`` (seed 8(c)): there the vertex LMI is infeasible (``A`` is
+            ``rank(D Lambda) < 3``: there the vertex LMI is infeasible (``A`` is
             not Schur and nothing acts on some axis), which a conic solver may hide behind an
             "inaccurate" status with a finite gamma.
 

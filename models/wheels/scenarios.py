@@ -1,9 +1,9 @@
-"""Paper W's four test scenarios S1-S4 as data (seed ``paper-W-wheel-faults.md``, section 5).
+"""Paper W's four test scenarios S1-S4 as data.
 
 Faults, windows and initial angles are **certain** as printed; the durations (60/150/150/150 s),
 the zero initial rates (**likely**), the S4 inertia errors (plant ``1.2 J`` and ``0.8 J``, the
 controller keeps ``J``) and the S4 disturbance's placement are **assumed**. S1's stuck torque is
-0.05 N m in paper W's paragraph but 0.03 N m in its fault list (seed 6.11): 0.05 by default,
+0.05 N m in paper W's paragraph but 0.03 N m in its fault list: 0.05 by default,
 0.03 as the variant ``stuck_torque=0.03``. Wheel 4 is the skew wheel.
 
 The benchmark suite ("W1".."W4" = S1-S4) builds its runs from these records.

@@ -2,7 +2,7 @@
 
 One object, :class:`WheelInputStage`, follows the input-stage protocol of
 :class:`rmpc.sim.plants.SampledPlant` (``stage(t, x, u_cmd) -> u_applied``, ``reset()``,
-``begin_sample(t, x, u_cmd) -> dict``). In order (seed sections 2.3, 3 and 5):
+``begin_sample(t, x, u_cmd) -> dict``). In order:
 
 1. wheel-level disturbance (S4): ``u = u_cmd + d_w(t)`` (:class:`~models.WheelDisturbance`);
 2. faults: ``u_j = lambda_j(t) u_j + b_j(t)`` (:class:`~models.FaultSchedule`);
@@ -12,7 +12,7 @@ One object, :class:`WheelInputStage`, follows the input-stage protocol of
    (**assumed**).
 
 The limits act after the fault stage, so faulty wheels are limited too (a stuck wheel
-reaches its momentum limit: seed 6.8). The stage is evaluated inside the integration, so a
+reaches its momentum limit). The stage is evaluated inside the integration, so a
 limit reached within a sample acts there (with RK4 at 5 ms, ``|h_j|`` overshoots the limit by
 at most ``torque_max_j`` times one substep, 0.6 mN m s); the per-sample log
 (``Trajectory.stage_log``) records the state at the start of each sample, so such a limit
@@ -149,7 +149,7 @@ class WheelInputStage:
         ``u_fault`` (after the faults, before the limits), ``torque_clipped`` and
         ``momentum_limited`` (bool), ``fault_active`` (bool), ``effectiveness``
         (``lambda(t)``) and ``fault_altered`` (an active fault whose torque a limit changed:
-        "fault output altered by momentum limit", seed 6.8).
+        "fault output altered by momentum limit").
         """
         if self.wheel_disturbance is not None:
             self.wheel_disturbance.draw()

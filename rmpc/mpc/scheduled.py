@@ -2,7 +2,7 @@
 
 Paper P linearises the satellite once, at its initial attitude, and its robust MPC covers the
 inertia uncertainty of that one linearisation. Two ways to take the nonlinear kinematics into
-account (SPEC section 1, going beyond paper P):
+account (going beyond paper P):
 
 - the *covering* polytope (``RigidSatellite.polytope(..., attitude_range=...)``): one polytope
   that contains the frozen-attitude model at every attitude of a box, so the LMI guarantees

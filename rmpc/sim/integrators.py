@@ -247,7 +247,7 @@ class Newmark(Integrator):
     Paper V integrates its model with Newmark-beta (**certain**); the toolkit's default is
     adaptive Runge-Kutta between control samples, Newmark-beta with ``beta = 1/4``,
     ``gamma = 1/2`` (average acceleration, unconditionally stable, no numerical damping) is the
-    option (**assumed**; seed ``papers-S-V-flexible.md`` section 3).
+    option (**assumed**).
 
     The plant declares its structure with ``second_order_layout``: a mapping of ``"quaternion"``
     (the unit attitude quaternion, scalar first, 4 states), ``"rate"`` (the body rate ``w``, 3

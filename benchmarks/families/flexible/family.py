@@ -4,7 +4,7 @@ The fields (all with defaults; :mod:`benchmarks.families.flexible.defaults` hold
 and V leave out):
 
 plant : {"flexible"}
-    The plant family's name (API.md): the hub with four flexible modes and the PZT channel
+    The plant family's name: the hub with four flexible modes and the PZT channel
     (:class:`models.FlexibleSatellite`, Di Gennaro's published 4-mode set), quaternion attitude,
     integrated by DOP853 (rtol 1e-8) between samples.
 experiment : {"vslew", "steady", "small"}

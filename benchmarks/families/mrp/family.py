@@ -4,7 +4,7 @@ The fields (all with defaults; :mod:`benchmarks.families.mrp.defaults` holds wha
 leaves out):
 
 plant : {"mrp"}
-    The plant family's name (API.md): the rigid satellite in MRPs relative to the orbital
+    The plant family's name: the rigid satellite in MRPs relative to the orbital
     frame, RK4 at the control step, the shadow-set switch after every step.
 scenario : {"M1", "M2", "M3"}
     Paper M's scenario (:func:`models.paper_m_scenario`): M1 nominal, M2 the spinning disk, M3

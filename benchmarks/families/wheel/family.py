@@ -4,9 +4,8 @@ The fields (all with defaults; ``benchmarks.families.wheel.defaults`` holds what
 out):
 
 plant : {"wheel"}
-    The plant family's name, as API.md asks of records of the later systems: the nonlinear
-    wheel satellite (RK4 at 5 ms inside the 40 ms hold, the wheel input stage with faults,
-    torque and momentum limits inside the integration).
+    The plant family's name: the nonlinear wheel satellite (RK4 at 5 ms inside the 40 ms hold, the
+    wheel input stage with faults, torque and momentum limits inside the integration).
 saturation : {"constraint", "limiter"}
     Whether the controller designs for the wheel torque limit (see
     :mod:`benchmarks.families.wheel.controllers`); the plant clips either way. Default:

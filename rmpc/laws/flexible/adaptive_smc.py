@@ -6,8 +6,8 @@ SMC equivalent control::
     u_ad = -(s / ||s||) (b0h + p1h Phi1)   if ||s|| >= s_b,   else -(s / s_b) (b0h + p1h Phi1)
     Phi1 = 1 + ||w||^2,   b0h' = n0 (||s|| - e0 b0h),   p1h' = n1 (||s|| Phi1 - e1 p1h)
 
-Paper S prints the surface ``s = x + c x'``; the toolkit uses ``s = w + lambda q_v`` (seed
-``papers-S-V-flexible.md`` section 5 and table 8). The equivalent control is the CSMC law of
+Paper S prints the surface ``s = x + c x'``; the toolkit uses ``s = w + lambda q_v``. The
+equivalent control is the CSMC law of
 :mod:`rmpc.laws.flexible.csmc` without its switching term (gyroscopic and modal-reaction cancellation,
 ``-lambda J_mb q_v'``, ``-K_s s``); the adaptive term replaces the constant switching gain.
 Defaults (all **assumed**; paper S gives no gains): ``lambda = 0.1 1/s``, ``K_s = 20 N m s`` (as

@@ -4,8 +4,8 @@ Source: paper S (Persian review, 2023-24), section on PD/PID control of flexible
 ``u = -K_d w - K_p rho`` (**certain**), the industrial anchor, with ``rho = q_v`` of the error
 quaternion here; vibration decays only by the structural damping. With
 ``disturbance_observer=True``, paper S's ``u = -K_d w - K_p rho - d_hat`` (**certain**), ``d_hat``
-lumping the disturbance and the appendages' reaction, from the observer of seed
-``papers-S-V-flexible.md`` section 5 (**assumed**)::
+lumping the disturbance and the appendages' reaction, from the observer
+(**assumed**)::
 
     d_hat = z + L_o J_mb w,   z' = -L_o z - L_o (-w x J_mb w + u + L_o J_mb w)
 

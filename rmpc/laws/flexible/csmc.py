@@ -1,7 +1,7 @@
 """Classical sliding-mode attitude control (CSMC) of a flexible satellite, paper V's baseline.
 
 Source: paper V's 2x2 study compares its MTSMC with a "classical SMC" whose equation it does not
-print; seed ``papers-S-V-flexible.md`` section 4.3 (**assumed**) takes the MTSMC law of
+print; the toolkit (**assumed**) takes the MTSMC law of
 :mod:`rmpc.laws.flexible.mtsmc` with a fixed slope ``lambda``, a constant switching gain and no integral::
 
     sigma = w + lambda q_v

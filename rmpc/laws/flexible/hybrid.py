@@ -1,7 +1,7 @@
 """An attitude law and a vibration law run together on a flexible satellite (paper V's hybrid).
 
-Paper V runs its attitude SMC and its PZT vibration control (AVC) at the same time; seed
-``papers-S-V-flexible.md`` section 4.5 fixes the order (**assumed**): each sample the vibration
+Paper V runs its attitude SMC and its PZT vibration control (AVC) at the same time; the
+toolkit fixes the order (**assumed**): each sample the vibration
 law computes the PZT command ``v`` first, then the attitude law its hub torque given ``v`` (it
 cancels the reaction of ``Gamma_a v`` on the hub), and the plant gets ``[u; v]``.
 """

@@ -1,6 +1,6 @@
 """LQR on the linearised 6 + 2N flexible-satellite model, the unconstrained one-vertex RMPC reference.
 
-Seed ``papers-S-V-flexible.md`` section 5: discrete LQR (python-control ``dlqr``, through
+Discrete LQR (python-control ``dlqr``, through
 :class:`rmpc.LQR`) on the ZOH of :meth:`models.FlexibleSatellite.linearize` with the quaternion
 attitude (``Theta = q_v`` of the error quaternion, ``Kin = I/2``), run on the nonlinear plant
 through :class:`rmpc.MappedController`: the measured ``[q, w, eta, eta']`` is mapped to

@@ -3,7 +3,7 @@
 Source: paper V (Persian journal, about 2023), eqs. 11-15: the surface ``sigma = w + alpha(t) q_v``
 whose slope ``alpha`` moves in time, a switching term ``W_s tanh(sigma/eps)`` and compensation of
 the rigid-flexible coupling. The paper's equations and gain table were lost in extraction; this
-module is the toolkit's documented reconstruction of seed ``papers-S-V-flexible.md`` section 4.2
+module is the toolkit's documented reconstruction
 (**assumed** as a whole)::
 
     q_v from the error quaternion (q0 >= 0);   z' = q_v while the rotation error < theta_I, else 0
@@ -21,11 +21,11 @@ stays on it. ``alpha_law="adaptive"`` (paper V eq. 12's structure)::
     clipped to [alpha_min, alpha_max], alpha(0) = alpha0 > 0
 
 ``W_s`` is ``W_0`` (``g_w = 0``, default) or adapts, ``W_s' = g_w (||sigma||_1 - e_w W_s)`` with
-``|W_s'| <= rho_w W_s`` (paper V eqs. 13-14's relative-rate bound). Defaults (seed 4.2, all
+``|W_s'| <= rho_w W_s`` (paper V eqs. 13-14's relative-rate bound). Defaults (all
 **assumed**; paper V's table is blank): ``alpha_f = 0.1 1/s``, ``tau_a = 15 s``, ``K_s = 20 N m s``,
 ``W_0 = 1 N m``, ``eps = 0.01 rad/s``, ``k_I = 0`` (option 0.01 1/s^2 with ``theta_I = 5 deg``);
 adaptive ``alpha0 = 0.02``, ``k1 = 0.005``, ``k2 = 0``, ``[alpha_min, alpha_max] = [0.005, 0.5]``;
-``e_w = 0.01``, ``rho_w = 0.1 1/s`` (toolkit values, not in the seed).
+``e_w = 0.01``, ``rho_w = 0.1 1/s`` (toolkit values).
 
 The controller keeps its own clock ``t = k dt`` (``dt`` = its sample time) and the discrete states
 ``z``, ``alpha`` (adaptive) and ``W_s``, advanced by forward Euler after each sample. The modal

@@ -3,7 +3,7 @@
 Source: paper V (Persian journal, about 2023), theorem 2: a sliding variable on the modal error,
 cancellation of the known ("nominal") part of the modal equation and a robust term against the
 bounded unknown part, with a Lyapunov function ``V = s' M s / 2``. Structure **likely**, details
-**assumed** (seed ``papers-S-V-flexible.md`` section 4.5)::
+**assumed**::
 
     e = eta - eta_d,   eta_d = eta(t0) exp(-beta (t - t0)),   s = e' + Lam e
     rho = b0 + b1 ||eta|| + b2 ||eta'||,   eps_a(t) = max(e1 exp(-e2 t), e_min)

@@ -2,7 +2,7 @@
 
 :class:`FlexibleTerms` reads a measured state ``x = [q, w, eta, eta']`` of
 :class:`models.FlexibleSatellite`, forms the attitude error against a reference quaternion and
-evaluates the model terms the laws cancel (seed papers-S-V-flexible.md section 4.2)::
+evaluates the model terms the laws cancel::
 
     gyroscopic:      w x (J w + delta' eta')              (w x J w without flex feed-forward)
     modal reaction:  delta' M^-1 (C eta' + K eta - Gamma_a v)   (zero without flex feed-forward)
@@ -143,7 +143,7 @@ class FlexibleTerms:
         eps: float,
         switch: SwitchKind,
     ) -> np.ndarray:
-        """The sliding-mode torque of seed section 4.2 (before saturation)::
+        """The sliding-mode torque (before saturation)::
 
             u = w x (J w + delta' eta') - delta' M^-1 (C eta' + K eta - Gamma_a v)
                 - J_mb surface_rate - K_s sigma - W_s switch(sigma, eps)

@@ -1,6 +1,6 @@
 """Adaptive backstepping compensation of reaction-wheel faults (paper W), the ``step(x)`` protocol.
 
-Source: paper W (seed ``paper-W-wheel-faults.md``, section 4), two-step adaptive backstepping on
+Source: paper W, two-step adaptive backstepping on
 3-2-1 Euler angles and body rates with no fault detection. Design model (nominal ``J``, the
 plant's gravity model, ``K`` = :func:`models.attitude.euler.kinematics_matrix`, paper W's ``R``)::
 
@@ -17,14 +17,14 @@ Law (eqs. 37-39, with the printed scalar ``-c2 e2'e2`` read as the vector ``-c2 
     G_hat'       = Gamma0 e2 (f2 - alpha1')'
     Theta_hat_j' = Gamma_j e2 varpi_j(t)'
 
-``alpha1'`` is the closed form of seed 4.3, from the measured rates (no numerical
+``alpha1'`` is in closed form, from the measured rates (no numerical
 differentiation). With the true ``G = (g2 sigma g2')^-1`` and ``Theta_j = G g2_j (1 - sigma_j)
 delta_j'`` of the current fault state, ``V2 = 1/2 |e1|^2 + 1/2 e2' G e2 + 1/2 tr(Gt' Gamma0^-1
 Gt) + 1/2 sum_j tr(Tt_j' Gamma_j^-1 Tt_j)`` obeys ``V2' = -c1 |e1|^2 - c2 |e2|^2`` in continuous
 time, unsaturated, with ``f2`` and ``g2`` exact (:meth:`AdaptiveBacksteppingFTC.lyapunov`).
 ``V2`` jumps at every fault event (paper W is silent on this).
 
-Values and their tags (seed sections 4.6, 4.7 and 7): ``c1 = 0.5``, ``c2 = 3`` (**certain**);
+Values and their tags: ``c1 = 0.5``, ``c2 = 3`` (**certain**);
 ``Gamma0 = Gamma_j = 0.1 I3`` (**assumed**, the appendix table is lost); ``G_hat(0) = G_nom =
 (g2 g2')^-1``, ``Theta_hat_j(0) = 0`` and the common basis ``varpi_j = [1, sin(0.2 t)]`` (all
 **assumed**); the 40 ms zero-order hold with forward-Euler adaptation over ``Ts`` (**assumed**);
@@ -166,7 +166,7 @@ class AdaptiveBacksteppingFTC:
     >>> from rmpc import AdaptiveBacksteppingFTC
     >>> sat = WheelSatellite.paper_w()
     >>> ftc = AdaptiveBacksteppingFTC(sat)
-    >>> nu = ftc.step(paper_w_scenario("S1").initial_state())  # 13x the wheel limit (seed 6.6)
+    >>> nu = ftc.step(paper_w_scenario("S1").initial_state())  # 13x the wheel limit
     >>> nu.round(3).tolist(), ftc.last.status
     ([-0.262, 1.616, 0.64, 1.151], 'ok')
     """
@@ -436,7 +436,7 @@ class AdaptiveBacksteppingFTC:
         return rates.nu
 
     def settings(self) -> dict[str, Any]:
-        """Every parameter, for reports (with the seed's tags)."""
+        """Every parameter, for reports (with their tags)."""
         return {
             "controller": self.name,
             "c1": self.c1,
