@@ -16,20 +16,13 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from benchmarks.reports.figure_style import PALETTE
+
 __all__ = ["gamma_figure", "plot_gamma", "plot_responses", "responses_figure"]
 
 _AXIS_LABELS = ("roll $\\phi$", "pitch $\\theta$", "yaw $\\psi$")
 _TORQUE_LABELS = ("$M_x$", "$M_y$", "$M_z$")
-_COLORS = (
-    "tab:blue",
-    "tab:orange",
-    "tab:green",
-    "tab:red",
-    "tab:purple",
-    "tab:brown",
-    "tab:pink",
-    "tab:gray",
-)
+_COLORS = PALETTE[:8]  # paper P's figures: matplotlib's first eight
 _STYLES = {"nonlinear": "-", "linear": "--"}
 
 Run = tuple[Mapping[str, Any], Mapping[str, np.ndarray]]

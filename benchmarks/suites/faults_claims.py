@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from benchmarks.families.wheel import defaults
-from benchmarks.suites.paper_claims import Claim
+from benchmarks.suites.paper_claims import Claim, claim_lines
 
 __all__ = [
     "ABOUT_FACTOR",
@@ -344,11 +344,5 @@ def assess_null_drift(records: Sequence[dict[str, Any]]) -> list[tuple[str, floa
     return out
 
 
-def claims_markdown(claims: Sequence[Claim]) -> list[str]:
-    """The Markdown lines of the verdicts (one bullet each, then why where not reproduced)."""
-    lines = []
-    for c in claims:
-        lines.append(f"- **{c.experiment}: {c.verdict}.** {c.claim} Measured: {c.evidence}.")
-        if c.why:
-            lines.append(f"  Why: {c.why}.")
-    return lines
+#: The Markdown lines of the verdicts (one bullet each, then why where not reproduced).
+claims_markdown = claim_lines

@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from benchmarks.reports.sections import dash
-from benchmarks.suites.paper_claims import Claim
+from benchmarks.suites.paper_claims import Claim, claim_lines
 
 __all__ = [
     "CHATTER_RATIO",
@@ -183,11 +183,5 @@ def assess_paper_m(records: Sequence[dict[str, Any]]) -> list[Claim]:
     return [check(records) for check in _CHECKS]
 
 
-def paper_m_claims_markdown(claims: Sequence[Claim]) -> list[str]:
-    """The Markdown lines of the verdicts (one bullet per outcome, then why where not reproduced)."""
-    lines = []
-    for c in claims:
-        lines.append(f"- **{c.experiment}: {c.verdict}.** {c.claim} Measured: {c.evidence}.")
-        if c.why:
-            lines.append(f"  Why: {c.why}.")
-    return lines
+#: The Markdown lines of the verdicts (one bullet per outcome, then why where not reproduced).
+paper_m_claims_markdown = claim_lines

@@ -22,6 +22,7 @@ __all__ = [
     "STABLE_ERROR",
     "Claim",
     "assess_claims",
+    "claim_lines",
     "claims_markdown",
 ]
 
@@ -307,9 +308,17 @@ def claims_markdown(claims: Sequence[Claim]) -> list[str]:
         "1.7 x paper P's and over the disturbance axes.",
         "",
     ]
+    lines += claim_lines(claims)
+    lines.append("")
+    return lines
+
+
+def claim_lines(claims: Sequence[Claim]) -> list[str]:
+    """One Markdown bullet per claim (verdict, claim, what was measured), then why where it is not
+    reproduced; the verdict sections of every suite's report use it."""
+    lines = []
     for c in claims:
         lines.append(f"- **{c.experiment}: {c.verdict}.** {c.claim} Measured: {c.evidence}.")
         if c.why:
             lines.append(f"  Why: {c.why}.")
-    lines.append("")
     return lines
