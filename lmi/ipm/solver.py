@@ -104,11 +104,12 @@ QR_SWITCH = 1e-6
 
 #: The switch (see :data:`QR_SWITCH`) on large problems of the direct path, where ``H`` is formed
 #: from the factored coefficients and the QR phase must also form ``P``: there a QR iteration
-#: costs many Cholesky iterations (measured on the flexible satellite at 20 states, 487
-#: variables, ``P`` of 3099 rows: 71-80 ms against 9 ms), and switching later saves more QR
-#: iterations than the Cholesky phase adds. Over 5 warm solves there: 1e-6 took 10-20
-#: iterations (4-5 of them QR) and 415 ms median; 1e-8 10-24 (1-4 QR) and 217 ms, the same
-#: gammas to 3e-9; 1e-10 the same iterations as 1e-8 (Cholesky then breaks down outright).
+#: costs many Cholesky iterations (the flexible satellite at 20 states, 487 variables, ``P`` of
+#: 3099 / 8019 rows at 2 / 8 vertices: 77-81 ms against 9-12 ms, 220-238 against 16-18 ms), and
+#: switching later saves more QR iterations than the Cholesky phase adds. Over 5 warm solves
+#: there (thread time): 1e-6 took a median 447 / 1339 ms (4-5 / 5-8 QR iterations), 1e-8 240 /
+#: 691 ms (1-4 / 1-3), gamma the same within 6e-9 relative; 1e-10 gave the iterations of 1e-8
+#: (where the switch then comes, Cholesky breaks down outright).
 QR_SWITCH_LATE = 1e-8
 
 #: The direct path uses :data:`QR_SWITCH_LATE` when the QR of ``P`` (``2 m n^2`` operations for
