@@ -647,3 +647,58 @@ def test_work_arrays_are_reused_across_solves_and_left_out_of_copies():
     assert np.array_equal(again.x, fresh.x) and np.array_equal(first.x, fresh.x)
     assert "_work" not in pickle.loads(pickle.dumps(slv)).__dict__
     assert "_work" not in copy.copy(slv).__dict__
+
+
+def _kothare_example_2_textbook_blocks() -> tuple[np.ndarray, list, list]:
+    """Kothare, Balakrishnan & Morari's example 2 (two masses, spring constant 0.5 and 10, Ts
+    0.1 s, ``Q1 = I``, ``R = 1``, ``|u| <= 1``, ``x = [1, 1, 0, 0]``) as the textbook LMIs of
+    eq. (14) in ``z = [gamma, svec(Q), Y]`` for :class:`BlockLMISolver` (no scaling, no
+    reformulation), and the affine blocks to evaluate a point with. The blocks come in the order
+    the failure was found in (the two cost LMIs, the state LMI, the input LMI); with the state and
+    input LMIs first the run happened to converge without the step's accuracy test."""
+    from lmi.affine import AffineMatrix
+
+    def plant(k: float) -> np.ndarray:
+        return np.array([[1, 0, .1, 0], [0, 1, 0, .1], [-.1 * k, .1 * k, 1, 0], [.1 * k, -.1 * k, 0, 1]])
+
+    n, nv = 4, 1 + 10 + 4
+    b = np.array([[0.0], [0.0], [0.1], [0.0]])
+    x = np.array([1.0, 1.0, 0.0, 0.0])
+    q = AffineMatrix.symmetric_variable(n, 1, nv)
+    y = AffineMatrix.full_variable(1, n, 11, nv)
+
+    def gamma(size: int) -> AffineMatrix:
+        return AffineMatrix.scalar_variable_times(np.eye(size), 0, nv)
+
+    blocks = []
+    for k in (0.5, 10.0):
+        aqby = q.lmul(plant(k)) + y.lmul(b)
+        blocks.append(AffineMatrix.bmat([[q, aqby.T, q, y.T], [aqby, q, None, None],
+                                         [q, None, gamma(n), None], [y, None, None, gamma(1)]], nv))
+    one = AffineMatrix.constant(np.eye(1), nv)
+    blocks.append(AffineMatrix.bmat([[one, AffineMatrix.constant(x[None], nv)],
+                                     [AffineMatrix.constant(x[:, None], nv), q]], nv))
+    blocks.append(AffineMatrix.bmat([[one, y], [y.T, q]], nv))
+    data = [(blk.coef[0], -blk.coef[1:]) for blk in blocks]
+    return np.eye(nv)[0], data, blocks
+
+
+def test_kothare_example_2_ends_optimal_where_a_cholesky_step_loses_the_dual_equation():
+    """Kothare's example 2 in its textbook form, straight into the solver: near the optimum the
+    Cholesky factor of ``H`` keeps its pivots above :data:`lmi.ipm.solver.QR_SWITCH` while a
+    step computed with it raises the dual residual from 2e-11 to 3e-6 relative. Without the
+    step's accuracy test (:data:`lmi.ipm.solver.STEP_ACCURACY`) the run stalled and ended
+    ``"inaccurate"`` at gamma 279.65208 after 40 iterations; with it, ``"optimal"``. The answer
+    is checked outside the solver: every LMI recomputed at the returned point (smallest
+    eigenvalue >= -1e-12 relative), and gamma against the solver's own dual objective and the
+    value the Kothare pipeline finds on the same problem through scaled, reformulated LMIs
+    (279.652076, agreeing to 1e-8 relative in its three formulations; cvxpy + Clarabel ends
+    ``"optimal_inaccurate"`` at 276.48 with a point that violates the LMIs by 2.6e-6)."""
+    c, data, blocks = _kothare_example_2_textbook_blocks()
+    res = BlockLMISolver(c, data).solve()
+    assert res.status == "optimal"
+    for blk in blocks:
+        val = blk.value(res.x)
+        assert np.linalg.eigvalsh(0.5 * (val + val.T))[0] >= -1e-12 * max(1.0, np.abs(val).max())
+    assert abs(res.primal_objective - res.dual_objective) <= 1e-8 * abs(res.primal_objective)
+    assert abs(res.x[0] - 279.652076) <= 1e-8 * 279.652076 + 1e-6

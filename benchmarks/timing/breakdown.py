@@ -111,7 +111,7 @@ def replay_iteration(args: tuple) -> dict[str, float]:
 
     (s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
      pair_row, pair_col, kk, lam, pt, h, work, r_fac, qr_h, qr_tau, no_qr_h, no_qr_tau, use_qr, x, theta,
-     r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_out, z_out, chol_out) = args
+     r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_out, z_out, chol_out, err_limit) = args
     layout = (orders, offsets, ent_row, ent_col, ent_w)
     sparse = (sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)
     parts = {"NT scaling and P": _median_time(
@@ -127,7 +127,7 @@ def replay_iteration(args: tuple) -> dict[str, float]:
         householder = (qr_h, qr_tau)
     parts["Newton step (2 solves, step lengths, update)"] = _median_time(lambda: newton_step(
         pt, r_fac, *householder, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, *layout,
-        *sparse, s_out, z_out, chol_out), REPEATS)
+        *sparse, s_out, z_out, chol_out, err_limit if not use_qr else np.inf), REPEATS)
     return parts
 
 

@@ -74,8 +74,7 @@ from toolkit_common.validation import as_vector, check_positive
 
 __all__ = [
     "INFEASIBILITY_RADIUS", "OBJECTIVE_AGREEMENT", "QR_LATE_FLOPS", "QR_SWITCH", "QR_SWITCH_LATE",
-    "REDUCED_TOL", "SOLVER_STATUS_MAP",
-    "STALL_WINDOW", "BlockLMISolver", "IPMResult",
+    "REDUCED_TOL", "SOLVER_STATUS_MAP", "STALL_WINDOW", "STEP_ACCURACY", "BlockLMISolver", "IPMResult",
 ]
 
 _LOG = logging.getLogger(__name__)
@@ -117,6 +116,20 @@ QR_SWITCH_LATE = 1e-8
 #: 14 states, 1.5e9 at 20; paper P's problems (2.6e6-7.4e6, with or without a peak bound) keep
 #: :data:`QR_SWITCH`, which gave them the fewest iterations.
 QR_LATE_FLOPS = 1e8
+
+#: A Newton step of the Cholesky phase must meet its dual equation (``||P' dz~ + r_d||``) to
+#: this fraction of the larger of the current dual residual and the dual tolerance (in the units
+#: of ``||r_d||``): at 1 a step of any length ``alpha <= 1`` then leaves the dual residual,
+#: ``(1 - alpha) r_d + alpha e``, no larger than that. A step that misses it is not taken, and the
+#: solve goes on in the QR phase from that iteration (:func:`lmi.ipm.kernels.step.newton_step`).
+#: The pivot test (:data:`QR_SWITCH`) sees the factor, not the step: on Kothare's example 2 (two
+#: masses, spring constant in [0.5, 10], the textbook LMIs, 15 variables) the pivots stayed above
+#: it while one Cholesky step raised the dual residual from 2e-11 to 3e-6 relative at a relative
+#: gap of 1e-8; the run then stalled and ended ``"inaccurate"`` (gamma 279.65208, 40
+#: iterations). With the test it ends ``"optimal"`` in 37. On paper P's closed loop it sends 2
+#: of 320 iterations (2 vertices) and 4 of 376 (8) to the QR phase earlier; a fraction of 0.1
+#: sent 6 and 15.
+STEP_ACCURACY = 1.0
 
 #: A run stops as ``"insufficient_progress"`` when none of its measures (relative primal and
 #: dual residuals, gap) has halved over this many iterations. Infeasible problems stall like
@@ -527,17 +540,18 @@ class BlockLMISolver(BlockData):
                 break
             s_new, z_new, chol_new = np.zeros_like(s), np.zeros_like(z), np.zeros_like(s)
             mu, ref_scale = gap / self.degree, max(c_norm, n_gtz)
+            err_limit = STEP_ACCURACY * max(n_rd, self.tol_feas * ref_scale)
             # one compiled call: the scaling, H or P, its factor and the step (kernels.iteration)
             if self._direct:  # H from the factored coefficients, P formed in the QR phase only
                 out = _kernels.grouped_iteration(
                     s_chol, z, *packing, *sp, *self._fact, *self._groups, kk, lam, pt_mat, no_pt, h_mat,
                     h_work, r_fac, qr_h, qr_tau, *no_qr, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu,
-                    ref_scale, qr_switch, s_new, z_new, chol_new)
+                    ref_scale, qr_switch, s_new, z_new, chol_new, err_limit)
             else:
                 out = _kernels.rows_iteration(
                     s_chol, z, *packing, *sp, kk, lam, pt_mat, h_mat, h_work, r_fac, qr_h, qr_tau, *no_qr,
                     use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_new, z_new,
-                    chol_new)
+                    chol_new, err_limit)
             code, x_new, theta, a_aff, sigma, alpha, use_qr = out
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)

@@ -24,7 +24,7 @@ from numba import njit
 from lmi.ipm.kernels.lapack import cholesky_upper, householder_qr, schur_complement
 from lmi.ipm.kernels.packed import JIT
 from lmi.ipm.kernels.schur import scaling_and_schur_grouped, scaling_and_schur_rows
-from lmi.ipm.kernels.step import newton_step
+from lmi.ipm.kernels.step import STEP_INACCURATE, newton_step
 
 __all__ = ["STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "grouped_iteration", "rows_iteration"]
 
@@ -73,14 +73,14 @@ def _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var
                 return STEP_SINGULAR, x, theta, 0.0, 0.0, 0.0
     return newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
                        ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
-                       sp_val, pair_off, pair_row, pair_col, s_out, z_out, chol_out)
+                       sp_val, pair_off, pair_row, pair_col, s_out, z_out, chol_out, np.inf)
 
 
 @njit(**JIT)
 def rows_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
                    pair_off, pair_row, pair_col, kk, lam, pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
                    no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_out,
-                   z_out, chol_out):
+                   z_out, chol_out, err_limit):
     """One iteration with ``P`` formed (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_rows`):
     ``H = P'P`` and its Cholesky factor, or (``use_qr``, or once a pivot of that factor falls
     below ``qr_switch``) the QR factorisation of ``P``. Returns ``(code, x, theta, alpha_aff,
@@ -96,8 +96,9 @@ def rows_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, 
             out = newton_step(pt, r_fac, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat,
                               h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
                               sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
-                              chol_out)
-            return out[0], out[1], out[2], out[3], out[4], out[5], False
+                              chol_out, err_limit)
+            if out[0] != STEP_INACCURATE:
+                return out[0], out[1], out[2], out[3], out[4], out[5], False
     out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
                    pair_off, pair_row, pair_col, kk, lam, pt, True, qr_h, qr_tau, r_fac, x, theta, r0, rd,
                    rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
@@ -109,7 +110,7 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
                       sp_val, pair_off, pair_row, pair_col, dict_mat, dict_dims, fe_off, fe_var, fe_p,
                       fe_q, fe_val, grp_off, grp_blk, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau,
                       no_qr_h, no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale,
-                      qr_switch, s_out, z_out, chol_out):
+                      qr_switch, s_out, z_out, chol_out, err_limit):
     """One iteration with ``H`` formed from the factored coefficients
     (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_grouped`), ``P`` not formed (``no_pt``
     ``(n, 0)``), until the QR phase, which forms ``P`` in ``pt``; see :func:`rows_iteration`."""
@@ -121,8 +122,9 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
             out = newton_step(no_pt, r_fac, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat,
                               h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
                               sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
-                              chol_out)
-            return out[0], out[1], out[2], out[3], out[4], out[5], False
+                              chol_out, err_limit)
+            if out[0] != STEP_INACCURATE:
+                return out[0], out[1], out[2], out[3], out[4], out[5], False
     out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
                    pair_off, pair_row, pair_col, kk, lam, pt, False, qr_h, qr_tau, r_fac, x, theta, r0, rd,
                    rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)

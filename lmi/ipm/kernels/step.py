@@ -8,7 +8,11 @@ from numba import njit
 
 from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, pack_block, unpack_block
 
-__all__ = ["REFINE_STEPS", "newton_step", "smallest_eigenvalue"]
+__all__ = ["REFINE_STEPS", "STEP_INACCURATE", "newton_step", "smallest_eigenvalue"]
+
+#: :func:`newton_step`'s code for a corrector whose dual equation missed the accuracy asked
+#: (outside the QR phase); no step was taken.
+STEP_INACCURATE = 5
 
 #: At most this many steps of iterative refinement per Newton solve (each stops early once
 #: the residual of ``P' dz = -r_d`` stops shrinking).
@@ -95,10 +99,11 @@ def _triangular_solve(r_fac, b):
 
 @njit(**JIT)
 def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col, ent_w, sp):
-    """Scaled Newton step ``(dx, ds~, dz~)`` for the complementarity right-hand side ``u``.
+    """Scaled Newton step ``(dx, ds~, dz~, e)`` for the complementarity right-hand side ``u``.
 
     Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
-    refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks. ``sp`` holds the
+    refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks; ``e`` is the norm
+    of that residual, ``||P' dz~ + r_d||``, at the end. ``sp`` holds the
     sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)`` used for the
     products with ``P`` when ``P`` is not formed (see :func:`_pt_times`).
     """
@@ -119,7 +124,7 @@ def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_
         if new_norm >= err_norm:
             break
         dx, dzt, err, err_norm = dx + ddx, dzt_new, err_new, new_norm
-    return dx, u - dzt, dzt
+    return dx, u - dzt, dzt, err_norm
 
 
 @njit(**JIT)
@@ -306,7 +311,7 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
 @njit(**JIT)
 def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
                 ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-                pair_off, pair_row, pair_col, s_out, z_out, chol_out):
+                pair_off, pair_row, pair_col, s_out, z_out, chol_out, err_limit):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
 
     The new ``S`` is recomputed from ``x`` as ``h - G x + theta r0`` (``theta`` decays by
@@ -327,9 +332,13 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     was (:func:`scaling_and_schur_direct`); then the products with ``P`` come from the sparse
     coefficients ``sp_*``, ``pair_*`` (layout of :func:`scaling_and_schur_rows`).
 
+    Outside the QR phase, a corrector whose dual equation is met only to more than
+    ``err_limit`` (``||P' dz~ + r_d||``, :func:`_newton`) is not taken: the Cholesky factor of
+    ``H`` has lost the accuracy the step needs, and the caller goes on with the QR phase.
+
     Returns ``(code, x_new, theta_new, alpha_aff, sigma, alpha)``; ``code`` 0 on success, 1 if
     the step length is not finite or <= 1e-12, 2 if no shortened step kept ``S`` positive
-    definite.
+    definite, :data:`STEP_INACCURATE` if the corrector missed ``err_limit`` (nothing written).
     """
     nb = orders.shape[0]
     m = offsets[-1]
@@ -350,8 +359,8 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     if qr_h.shape[0] > 0:
         _dx, dsa, dza = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale)
     else:
-        _dx, dsa, dza = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row,
-                                ent_col, ent_w, sp)
+        _dx, dsa, dza, _err = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row,
+                                      ent_col, ent_w, sp)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
     sigma = (1.0 - alpha_aff) ** 3
     # corrector: u = lambda^{o-1}(sigma mu e - lambda o lambda - ds_a o dz_a)
@@ -371,8 +380,10 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     if qr_h.shape[0] > 0:
         dx, dst, dzt = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u_cor, ref_scale)
     else:
-        dx, dst, dzt = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
-                               ent_col, ent_w, sp)
+        dx, dst, dzt, err = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
+                                    ent_col, ent_w, sp)
+        if not err <= err_limit:
+            return STEP_INACCURATE, x, theta, alpha_aff, sigma, 0.0
     alpha = min(1.0, 0.99 * _max_step(lam, dst, dzt, orders, offsets, ent_row, ent_col, ent_w))
     if not (np.isfinite(alpha) and alpha > 1e-12):
         return 1, x, theta, alpha_aff, sigma, alpha
