@@ -284,7 +284,7 @@ def test_the_qr_switch_comes_later_only_where_the_qr_phase_is_expensive(monkeypa
     kernel = solver_module._kernels.grouped_iteration
 
     def spy(*args):
-        seen.append(args[-4])  # (..., ref_scale, qr_switch, s_out, z_out, chol_out)
+        seen.append(args[-5])  # (..., ref_scale, qr_switch, s_out, z_out, chol_out, err_limit)
         return kernel(*args)
 
     monkeypatch.setattr(solver_module._kernels, "grouped_iteration", spy)
