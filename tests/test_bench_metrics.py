@@ -152,6 +152,7 @@ def test_scenario_ids_are_stable_and_round_trip():
         ({"controller": "LQR", "saturation": "constraint"}, "base.saturation"),
         ({"true_inertia": [1.0, -1.0, 2.0]}, "base.true_inertia"),
         ({"disturbance_axes": ["roll", "roll"]}, "base.disturbance_axes"),
+        ({"disturbance_axes": [[]]}, "base.disturbance_axes"),  # unhashable: was a TypeError
         ({"ic_scale": 3.0}, "base.ic_scale"),
         ({"duration": 0.001}, "base.duration"),
         ({"settings": {"Npp": 3}}, "base.settings.Npp"),

@@ -100,8 +100,9 @@ def _inertia(value: Any, where: str) -> tuple[float, float, float] | None:
 
 
 def _axes(value: Any, where: str) -> tuple[str, ...]:
-    ok = isinstance(value, list | tuple) and len(value) > 0 and len(set(value)) == len(value)
-    if not ok or not all(isinstance(v, str) and v in AXES for v in value):
+    ok = (isinstance(value, list | tuple) and len(value) > 0 and all(isinstance(v, str) for v in value)
+          and len(set(value)) == len(value))
+    if not ok or not all(v in AXES for v in value):
         raise ConfigError(
             where, "a non-empty list of distinct axes among 'roll', 'pitch', 'yaw'", repr(value)
         )
