@@ -5,17 +5,17 @@ equation. The toolkit's form (**assumed**) saturates the proportional term per a
 
     u = -K_d w - K_p sat(q_v, q_s),   sat(q_v, q_s)_i = min(max(q_v,i, -q_s), q_s)
 
-on the error quaternion's vector part ``q_v``: near the target (``|q_v,i| <= q_s``) it is the
-PD of :class:`rmpc.AttitudePD` with a stiffer ``K_p``; along a large slew the proportional torque
-is at most ``K_p q_s`` per axis (diagonal gains), so the rate the loop cruises at is bounded by
-``K_p q_s / K_d`` per axis instead of growing with the slew angle. This is the saturated
-proportional term of the eigenaxis slew logic of B. Wie and J. Lu, "Feedback control logic for
-spacecraft eigenaxis rotations under slew rate and control constraints", Journal of Guidance,
-Control, and Dynamics 18(6), 1995 (there ``u = -J (2 k sat(q_v) + c w)``; here without the inertia
-factor, so that the gains compare with PD's). Defaults (**assumed**): ``K_p = 6 N m``,
-``K_d = 40 N m s`` (about the published axes: natural frequency ~0.1 rad/s, damping ~0.7 near the
-target), ``q_s = 0.2`` (proportional torque at most 1.2 N m per axis, cruise rate at most
-0.03 rad/s per axis).
+on the error quaternion's vector part ``q_v``: near the target (``|q_v,i| <= q_s``) it is the PD
+of :class:`rmpc.AttitudePD` with a stiffer ``K_p``; along a large slew the proportional torque is
+at most ``K_p q_s`` per axis (diagonal gains), so the loop cruises at about ``K_p q_s / K_d`` per
+axis (plus the gyroscopic torque's share) instead of at a rate that grows with the slew angle.
+This is the saturated proportional term of the eigenaxis slew logic of B. Wie and J. Lu, "Feedback
+control logic for spacecraft eigenaxis rotations under slew rate and control constraints", Journal
+of Guidance, Control, and Dynamics 18(6), 1995 (there ``u = -J (2 k sat(q_v) + c w)``; here
+without the inertia factor, so that the gains compare with PD's). Defaults (**assumed**): ``K_p =
+6 N m``, ``K_d = 40 N m s`` (about the published axes: natural frequency ~0.1 rad/s, damping ~0.7
+near the target), ``q_s = 0.2`` (proportional torque at most 1.2 N m per axis, cruise rate about
+0.03 rad/s per axis; 0.033 rad/s measured on the 160 deg V-slew).
 """
 
 from __future__ import annotations
