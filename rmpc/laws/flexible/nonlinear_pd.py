@@ -12,8 +12,8 @@ axis (plus the gyroscopic torque's share) instead of at a rate that grows with t
 This is the saturated proportional term of the eigenaxis slew logic of B. Wie and J. Lu, "Feedback
 control logic for spacecraft eigenaxis rotations under slew rate and control constraints", Journal
 of Guidance, Control, and Dynamics 18(6), 1995 (there ``u = -J (2 k sat(q_v) + c w)``; here
-without the inertia factor, so that the gains compare with PD's). Defaults (**assumed**): ``K_p =
-6 N m``, ``K_d = 40 N m s`` (about the published axes: natural frequency ~0.1 rad/s, damping ~0.7
+without the inertia factor, so that the gains compare with PD's). Defaults (**assumed**):
+``K_p = 6 N m``, ``K_d = 40 N m s`` (about the published axes: natural frequency ~0.1 rad/s, damping ~0.7
 near the target), ``q_s = 0.2`` (proportional torque at most 1.2 N m per axis, cruise rate about
 0.03 rad/s per axis; 0.033 rad/s measured on the 160 deg V-slew).
 """
