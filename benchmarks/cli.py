@@ -177,10 +177,11 @@ _SUITES: dict[str, tuple[str, str, str, str, str, str]] = {
     "flexible": (
         "flexible",
         "run_flexible",
-        "paper V's flexible satellite study F1-F4",
+        "paper V's flexible satellite study F1-F4 and paper S's baselines F5",
         "Run F1-F4 (paper V's flexible satellite: MTSMC and CSMC with and without PZT vibration control on "
         "the V-slew, the boundary-layer sweep, steady error with the integral term, OfflineRMPC and RMPC on "
-        "the 14-state model on a small slew) and write results.json, results.md (tables, paper V's reported "
+        "the 14-state model on a small slew; F5: paper S's baselines on the V-slew) and write results.json, "
+        "results.md (tables, paper V's reported "
         "results next to the measured ones, the papers' inconsistencies, every setting chosen), results.csv, "
         "run.json, figures/F*.png and traces/*.npz into DIR.",
         "a smoke run (run lengths x 0.02); no measurement",

@@ -7,12 +7,15 @@ uses).
 """
 
 from rmpc.controller import Controller, Status, StepInfo, StepInputs
+from rmpc.laws.flexible.adaptive_pd import AdaptivePD
 from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
 from rmpc.laws.flexible.attitude_pd import AttitudePD
 from rmpc.laws.flexible.csmc import CSMC
 from rmpc.laws.flexible.hybrid import FlexibleHybrid
+from rmpc.laws.flexible.input_shaping import ShapedPD
 from rmpc.laws.flexible.lqr import flexible_lqr
 from rmpc.laws.flexible.mtsmc import MTSMC
+from rmpc.laws.flexible.nonlinear_pd import NonlinearPD
 from rmpc.laws.flexible.robust_avc import RobustAVC
 from rmpc.laws.mrp.cf_backstepping import CFBackstepping
 from rmpc.laws.mrp.command_filter import CommandFilter
@@ -41,6 +44,7 @@ __all__ = [
     "NESO",
     "RMPC",
     "AdaptiveBacksteppingFTC",
+    "AdaptivePD",
     "AdaptiveSMC",
     "AttitudePD",
     "CFBackstepping",
@@ -49,9 +53,11 @@ __all__ = [
     "Controller",
     "FlexibleHybrid",
     "MappedController",
+    "NonlinearPD",
     "OfflineRMPC",
     "RobustAVC",
     "ScheduledRMPC",
+    "ShapedPD",
     "SineDisturbance",
     "Status",
     "StepDisturbance",

@@ -31,15 +31,18 @@ from rmpc import (
     MTSMC,
     RMPC,
     AdaptiveBacksteppingFTC,
+    AdaptivePD,
     AdaptiveSMC,
     AttitudePD,
     CFBackstepping,
     Controller,
     FlexibleHybrid,
     MappedController,
+    NonlinearPD,
     OfflineRMPC,
     RobustAVC,
     ScheduledRMPC,
+    ShapedPD,
     Status,
     StepInfo,
     StepInputs,
@@ -112,6 +115,10 @@ CONTROLLERS: dict[str, tuple[Callable[[], tuple[Any, np.ndarray]], str]] = {
     "PD": (lambda: _flexible_with(AttitudePD), "PD"),
     "PD-DOB": (lambda: _flexible_with(lambda s: AttitudePD(s, disturbance_observer=True)), "PD-DOB"),
     "ASMC": (lambda: _flexible_with(AdaptiveSMC), "ASMC"),
+    "NPD": (lambda: _flexible_with(NonlinearPD), "NPD"),
+    "APD": (lambda: _flexible_with(AdaptivePD), "APD"),
+    "ZVD-PD": (lambda: _flexible_with(ShapedPD), "ZVD-PD"),
+    "ZV-PD": (lambda: _flexible_with(lambda s: ShapedPD(s, kind="zv")), "ZV-PD"),
     "AVC": (lambda: _flexible_with(RobustAVC), "AVC"),
     "CSMC+AVC": (lambda: _flexible_with(lambda s: FlexibleHybrid(CSMC(s), RobustAVC(s))), "CSMC+AVC"),
     "flexible LQR": (lambda: _flexible_with(flexible_lqr), "LQR"),
@@ -157,7 +164,8 @@ def test_every_controller_takes_the_step_channel_and_names_an_unknown_field(key:
 
 def test_the_attitude_laws_accept_the_pzt_command_and_nothing_else() -> None:
     sat, x = _flexible()
-    for law in (MTSMC(sat), CSMC(sat), AttitudePD(sat), AdaptiveSMC(sat)):
+    for law in (MTSMC(sat), CSMC(sat), AttitudePD(sat), AdaptiveSMC(sat), NonlinearPD(sat), AdaptivePD(sat),
+                ShapedPD(sat)):
         assert law.accepts == frozenset({"pzt"}), law.name
         v = np.array([0.02, -0.01, 0.0, 0.005])
         u = law.step(x, StepInputs(pzt=v))

@@ -1,4 +1,5 @@
-"""The benchmark suite "flexible": paper V's study on the flexible satellite (F1-F4).
+"""The benchmark suite "flexible": paper V's study on the flexible satellite (F1-F4) and paper S's
+baselines (F5).
 
 Every run uses the published 4-mode plant with the PZT channel (:class:`models.FlexibleSatellite`,
 the published 4-mode set), the 2 N m per-axis hub-torque limit and the hub disturbance the toolkit
@@ -14,6 +15,8 @@ F4    a 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14
       over the 8-vertex polytope (inertia, modal frequencies, damping) against MTSMC and the
       LQR reference, RMPC with a bound on the modal coordinates; the V-slew by MTSMC handing
       over to OfflineRMPC inside 20 deg
+F5    paper S's baselines on the V-slew (:mod:`benchmarks.suites.flexible_f5`): PD, PD-DOB,
+      ASMC, nonlinear PD, adaptive-gain PD, ZVD-shaped PD
 ====  =====================================================================================
 
 :func:`flexible_cases` lists the cases; :func:`run_flexible` runs them in parallel and writes
@@ -41,6 +44,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.flexible import defaults
+from benchmarks.suites.flexible_f5 import F5_BASELINES
 from benchmarks.suites.flexible_report import (
     REACH_GAMMAS,
     case_row,
@@ -74,6 +78,9 @@ EXPERIMENTS: dict[str, str] = {
     "reference; RMPC with |eta_i| <= 0.02 on the 8-vertex polytope, and with and without it on the "
     "2-vertex polytope; and the 160 deg "
     "V-slew by MTSMC handing over to OfflineRMPC (0.01 s) inside 20 deg.",
+    "F5": "Paper S's baselines head to head on F1's V-slew with F1's metrics: PD, PD with the disturbance "
+    "observer, adaptive SMC, nonlinear (saturated) PD, adaptive-gain PD and PD behind a ZVD shaper on "
+    "mode 1.",
 }
 
 #: The fraction of each run length kept by ``--short``.
@@ -95,13 +102,13 @@ def _case(exp: str, tag: str, data: dict[str, Any]) -> SuiteCase:
 
 
 def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[SuiteCase]:
-    """The cases of F1-F4 (run lengths multiplied by ``time_scale``).
+    """The cases of F1-F5 (run lengths multiplied by ``time_scale``).
 
     Examples
     --------
     >>> cases = flexible_cases()
     >>> len(cases), sorted({c.experiment for c in cases})
-    (26, ['F1', 'F2', 'F3', 'F4'])
+    (32, ['F1', 'F2', 'F3', 'F4', 'F5'])
     """
     from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 
@@ -127,6 +134,9 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
                 data = {**base, "controller": "MTSMC", "experiment": "steady", "integral_gain": k_i}
                 cases.append(_case(exp, f"MTSMC_kI{k_i:g}", data))
             cases.append(_case(exp, "CSMC", {**base, "controller": "CSMC", "experiment": "steady"}))
+        elif exp == "F5":
+            for tag, data in F5_BASELINES:
+                cases.append(_case(exp, tag, {**base, **data}))
         else:
             for ctrl in ("MTSMC", "LQR", "OfflineRMPC", "RMPC"):
                 cases.append(_case(exp, ctrl, {**base, "controller": ctrl, "experiment": "small"}))
@@ -166,7 +176,7 @@ def run_flexible(
     experiments: Sequence[str] | None = None,
     progress: bool | None = None,
 ) -> SuiteOutcome:
-    """Run F1-F4 and write every output file into ``out`` (created if needed).
+    """Run F1-F5 and write every output file into ``out`` (created if needed).
 
     Parameters are those of :func:`benchmarks.suites.faults.run_faults`.
     """

@@ -1,6 +1,6 @@
 """The text of the flexible suite's report: table rows, paper V's claims, the F3/F4 notes, results.md.
 
-:mod:`benchmarks.suites.flexible` defines and runs the experiments F1-F4 and writes the files;
+:mod:`benchmarks.suites.flexible` defines and runs the experiments F1-F5 and writes the files;
 this module turns the records into words: :func:`case_row` (one table row), the F3 steady error
 against the boundary-layer prediction, what the robust MPC costs in F4 (with its modal bound and, measured
 when the report is written, how far along the slew axis the LMIs reach),
@@ -509,6 +509,10 @@ def results_markdown(
             lines += _steady_lines(records)
         if exp == "F4":
             lines += _f4_lines(records, modal_bound_polytopes)
+        if exp == "F5":
+            from benchmarks.suites.flexible_f5 import f5_lines
+
+            lines += f5_lines(records, case_row)
         if exp in figures:
             lines += [f"![{exp}]({figures[exp].relative_to(out).as_posix()})", ""]
     lines += paper_v_comparison(records)

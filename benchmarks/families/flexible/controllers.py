@@ -11,6 +11,10 @@
 - ``PD`` (:class:`rmpc.AttitudePD`, paper S's industrial anchor, optionally with its disturbance
   observer) and ``LQR`` (:func:`rmpc.flexible_lqr`, the unconstrained one-vertex reference), also
   with AVC on request;
+- paper S's other baselines: ``ASMC`` (:class:`rmpc.AdaptiveSMC`), ``NPD``
+  (:class:`rmpc.NonlinearPD`, saturated proportional term), ``APD`` (:class:`rmpc.AdaptivePD`,
+  gains adapted in a box) and ``ZVD-PD`` (:class:`rmpc.ShapedPD`, PD behind a ZVD shaper on the
+  first mode), also with AVC on request;
 - ``RMPC`` (:class:`rmpc.RMPC`, on-line, holding its last solution while the state stays in
   the ``resolve_threshold`` level set of its ellipsoid) and ``OfflineRMPC``
   (:class:`rmpc.OfflineRMPC`, Wan & Kothare 2003, its table designed once from the initial
@@ -36,6 +40,7 @@ from toolkit_common.errors import ConfigError
 __all__ = [
     "CONSTRAINED",
     "CONTROLLERS",
+    "PD_LIKE",
     "FlexibleModel",
     "HandOver",
     "linear_weights",
@@ -170,6 +175,47 @@ def _pd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControlle
     return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
 
 
+def _asmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc import AdaptiveSMC
+
+    keys = ("lam", "K_s", "s_b", "n0", "e0", "n1", "e1")
+    law = AdaptiveSMC(m.satellite, m.dt, **{k: s[k] for k in keys})
+    return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
+
+
+def _npd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc import NonlinearPD
+
+    law = NonlinearPD(m.satellite, m.dt, K_p=s["K_p"], K_d=s["K_d"], q_s=s["q_s"])
+    return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
+
+
+def _apd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc import AdaptivePD
+
+    keys = ("k_p0", "k_d0", "k_p_max", "k_d_max", "gamma_p", "gamma_d", "sigma")
+    law = AdaptivePD(m.satellite, m.dt, **{k: s[k] for k in keys})
+    return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
+
+
+def _zvd_pd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from rmpc import ShapedPD
+
+    law = ShapedPD(m.satellite, m.dt, K_p=s["K_p"], K_d=s["K_d"], kind="zvd")
+    return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
+
+
+#: Paper S's baselines with their PD-like gains ``(K_p, K_d)`` near the target (for the regime
+#: label's bandwidth): PD, nonlinear PD (unsaturated there), adaptive-gain PD (its lowest gains)
+#: and PD behind the ZVD shaper.
+PD_LIKE: Mapping[str, tuple[str, str]] = {
+    "PD": ("K_p", "K_d"),
+    "NPD": ("K_p", "K_d"),
+    "APD": ("k_p0", "k_d0"),
+    "ZVD-PD": ("K_p", "K_d"),
+}
+
+
 def linear_weights(settings: Mapping[str, Any], n_modes: int) -> tuple[np.ndarray, np.ndarray]:
     """``(Q, R)`` on ``[q_v, w, eta, eta']`` and the hub torques from the scalar weight settings."""
     diag = [settings["q_weight"]] * 3 + [settings["w_weight"]] * 3 + [settings["eta_weight"]] * (2 * n_modes)
@@ -275,6 +321,10 @@ CONTROLLERS: Mapping[str, Callable[[Any, Any, Mapping[str, Any]], BuiltControlle
     "CSMC": _csmc,
     "PD": _pd,
     "LQR": _lqr,
+    "ASMC": _asmc,
+    "NPD": _npd,
+    "APD": _apd,
+    "ZVD-PD": _zvd_pd,
     "RMPC": _rmpc,
     "OfflineRMPC": _offline,
 }

@@ -54,6 +54,22 @@ CONTROLLER_DEFAULTS: Mapping[str, Mapping[str, Any]] = MappingProxyType(
         "MTSMC": MappingProxyType({"alpha_f": 0.1, "tau_a": 15.0, **_SMC_COMMON}),
         "CSMC": MappingProxyType({"lam": 0.1, **_SMC_COMMON}),
         "PD": MappingProxyType({"K_p": 2.0, "K_d": 30.0, "disturbance_observer": False}),
+        "ASMC": MappingProxyType(
+            {"lam": 0.1, "K_s": 20.0, "s_b": 0.01, "n0": 10.0, "e0": 0.1, "n1": 10.0, "e1": 0.1}
+        ),
+        "NPD": MappingProxyType({"K_p": 6.0, "K_d": 40.0, "q_s": 0.2}),
+        "APD": MappingProxyType(
+            {
+                "k_p0": 2.0,
+                "k_d0": 30.0,
+                "k_p_max": 8.0,
+                "k_d_max": 60.0,
+                "gamma_p": 1.0,
+                "gamma_d": 500.0,
+                "sigma": 0.05,
+            }
+        ),
+        "ZVD-PD": MappingProxyType({"K_p": 2.0, "K_d": 30.0}),
         "LQR": MappingProxyType({"q_weight": 4.0, "w_weight": 0.0, "eta_weight": 0.0, "r_weight": 1.0}),
         "RMPC": MappingProxyType(
             {
@@ -153,6 +169,14 @@ def settings_rows() -> list[tuple[str, str, str]]:
             "structure likely (paper V's theorem 2), details assumed (lost)",
         ),
         ("PD (paper S)", "K_p = 2, K_d = 30 N m s", "assumed: paper S prints the law, not its gains"),
+        (
+            "paper S's other baselines (F5)",
+            "PD-DOB: PD with L_o = 0.5 1/s; ASMC: lambda = 0.1 1/s, K_s = 20 N m s, s_b = 0.01 rad/s, "
+            "n0 = n1 = 10, e0 = e1 = 0.1; NPD: K_p = 6 N m, K_d = 40 N m s, q_s = 0.2; APD: k_p in "
+            "[2, 8] N m, k_d in [30, 60] N m s, gamma_p = 1, gamma_d = 500, sigma = 0.05 1/s; ZVD-PD: "
+            "PD's gains behind a ZVD shaper on mode 1 (Lambda_1 = 0.7681 rad/s, zeta_1 = 0.0056)",
+            "assumed: paper S surveys these laws without gains (ASMC's adaptive term is printed)",
+        ),
         ("LQR", "Q = diag(4 I3, 0), R = I3 on [q_v, w, eta, eta']", "assumed (rmpc.flexible_lqr)"),
         (
             "RMPC / OfflineRMPC weights",

@@ -68,7 +68,13 @@ from benchmarks.core.family import (
 )
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.flexible import defaults
-from benchmarks.families.flexible.controllers import CONSTRAINED, CONTROLLERS, FlexibleModel, settings_check
+from benchmarks.families.flexible.controllers import (
+    CONSTRAINED,
+    CONTROLLERS,
+    PD_LIKE,
+    FlexibleModel,
+    settings_check,
+)
 from toolkit_common.errors import ConfigError
 
 __all__ = ["FLEXIBLE", "eta1_frequency", "simulate_case"]
@@ -142,6 +148,8 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
 def controller_name(scenario: Any) -> str:
     """The record name of the closed loop: the controller, ``"+AVC"`` with vibration control."""
     base = scenario.controller if scenario.handover_deg is None else "MTSMC>" + scenario.controller
+    if scenario.controller == "PD" and scenario.settings.get("disturbance_observer"):
+        base = "PD-DOB"  # the law's own name
     return base + ("+AVC" if scenario.avc else "")
 
 
@@ -196,13 +204,12 @@ def _bandwidth(scenario: Any, settings: Mapping[str, Any], sat: Any, gain: np.nd
     """The attitude loop's bandwidth (rad/s) for paper S's regime label (see the defaults)."""
     if scenario.controller == "MTSMC":
         return settings["alpha_f"] / 2.0
-    if scenario.controller == "CSMC":
+    if scenario.controller in ("CSMC", "ASMC"):
         return settings["lam"] / 2.0
-    if scenario.controller == "PD":
+    if scenario.controller in PD_LIKE:
+        k_p, k_d = (settings[key] for key in PD_LIKE[scenario.controller])
         jinv = np.linalg.inv(sat.inertia)
-        a = np.block(
-            [[np.zeros((3, 3)), 0.5 * np.eye(3)], [-settings["K_p"] * jinv, -settings["K_d"] * jinv]]
-        )
+        a = np.block([[np.zeros((3, 3)), 0.5 * np.eye(3)], [-k_p * jinv, -k_d * jinv]])
         return float(np.abs(np.linalg.eigvals(a)).max())
     if gain is None:
         return None
