@@ -64,10 +64,12 @@ def test_short_records_carry_the_window_and_rate_metrics(short_records):
         for (lo, hi), key in ((EARLY_WINDOW, "eta1_rms_early"), (LATE_WINDOW, "eta1_rms_late")):
             inside = (t >= t[0] + lo * span - 1e-9) & (t <= t[0] + hi * span + 1e-9)
             assert m[key] == pytest.approx(np.sqrt(np.mean(eta1[inside] ** 2)), rel=1e-12)
+        late = (t >= t[0] + LATE_WINDOW[0] * span - 1e-9)
         w = np.asarray(tr["w"])
-        hf = highpass(w, 0.01, rec["settings"]["first_mode_frequency"] / 2)
-        assert m["rate_hf_rms"] == pytest.approx(np.sqrt(np.mean(np.sum(hf**2, axis=1))), rel=1e-12)
-        assert m["rate_hf_share"] == pytest.approx(m["rate_hf_rms"] / np.sqrt(np.mean(np.sum(w**2, 1))))
+        hf = highpass(w, 0.01, rec["settings"]["first_mode_frequency"] / 2)[late]
+        assert m["rate_hf_rms_late"] == pytest.approx(np.sqrt(np.mean(np.sum(hf**2, axis=1))), rel=1e-12)
+        rms_w = np.sqrt(np.mean(np.sum(w[late] ** 2, axis=1)))
+        assert m["rate_hf_share_late"] == pytest.approx(m["rate_hf_rms_late"] / rms_w, rel=1e-12)
         assert m["mode1_open_loop_decay_rate"] == pytest.approx(0.0050, abs=5e-5)  # eigenvalue -0.0050
 
 
@@ -81,12 +83,12 @@ def test_verdicts_follow_the_short_runs_numbers(short_records):
     assert claims["V6"].verdict == expected
     assert f"{mt['modal_work_after']:.3g} J" in claims["V6"].evidence
     factors = [
-        r["metrics"]["rate_hf_share"] / r["metrics"]["attitude_hf_share"]
+        r["metrics"]["rate_hf_share_late"] / r["metrics"]["attitude_hf_share_late"]
         for r in (_rec(short_records, "F1", "MTSMC"), _rec(short_records, "F1", "CSMC"))
     ]
     assert claims["V7"].verdict == ("reproduced" if min(factors) >= fc.SHOWS_FACTOR else "not reproduced")
     base, fast = _rec(short_records, "F1", "MTSMC"), _rec(short_records, "F6", "MTSMC")
-    ordered = fast["metrics"]["attitude_hf_share"] > base["metrics"]["attitude_hf_share"]
+    ordered = fast["metrics"]["modal_work_peak"] > base["metrics"]["modal_work_peak"]
     assert claims["S1"].verdict == ("reproduced" if ordered else "partly reproduced")
     assert "labels in the run: flexible-hard, rigid-like" in claims["S1"].evidence
 
@@ -101,11 +103,11 @@ def _synthetic():
     return [
         rec("F1", "MTSMC", modal_work_after=1e-4, modal_work_peak=3e-3, eta1_rms_early=0.04,
             eta1_rms_late=0.024, eta1_decay_rate=0.0054, mode1_open_loop_decay_rate=0.005,
-            rate_hf_share=0.015, attitude_hf_share=1e-4, rate_hf_rms=4e-4, attitude_hf_rms_deg=6e-3,
-            modal_energy_ratio=0.007),
-        rec("F1", "CSMC", rate_hf_share=0.04, attitude_hf_share=2e-3, rate_hf_rms=1e-3,
-            attitude_hf_rms_deg=0.08),
-        rec("F6", "MTSMC", bandwidth=0.4, regime="flexible-hard", attitude_hf_share=1e-2,
+            rate_hf_share_late=4e-3, attitude_hf_share_late=2e-4, rate_hf_rms_late=1.5e-6,
+            attitude_hf_rms_late_deg=1.2e-4, modal_energy_ratio=0.007),
+        rec("F1", "CSMC", rate_hf_share_late=9e-3, attitude_hf_share_late=5e-4, rate_hf_rms_late=3e-6,
+            attitude_hf_rms_late_deg=2e-4),
+        rec("F6", "MTSMC", bandwidth=0.4, regime="flexible-hard", modal_work_peak=1.5e-2, eta_peak=[0.2],
             modal_energy_ratio=0.004),
     ]
 
@@ -123,13 +125,13 @@ def test_verdicts_flip_with_the_numbers():
     grown[0]["metrics"].update(eta1_rms_late=0.05)
     assert _by_key(grown)["V6"].verdict == "not reproduced"
     flat = copy.deepcopy(records)
-    flat[1]["metrics"]["attitude_hf_share"] = 0.01  # CSMC: the attitude shares the rate's content
+    flat[1]["metrics"]["attitude_hf_share_late"] = 1e-3  # CSMC: rate share only 9 x the attitude's
     assert _by_key(flat)["V7"].verdict == "not reproduced"
     same = copy.deepcopy(records)
     same[2]["metrics"]["regime"] = "rigid-like"
     assert _by_key(same)["S1"].verdict == "partly reproduced" and "same label" in _by_key(same)["S1"].why
     reversed_ = copy.deepcopy(records)
-    reversed_[2]["metrics"]["attitude_hf_share"] = 1e-5
+    reversed_[2]["metrics"]["modal_work_peak"] = 1e-3
     assert _by_key(reversed_)["S1"].verdict == "partly reproduced"
     assert [c.verdict for c in fc.assess_flexible([])] == ["not run"] * 3
 

@@ -144,7 +144,11 @@ def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], 
         ax_m.set_ylabel("eta_1 (kg^1/2 m)")
     if ax_r is not None:
         ax_r.set_ylabel("||w_hf|| (rad/s)")
-        ax_r.set_title("body rate above Lambda_1/2 (the part the modes drive)", fontsize=9)
+        ax_r.set_title(
+            "body rate above Lambda_1/2: early the loop's own fast transient, late the modes "
+            "(the report's V7)",
+            fontsize=9,
+        )
     if ax_v is not None:
         ax_v.set_ylabel(f"max_j |v_j| ({PZT_UNIT})")
     names = [name for name, _, _ in items]

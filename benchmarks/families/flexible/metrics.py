@@ -27,10 +27,13 @@ Definitions where paper V gives none are the toolkit's (**assumed**):
 - ``modal_work_peak`` / ``modal_work_after``: the work ``-int eta'^T delta w' dt`` of the hub's motion on
   the modes (J, :func:`hub_work_on_modes`): its largest running value, and what it adds from the start
   of :data:`EARLY_WINDOW` to the end (the excitation after "about 30 s" of paper V);
-- ``rate_hf_rms`` / ``attitude_hf_rms_deg``: RMS over the run of the part of the body rate (rad/s) and
-  of the attitude error's rotation vector ``2 q_v`` (deg) above ``Lambda_1 / 2``
-  (:func:`highpass`); ``rate_hf_share`` / ``attitude_hf_share``: each over the RMS of its whole
-  signal (``None`` for runs too short to filter);
+- ``rate_hf_rms_late`` / ``attitude_hf_rms_late_deg``: RMS over :data:`LATE_WINDOW` of the part of
+  the body rate (rad/s) and of the attitude error's rotation vector ``2 q_v`` (deg) above
+  ``Lambda_1 / 2`` (:func:`highpass` over the whole run); ``rate_hf_share_late`` /
+  ``attitude_hf_share_late``: each over the RMS of its whole signal on that window (``None`` for
+  runs too short to filter). The late window, because early in a slew the part above
+  ``Lambda_1 / 2`` is also the loop's own fast transient (it is the same with the modes damped by
+  AVC), while at the end it is the modes';
 - ``modal_energy_ratio``: the largest modal energy over the largest rigid kinetic energy ``w' J w / 2``
   (0 for a run that never moves).
 """
@@ -181,7 +184,7 @@ def _modal_metrics(traj: Trajectory, satellite: FlexibleSatellite) -> dict[str, 
     if n:
         eta1 = traj.x[:, 7]
         rms_e, rms_l = _rms(eta1[early]), _rms(eta1[late])
-        gap = float(np.mean(t[late]) - np.mean(t[early]))
+        gap = float(np.mean(t[late]) - np.mean(t[early])) if early.any() and late.any() else 0.0
         out["eta1_rms_early"], out["eta1_rms_late"] = rms_e, rms_l
         decays = rms_e > 0 and rms_l > 0 and gap > 0
         out["eta1_decay_rate"] = float(np.log(rms_e / rms_l) / gap) if decays else None
@@ -196,11 +199,11 @@ def _modal_metrics(traj: Trajectory, satellite: FlexibleSatellite) -> dict[str, 
     cutoff = float(satellite.frequencies[0]) / 2.0 if n else np.inf
     hw = highpass(w, traj.dt, cutoff) if n else None
     hq = highpass(rotvec, traj.dt, cutoff) if n else None
-    out["rate_hf_rms"] = None if hw is None else _rms(hw)
-    out["attitude_hf_rms_deg"] = None if hq is None else float(np.degrees(_rms(hq)))
-    rms_w, rms_q = _rms(w), _rms(rotvec)
-    out["rate_hf_share"] = None if hw is None or rms_w == 0 else _rms(hw) / rms_w
-    out["attitude_hf_share"] = None if hq is None or rms_q == 0 else _rms(hq) / rms_q
+    out["rate_hf_rms_late"] = None if hw is None else _rms(hw[late])
+    out["attitude_hf_rms_late_deg"] = None if hq is None else float(np.degrees(_rms(hq[late])))
+    rms_w, rms_q = _rms(w[late]), _rms(rotvec[late])
+    out["rate_hf_share_late"] = None if hw is None or rms_w == 0 else _rms(hw[late]) / rms_w
+    out["attitude_hf_share_late"] = None if hq is None or rms_q == 0 else _rms(hq[late]) / rms_q
     inertia = np.asarray(satellite.inertia)
     kinetic = 0.5 * np.einsum("ti,ij,tj->t", w, inertia, w).max()
     modal = max(satellite.modal_energy(x) for x in traj.x)
