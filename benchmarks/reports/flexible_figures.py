@@ -145,8 +145,7 @@ def flexible_group_figure(items: Sequence[tuple[str, Mapping[str, Any], dict]], 
     if ax_r is not None:
         ax_r.set_ylabel("||w_hf|| (rad/s)")
         ax_r.set_title(
-            "body rate above Lambda_1/2: early the loop's own fast transient, late the modes "
-            "(the report's V7)",
+            "body rate above Lambda_1/2 (V7 of the report measures it on the run's last fifth)",
             fontsize=9,
         )
     if ax_v is not None:
