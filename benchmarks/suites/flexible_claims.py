@@ -95,7 +95,7 @@ def _v6(records: Sequence[dict]) -> Claim:
         )
         if lo <= ratio <= hi:
             why_ring = (
-                "what still rings is mode 1's free vibration from the slew's start, decaying at the "
+                f"what still rings is mode 1's free vibration, put in before {w0:g} s, decaying at the "
                 "structural damping rate: the attitude loop (bandwidth "
                 f"{mt['metrics'].get('bandwidth') or float('nan'):.3g} rad/s) neither feeds nor damps it"
             )
