@@ -104,7 +104,10 @@ def test_bench_faults_short_writes_every_file(tmp_path, capsys, monkeypatch):
     # the torque limits, the wheel momenta with the momentum limits, the fault window shaded
     ((items, windows, title, torque_max, momentum_max), fig) = built[0]
     assert len(built) == 1 and title.startswith("W1: ")
-    wheels = WheelArray.paper_w()
+    wheels = WheelArray.paper_w()  # S1's plant keeps paper W's wheels: the case's limits are theirs
+    for rec, _ in items:
+        assert rec["settings"]["wheel_torque_max"] == wheels.torque_max.tolist()
+        assert rec["settings"]["wheel_momentum_max"] == wheels.momentum_max.tolist()
     assert torque_max == np.max(wheels.torque_max) and momentum_max == np.max(wheels.momentum_max)
     assert [rec["controller"] for rec, _ in items] == [r["controller"] for r in records]
     grid = np.array(visible_axes(fig)).reshape(3, len(items))
@@ -149,3 +152,16 @@ def test_bench_faults_short_w3_hatches_the_rank_deficient_windows(tmp_path, caps
 def test_a_run_shorter_than_the_scenario_faults_is_refused():
     with pytest.raises(ConfigError, match="duration"):
         Scenario.from_dict({"family": "wheel", "scenario": "S2", "duration": 10.0})
+
+
+def test_fault_figures_draw_the_limits_of_the_case_not_the_defaults():
+    """The limits a figure draws are those the records' plants applied (here other than paper W's),
+    the largest over the group; a plant without limits adds none."""
+    from benchmarks.suites.faults import _case_limits
+
+    def rec(torque, momentum):
+        return {"settings": {"wheel_torque_max": torque, "wheel_momentum_max": momentum}}
+
+    records = [rec([0.05, 0.05, 0.06, 0.05], [0.3] * 4), rec(None, None), rec([0.04] * 4, [0.5] * 4)]
+    assert _case_limits(records) == (0.06, 0.5)
+    assert all(np.isnan(_case_limits([rec(None, None)])))

@@ -14,6 +14,7 @@ from benchmarks.cli import main
 from benchmarks.core.runner import run_scenario
 from benchmarks.core.scenario import Scenario
 from benchmarks.families.flexible.family import eta1_frequency
+from benchmarks.families.flexible.metrics import highpass
 from benchmarks.suites.flexible import F4_MODAL_BOUND, MODAL_BOUND_POLYTOPE, flexible_cases, inconsistencies
 from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 from toolkit_common.errors import ConfigError
@@ -210,13 +211,19 @@ def test_bench_flexible_short_writes_every_file(tmp_path, capsys, monkeypatch):
     # PZT panel holds the runs with AVC (the others' commands are zero)
     ((items, title), fig) = built[0]
     assert len(built) == 1 and title == f"F1: {flexible_suite.EXPERIMENTS['F1']}"  # the whole title
-    err, tor, zoom, mode, pzt = visible_axes(fig)
+    err, tor, zoom, mode, rate, pzt = visible_axes(fig)
     names = [name for name, _, _ in items]
-    assert len(names) == 4 and err.get_yscale() == "log"
+    assert len(names) == 4 and err.get_yscale() == "log" and rate.get_yscale() == "log"
     assert_readable(fig, names)
-    for ax in (err, tor, zoom, mode):
+    for ax in (err, tor, zoom, mode, rate):
         assert [line.get_label() for line in run_curves(ax, names)] == names
     assert tor.get_ylabel() == "max_i |u_i| (N m)" and pzt.get_ylabel().startswith("max_j |v_j| (kg")
+    # the rate panel: the body rate's part above Lambda_1/2 of each run, from its trace
+    assert rate.get_ylabel() == "||w_hf|| (rad/s)"
+    for line, (_, rec, trace) in zip(run_curves(rate, names), items, strict=True):
+        cut = rec["settings"]["first_mode_frequency"] / 2.0
+        hf = np.linalg.norm(highpass(np.asarray(trace["w"]), 0.01, cut), axis=1)
+        np.testing.assert_allclose(line.get_ydata(), np.maximum(hf, 1e-9), rtol=1e-12)
     avc = [(name, trace) for name, _, trace in items if name.endswith("_AVC")]  # the suite's tags
     assert [line.get_label() for line in curves(pzt)] == [name for name, _ in avc] and len(avc) == 2
     for line, (_, trace) in zip(curves(pzt), avc, strict=True):
@@ -255,7 +262,8 @@ def test_bench_flexible_short_figures_f2_and_f4(tmp_path, capsys, monkeypatch):
         assert_readable(fig, names)  # F2: eleven runs, eleven colours; F4: its long title inside
         assert title == f"{exp}: {flexible_suite.EXPERIMENTS[exp]}"
         axes = visible_axes(fig)
-        assert len(axes) == 4  # error, torque, torque on the residual window, eta_1: no run drives a PZT
+        assert len(axes) == 5  # error, torque, its residual window, eta_1, rates: no run drives a PZT
+        assert axes[4].get_ylabel() == "||w_hf|| (rad/s)"
         assert not any("v_j" in ax.get_ylabel() for ax in axes)
         bounds = sorted({r["settings"]["modal_bound"] for r in records if r["experiment"] == exp} - {None})
         assert hline_values(axes[3]) == sorted([-b for b in bounds] + bounds)

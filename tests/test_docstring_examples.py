@@ -43,6 +43,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.suites.mrp",
     "benchmarks.suites.faults_claims",
     "benchmarks.suites.mrp_claims",
+    "benchmarks.suites.flexible_claims",
     "benchmarks.suites.paper",
     "benchmarks.suites.paper_claims",
     "benchmarks.timing.common",

@@ -114,7 +114,9 @@ def test_gamma_figure_one_log_panel_per_experiment_with_a_bound():
     axes = visible_axes(fig)
     assert [ax.get_title() for ax in axes] == ["E1", "E2"]
     for ax in axes:
-        assert ax.get_yscale() == "log" and ax.get_ylabel() == "gamma(k)" and ax.get_xlabel() == "time (s)"
+        assert ax.get_yscale() == "log" and ax.get_xlabel() == "time (s)"
+        # "gamma(k)" alone passes a unit check through "(k)": the label must say it has no unit
+        assert ax.get_ylabel() == "cost bound gamma(k) (dimensionless)"
         labels = [line.get_label() for line in curves(ax)]
         assert labels == ["RMPC limiter (linear)", "RMPC limiter (nonlinear)"]
         np.testing.assert_allclose(curves(ax)[0].get_ydata(), runs[0][1]["gamma"])

@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 
 from benchmarks.reports.figure_style import PALETTE
 
-__all__ = ["gamma_figure", "plot_gamma", "plot_responses", "responses_figure"]
+__all__ = ["GAMMA_LABEL", "gamma_figure", "plot_gamma", "plot_responses", "responses_figure"]
 
 _AXIS_LABELS = ("roll $\\phi$", "pitch $\\theta$", "yaw $\\psi$")
 _TORQUE_LABELS = ("$M_x$", "$M_y$", "$M_z$")
@@ -113,6 +113,11 @@ def plot_responses(runs: Sequence[Run], path: str | Path, title: str, u_max: flo
     return path
 
 
+#: The y label of the gamma panels: the robust MPC's bound on the infinite-horizon cost
+#: ``sum x'Qx + u'Ru``, a pure number (the state and input weights make it dimensionless).
+GAMMA_LABEL = "cost bound gamma(k) (dimensionless)"
+
+
 def gamma_figure(groups: Mapping[str, Sequence[Run]]) -> Figure | None:
     """The cost bound gamma(k) on a log axis, one panel per experiment (steps that solved only).
 
@@ -154,7 +159,7 @@ def gamma_figure(groups: Mapping[str, Sequence[Run]]) -> Figure | None:
             )
         ax.set_title(name)
         ax.set_xlabel("time (s)")
-        ax.set_ylabel("gamma(k)")
+        ax.set_ylabel(GAMMA_LABEL)
         ax.grid(True, which="major", alpha=0.3)
         ax.legend(fontsize="x-small")
     for ax in axes[len(panels) :]:

@@ -29,8 +29,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
@@ -428,6 +426,16 @@ def inconsistencies(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+def _case_limits(records: Sequence[dict]) -> tuple[float, float]:
+    """The largest wheel torque (N m) and momentum (N m s) limits of the plants of ``records`` (NaN where
+    no plant applies one)."""
+    def largest(key: str) -> float:
+        values = [max(r["settings"][key]) for r in records if r["settings"].get(key)]
+        return float(max(values, default=math.nan))
+
+    return largest("wheel_torque_max"), largest("wheel_momentum_max")
+
+
 def _write(
     out: Path,
     cases: list[SuiteCase],
@@ -439,10 +447,8 @@ def _write(
 ) -> list[Path]:
     from benchmarks.families.wheel.family import case_faults
     from benchmarks.reports.fault_figures import plot_fault_case_group
-    from models import WheelArray
 
     files: list[Path] = write_traces(out, runs)
-    wheels = WheelArray.paper_w()
     groups: dict[tuple[str, float], list[tuple[SuiteCase, dict, dict]]] = {}
     for case, rec, trace in runs:
         groups.setdefault((case.experiment, rec["settings"]["inertia_scale_used"]), []).append(
@@ -459,8 +465,7 @@ def _write(
             windows,
             out / "figures" / f"{name}.png",
             f"{name}: paper W's {EXPERIMENTS[exp][0]}",
-            float(np.max(wheels.torque_max)),
-            float(np.max(wheels.momentum_max)),
+            *_case_limits([rec for _, rec, _ in items]),
         )
         figures.setdefault(exp, []).append(path)
         files.append(path)

@@ -1,5 +1,5 @@
-"""The benchmark suite "flexible": paper V's study on the flexible satellite (F1-F4) and paper S's
-baselines (F5).
+"""The benchmark suite "flexible": paper V's study on the flexible satellite (F1-F4, F6) and paper
+S's baselines (F5).
 
 Every run uses the published 4-mode plant with the PZT channel (:class:`models.FlexibleSatellite`,
 the published 4-mode set), the 2 N m per-axis hub-torque limit and the hub disturbance the toolkit
@@ -17,6 +17,8 @@ F4    a 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14
       over to OfflineRMPC inside 20 deg
 F5    paper S's baselines on the V-slew (:mod:`benchmarks.suites.flexible_f5`): PD, PD-DOB,
       ASMC, nonlinear PD, adaptive-gain PD, ZVD-shaped PD
+F6    the regime label: MTSMC on the V-slew at a high gain (alpha_f = F6_ALPHA_F), whose bandwidth
+      is past Lambda_1/2, against F1's MTSMC (rigid-like)
 ====  =====================================================================================
 
 :func:`flexible_cases` lists the cases; :func:`run_flexible` runs them in parallel and writes
@@ -56,6 +58,7 @@ from benchmarks.suites.flexible_report import (
 __all__ = [
     "EXPERIMENTS",
     "F4_MODAL_BOUND",
+    "F6_ALPHA_F",
     "HANDOVER_DEG",
     "MODAL_BOUND_POLYTOPE",
     "REACH_GAMMAS",
@@ -81,6 +84,8 @@ EXPERIMENTS: dict[str, str] = {
     "F5": "Paper S's baselines head to head on F1's V-slew with F1's metrics: PD, PD with the disturbance "
     "observer, adaptive SMC, nonlinear (saturated) PD, adaptive-gain PD and PD behind a ZVD shaper on "
     "mode 1.",
+    "F6": "Paper S's regime label: MTSMC on the V-slew with alpha_f = 0.8 1/s (bandwidth 0.4 rad/s, past "
+    "Lambda_1/2), against F1's MTSMC (0.05 rad/s, rigid-like).",
 }
 
 #: The fraction of each run length kept by ``--short``.
@@ -96,19 +101,22 @@ MODAL_BOUND_POLYTOPE = "effectiveness"
 #: F4's hand-over on the V-slew: MTSMC until the rotation error is below this angle (deg), then
 #: OfflineRMPC (assumed: inside about 20 deg, where the linear model is taken to hold).
 HANDOVER_DEG = 20.0
+#: F6's MTSMC surface gain (1/s): bandwidth alpha_f/2 = 0.4 rad/s, past Lambda_1/2 = 0.384 rad/s
+#: (paper S's hardest regime); on the V-slew it saturates about a quarter of the samples.
+F6_ALPHA_F = 0.8
 
 def _case(exp: str, tag: str, data: dict[str, Any]) -> SuiteCase:
     return SuiteCase(exp, Scenario.from_dict({"family": "flexible", **data}), tag)
 
 
 def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[SuiteCase]:
-    """The cases of F1-F5 (run lengths multiplied by ``time_scale``).
+    """The cases of F1-F6 (run lengths multiplied by ``time_scale``).
 
     Examples
     --------
     >>> cases = flexible_cases()
     >>> len(cases), sorted({c.experiment for c in cases})
-    (32, ['F1', 'F2', 'F3', 'F4', 'F5'])
+    (33, ['F1', 'F2', 'F3', 'F4', 'F5', 'F6'])
     """
     from models.flexible.scenario import F2_EPSILONS, F3_INTEGRAL_GAINS
 
@@ -117,6 +125,10 @@ def flexible_cases(time_scale: float = 1.0, experiments: Sequence[str] | None = 
     cases: list[SuiteCase] = []
     base = {"time_scale": time_scale}
     for exp in chosen:
+        if exp == "F6":
+            data = {**base, "controller": "MTSMC", "settings": {"alpha_f": F6_ALPHA_F}}
+            cases.append(_case(exp, f"MTSMC_alpha{F6_ALPHA_F:g}", data))
+            continue
         if exp == "F1":
             for ctrl in ("MTSMC", "CSMC"):
                 for avc in (False, True):

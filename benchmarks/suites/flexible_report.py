@@ -20,6 +20,7 @@ import numpy as np
 
 from benchmarks.families.flexible import defaults
 from benchmarks.reports.sections import dash, failed_cases, rows_table, run_lines, settings_section, statuses
+from benchmarks.suites.flexible_claims import flexible_claims_markdown
 
 __all__ = [
     "IPM_REACH_ANGLES",
@@ -165,6 +166,7 @@ def paper_v_comparison(records: list[dict[str, Any]]) -> list[str]:
     lines += ["", "## Inconsistencies, with this run's numbers", ""]
     lines += inconsistencies(records)
     lines.append("")
+    lines += flexible_claims_markdown(records)
     return lines
 
 
@@ -487,7 +489,8 @@ def results_markdown(
     time_scale = info["time_scale"]
     scale = f"time scale {time_scale:g}" + (" (a smoke run, no measurement)" if time_scale < 1 else "")
     lines = [
-        "# Benchmark suite `flexible`: paper V's study on the flexible satellite (F1-F4)",
+        "# Benchmark suite `flexible`: paper V's study on the flexible satellite (F1-F4, F6) and paper S's "
+        "baselines (F5)",
         "",
         *run_lines(info, scale),
         "",

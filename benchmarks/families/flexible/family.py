@@ -159,6 +159,10 @@ def _label(scenario: Any) -> str:
         parts.append(scenario.switch)
     if scenario.controller in ("MTSMC", "CSMC"):
         parts.append(f"eps {scenario.epsilon:g}")
+        gain = "alpha_f" if scenario.controller == "MTSMC" else "lam"
+        value = scenario.settings[gain]
+        if value != defaults.CONTROLLER_DEFAULTS[scenario.controller][gain]:
+            parts.append(f"{gain} {value:g}")
     if scenario.integral_gain > 0.0:
         parts.append(f"k_I {scenario.integral_gain:g}")
     if scenario.handover_deg is not None:
@@ -310,6 +314,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "limiter_in_loop": limiter is not None,
         "mode1_axis": "xyz"[int(np.argmax(np.abs(sat.coupling[0])))],
         "handover_time": _handover_time(built.controller, traj),
+        "first_mode_frequency": float(sat.frequencies[0]) if n else None,
     }
     trace: dict[str, np.ndarray] = {}
     if keep_trace:
@@ -319,6 +324,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
             "u": traj.u_applied[:, :3],
             "v": traj.u_applied[:, 3:],
             "eta": traj.x[:, 7 : 7 + n],
+            "w": traj.x[:, 4:7],
         }
     return CaseResult(extra, metrics, trace)
 

@@ -344,6 +344,9 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
         "faults_used": [repr(f) for f in schedule.faults],
         "wheel_disturbance": disturbance is not None,
         "limits_in_plant": limits,
+        # the plant's wheel limits (what its figure draws; none when the plant applies none)
+        "wheel_torque_max": plant_sat.wheels.torque_max.tolist() if limits else None,
+        "wheel_momentum_max": plant_sat.wheels.momentum_max.tolist() if limits else None,
     }
     if scenario.d_misalignment:
         extra["plant_D"] = plant_sat.wheels.D.tolist()
