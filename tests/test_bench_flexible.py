@@ -90,7 +90,7 @@ def test_suite_cases_cover_the_four_experiments():
     assert (hand.controller, hand.experiment, hand.dt) == ("OfflineRMPC", "vslew", 0.01)
     assert f4["RMPC"].saturation == f4["OfflineRMPC"].saturation == "constraint"
     with pytest.raises(ConfigError, match="--experiments"):
-        flexible_cases(experiments=["F6"])
+        flexible_cases(experiments=["F7"])
 
 
 def _run(**data):
