@@ -4,8 +4,9 @@ Build (warnings are errors)::
 
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
-The build needs no network: intersphinx is deliberately not enabled, and MathJax is only
-loaded by the browser when a page is viewed.
+The build needs no network: intersphinx is deliberately not enabled. Neither do the pages: the
+math is typeset in the browser by MathJax 3 served from ``_static/mathjax/`` (the package
+``sphinx-mathjax-offline``, in the ``docs`` extra, ships it and copies it into every build).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ version = ".".join(release.split(".")[:2])
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax from _static/mathjax/, not from a CDN (sets mathjax_path)
     "sphinx.ext.doctest",
     "numpydoc",
     "status_table",
