@@ -51,6 +51,9 @@ default_role = "literal"  # a single-backtick `x` is code, as in the docstrings'
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 autodoc_preserve_defaults = True
+# Keep the name of numpy's array-like alias in the signatures (``x: ArrayLike``), not its
+# expansion into a union of numpy's private protocols.
+autodoc_type_aliases = {"ArrayLike": "numpy.typing.ArrayLike"}
 
 # -- numpydoc ------------------------------------------------------------------------
 # numpydoc's own member tables duplicate autodoc's :members: and warn about missing stubs.
@@ -92,5 +95,22 @@ def _write_figures(app: object) -> None:
         module.write(out / f"{name}.png")
 
 
+def _alias_names(
+    app: object, what: str, name: str, obj: object, options: object, signature: str | None,
+    return_annotation: str | None,
+) -> tuple[str | None, str | None]:
+    """Show an alias of ``autodoc_type_aliases`` by its name also inside a union or a subscript.
+
+    Sphinx prints ``x: ArrayLike | None`` as ``TypeAliasForwardRef('numpy.typing.ArrayLike') | None``.
+    """
+    import re
+
+    def plain(text: str | None) -> str | None:
+        return None if text is None else re.sub(r"TypeAliasForwardRef\('([\w.]+)'\)", r"\1", text)
+
+    return plain(signature), plain(return_annotation)
+
+
 def setup(app: object) -> None:
     app.connect("builder-inited", _write_figures)  # type: ignore[attr-defined]
+    app.connect("autodoc-process-signature", _alias_names)  # type: ignore[attr-defined]

@@ -26,12 +26,15 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from benchmarks.core.family import BuiltController, check_ellipsoid_count
 from toolkit_common.errors import ConfigError
+
+if TYPE_CHECKING:  # the scenario module imports the families
+    from benchmarks.core.scenario import Scenario
 
 __all__ = [
     "CONSTRAINED",
@@ -120,17 +123,17 @@ class HandOver:
         return u
 
 
-def _with_avc(law: Any, m: FlexibleModel, scenario: Any) -> Any:
+def _with_avc(law: Any, m: FlexibleModel, scenario: Scenario) -> Any:
     from rmpc import FlexibleHybrid, RobustAVC
 
     return FlexibleHybrid(law, RobustAVC(m.satellite, m.dt) if scenario.avc else None)
 
 
-def _limited(scenario: Any) -> bool:
+def _limited(scenario: Scenario) -> bool:
     return scenario.saturation == "limiter"
 
 
-def _mtsmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _mtsmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import MTSMC
 
     law = MTSMC(
@@ -146,7 +149,7 @@ def _mtsmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContro
     return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
 
 
-def _csmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _csmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CSMC
 
     law = CSMC(
@@ -161,7 +164,7 @@ def _csmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControl
     return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
 
 
-def _pd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _pd(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import AttitudePD
 
     law = AttitudePD(
@@ -176,7 +179,7 @@ def linear_weights(settings: Mapping[str, Any], n_modes: int) -> tuple[np.ndarra
     return np.diag(diag), settings["r_weight"] * np.eye(3)
 
 
-def _lqr(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _lqr(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import flexible_lqr
 
     Q, R = linear_weights(s, m.satellite.n_modes)
@@ -221,7 +224,7 @@ def modal_output(n_modes: int, bound: float | None) -> dict[str, Any]:
     return {"output_matrix": c, "y_max": np.full(n_modes, float(bound))}
 
 
-def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"
@@ -239,7 +242,7 @@ def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControl
     return BuiltController(_with_avc(_mapped(ctrl, m, "RMPC"), m, scenario), _limited(scenario))
 
 
-def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _offline(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import MTSMC, OfflineRMPC
 
     constrained = scenario.saturation == "constraint"

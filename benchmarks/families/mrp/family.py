@@ -41,9 +41,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from benchmarks.core.family import (
     CaseResult,
@@ -58,6 +59,9 @@ from benchmarks.core.metrics import step_timing, total_variation_rate
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
 from toolkit_common.errors import ConfigError
+
+if TYPE_CHECKING:  # the scenario module imports the families
+    from benchmarks.core.scenario import Scenario
 
 __all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
 
@@ -86,7 +90,7 @@ def late_window_start(steady_start: float) -> float:
     return min(LATE_WINDOW_START, steady_start)
 
 
-def chattering(t: Any, u: Any, d: Any, start: float) -> dict[str, float | None]:
+def chattering(t: ArrayLike, u: ArrayLike, d: ArrayLike, start: float) -> dict[str, float | None]:
     """The chattering metric of a run: the torque's total variation per second on ``t >= start``.
 
     ``chatter_tv_rate`` is :func:`benchmarks.core.metrics.total_variation_rate` of the applied
@@ -166,14 +170,14 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         check_run_length(length, values["dt"], name("dt"))
 
 
-def _label(scenario: Any) -> str:
+def _label(scenario: Scenario) -> str:
     parts = [scenario.controller, scenario.scenario, scenario.saturation]
     if scenario.inertia_scale is not None:
         parts.append(f"J x{scenario.inertia_scale:g}")
     return " ".join(parts)
 
 
-def paper_scenario(scenario: Any) -> Any:
+def paper_scenario(scenario: Scenario) -> Any:
     """The :class:`models.mrp.scenarios.PaperMScenario` of a case (its length, step, inertia)."""
     from models import paper_m_scenario
 
@@ -185,7 +189,7 @@ def paper_scenario(scenario: Any) -> Any:
     return paper_m_scenario(scenario.scenario, **overrides)
 
 
-def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+def simulate_case(scenario: Scenario, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper M's satellite, the disk, the controller (and the RMPC polytope); run; measure."""
     from models import RigidSatellite, TorqueLimiter
     from models.attitude.mrp import mrp_error_angle
