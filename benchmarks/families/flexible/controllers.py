@@ -26,15 +26,12 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from benchmarks.core.family import BuiltController, check_ellipsoid_count
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = [
     "CONSTRAINED",
@@ -123,17 +120,17 @@ class HandOver:
         return u
 
 
-def _with_avc(law: Any, m: FlexibleModel, scenario: Scenario) -> Any:
+def _with_avc(law: Any, m: FlexibleModel, scenario: Any) -> Any:
     from rmpc import FlexibleHybrid, RobustAVC
 
     return FlexibleHybrid(law, RobustAVC(m.satellite, m.dt) if scenario.avc else None)
 
 
-def _limited(scenario: Scenario) -> bool:
+def _limited(scenario: Any) -> bool:
     return scenario.saturation == "limiter"
 
 
-def _mtsmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _mtsmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import MTSMC
 
     law = MTSMC(
@@ -149,7 +146,7 @@ def _mtsmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltC
     return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
 
 
-def _csmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _csmc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CSMC
 
     law = CSMC(
@@ -164,7 +161,7 @@ def _csmc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltCo
     return BuiltController(_with_avc(law, m, scenario), _limited(scenario))
 
 
-def _pd(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _pd(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import AttitudePD
 
     law = AttitudePD(
@@ -179,7 +176,7 @@ def linear_weights(settings: Mapping[str, Any], n_modes: int) -> tuple[np.ndarra
     return np.diag(diag), settings["r_weight"] * np.eye(3)
 
 
-def _lqr(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _lqr(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import flexible_lqr
 
     Q, R = linear_weights(s, m.satellite.n_modes)
@@ -224,7 +221,7 @@ def modal_output(n_modes: int, bound: float | None) -> dict[str, Any]:
     return {"output_matrix": c, "y_max": np.full(n_modes, float(bound))}
 
 
-def _rmpc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"
@@ -242,7 +239,7 @@ def _rmpc(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltCo
     return BuiltController(_with_avc(_mapped(ctrl, m, "RMPC"), m, scenario), _limited(scenario))
 
 
-def _offline(m: FlexibleModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import MTSMC, OfflineRMPC
 
     constrained = scenario.saturation == "constraint"

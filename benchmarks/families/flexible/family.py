@@ -52,7 +52,7 @@ modal_bound : float or None
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -70,9 +70,6 @@ from benchmarks.core.metrics import step_timing
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import CONSTRAINED, CONTROLLERS, FlexibleModel, settings_check
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["FLEXIBLE", "eta1_frequency", "simulate_case"]
 
@@ -142,13 +139,13 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         check_run_length(length, values["dt"], name("dt"))
 
 
-def controller_name(scenario: Scenario) -> str:
+def controller_name(scenario: Any) -> str:
     """The record name of the closed loop: the controller, ``"+AVC"`` with vibration control."""
     base = scenario.controller if scenario.handover_deg is None else "MTSMC>" + scenario.controller
     return base + ("+AVC" if scenario.avc else "")
 
 
-def _label(scenario: Scenario) -> str:
+def _label(scenario: Any) -> str:
     parts = [controller_name(scenario), scenario.experiment, scenario.saturation]
     if scenario.controller == "CSMC":
         parts.append(scenario.switch)
@@ -166,7 +163,7 @@ def _label(scenario: Scenario) -> str:
     return " ".join(parts)
 
 
-def paper_scenario(scenario: Scenario) -> Any:
+def paper_scenario(scenario: Any) -> Any:
     """The :class:`models.flexible.scenario.VSlewScenario` of a case (its angle, length, step)."""
     from models.flexible.scenario import paper_v_scenario, steady_error_scenario
 
@@ -195,12 +192,7 @@ def _design_state(sat: Any, case: Any) -> np.ndarray:
     return sat.linear_state(sat.state(q))
 
 
-def _bandwidth(
-    scenario: Scenario,
-    settings: Mapping[str, Any],
-    sat: Any,
-    gain: np.ndarray | None,
-) -> float | None:
+def _bandwidth(scenario: Any, settings: Mapping[str, Any], sat: Any, gain: np.ndarray | None) -> float | None:
     """The attitude loop's bandwidth (rad/s) for paper S's regime label (see the defaults)."""
     if scenario.controller == "MTSMC":
         return settings["alpha_f"] / 2.0
@@ -246,7 +238,7 @@ def eta1_frequency(t: np.ndarray, eta1: np.ndarray) -> float | None:
     return float(np.pi * (idx.size - 1) / (tc[-1] - tc[0]))
 
 
-def simulate_case(scenario: Scenario, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build the flexible satellite, the case's run and controller; simulate; measure."""
     import time
 

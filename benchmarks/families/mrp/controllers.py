@@ -11,15 +11,12 @@ and :class:`models.mrp.tracking.RMPCStateMap`; paper M's controllers see the MRP
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from benchmarks.core.family import BuiltController
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "MRPModel", "settings_check"]
 
@@ -34,18 +31,18 @@ class MRPModel:
         self.state_map = state_map
 
 
-def _limit(scenario: Scenario) -> float | None:
+def _limit(scenario: Any) -> float | None:
     return None if scenario.saturation == "none" else scenario.u_max
 
 
-def _bs(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _bs(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CFBackstepping
 
     ctrl = CFBackstepping(m.model, m.target, c1=s["c1"], c2=s["c2"], dt=scenario.dt, u_max=_limit(scenario))
     return BuiltController(ctrl, False)
 
 
-def _mab(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _mab(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import MAB, NESO
 
     observer = NESO.from_bandwidth(m.model.inertia, s["observer_bandwidth"])
@@ -62,7 +59,7 @@ def _mab(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltControll
     return BuiltController(ctrl, False)
 
 
-def _tfab(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _tfab(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import TuningFunctionAB
 
     ctrl = TuningFunctionAB(
@@ -77,7 +74,7 @@ def _mapped(ctrl: Any, m: MRPModel, name: str) -> Any:
     return MappedController(ctrl, measure=m.state_map, name=name)
 
 
-def _rmpc(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"
@@ -93,7 +90,7 @@ def _rmpc(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltControl
     return BuiltController(_mapped(ctrl, m, "RMPC"), scenario.saturation == "limiter")
 
 
-def _crmpc(m: MRPModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CRMPC
     from rmpc.mpc.adaptation import LyapunovRule
 

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -59,9 +59,6 @@ from benchmarks.core.metrics import step_timing, total_variation_rate
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
 
@@ -170,14 +167,14 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         check_run_length(length, values["dt"], name("dt"))
 
 
-def _label(scenario: Scenario) -> str:
+def _label(scenario: Any) -> str:
     parts = [scenario.controller, scenario.scenario, scenario.saturation]
     if scenario.inertia_scale is not None:
         parts.append(f"J x{scenario.inertia_scale:g}")
     return " ".join(parts)
 
 
-def paper_scenario(scenario: Scenario) -> Any:
+def paper_scenario(scenario: Any) -> Any:
     """The :class:`models.mrp.scenarios.PaperMScenario` of a case (its length, step, inertia)."""
     from models import paper_m_scenario
 
@@ -189,7 +186,7 @@ def paper_scenario(scenario: Scenario) -> Any:
     return paper_m_scenario(scenario.scenario, **overrides)
 
 
-def simulate_case(scenario: Scenario, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper M's satellite, the disk, the controller (and the RMPC polytope); run; measure."""
     from models import RigidSatellite, TorqueLimiter
     from models.attitude.mrp import mrp_error_angle

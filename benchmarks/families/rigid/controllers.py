@@ -25,8 +25,7 @@ import numpy as np
 from benchmarks.core.family import BuiltController, check_ellipsoid_count, check_horizon
 from toolkit_common.errors import ConfigError
 
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
+if TYPE_CHECKING:
     from models import PolytopicModel
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "settings_check"]
@@ -36,7 +35,7 @@ def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
     return np.diag(settings["Q_diag"]), np.diag(settings["R_diag"])
 
 
-def _rmpc(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.robust_mpc import RMPC
 
     q, r = _weights(s)
@@ -69,7 +68,7 @@ def _rmpc(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> Bui
 
 def _crmpc_common(
     poly: PolytopicModel,
-    scenario: Scenario,
+    scenario: Any,
     s: Mapping[str, Any],
     adaptation: Any,
 ) -> BuiltController:
@@ -95,14 +94,14 @@ def _crmpc_common(
     return BuiltController(ctrl, limiter)
 
 
-def _crmpc(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.adaptation import LyapunovRule
 
     # the setting adaptation_gain is the Lyapunov rule's gain g
     return _crmpc_common(poly, scenario, s, LyapunovRule(gain=s["adaptation_gain"]))
 
 
-def _crmpc_mit(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc_mit(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.adaptation import MITRule
 
     # the settings mit_gain, normalized, alpha and reset_period are the MIT rule's
@@ -112,7 +111,7 @@ def _crmpc_mit(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -
     return _crmpc_common(poly, scenario, s, rule)
 
 
-def _gipc(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _gipc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.gipc import GIPC
 
     constrained = scenario.saturation == "constraint"
@@ -129,7 +128,7 @@ def _gipc(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> Bui
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _offline(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _offline(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.offline import OfflineRMPC
 
     q, r = _weights(s)
@@ -147,7 +146,7 @@ def _offline(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> 
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _lqr(poly: PolytopicModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _lqr(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.lqr import LQR
 
     q, r = _weights(s)

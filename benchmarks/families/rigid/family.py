@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -68,9 +68,6 @@ from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["RIGID", "initial_attitude"]
 
@@ -156,7 +153,7 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         )
 
 
-def _label(scenario: Scenario) -> str:
+def _label(scenario: Any) -> str:
     parts = [scenario.controller, scenario.plant, scenario.saturation]
     if scenario.disturbance:
         parts.append(f"d={scenario.disturbance:g}")
@@ -169,14 +166,14 @@ def _label(scenario: Scenario) -> str:
     return " ".join(parts)
 
 
-def _draw_inertia(scenario: Scenario, u: np.ndarray) -> dict[str, Any]:
+def _draw_inertia(scenario: Any, u: np.ndarray) -> dict[str, Any]:
     """The true principal inertias ``J0_i (1 + spread u_i)`` (one common ``u`` in scalar mode)."""
     factors = np.full(3, u[0]) if scenario.mode == "scalar" else u
     inertia = [float(j * (1.0 + scenario.spread * f)) for j, f in zip(PAPER_P_INERTIA, factors, strict=True)]
     return {"true_inertia": inertia}
 
 
-def simulate_case(scenario: Scenario, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper P's satellite, the controller's polytope and the controller; simulate; measure."""
     from models import ReactionWheelActuator, RigidSatellite, TorqueLimiter
     from rmpc import StepDisturbance, simulate

@@ -16,15 +16,12 @@ RMPC, CRMPC and GIPC see the attitude and the rates (the first six states) throu
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from benchmarks.core.family import BuiltController, check_horizon
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "WheelModel", "settings_check"]
 
@@ -47,7 +44,7 @@ def _mapped(ctrl: Any, name: str) -> Any:
     return MappedController(ctrl, measure=range(6), name=name)
 
 
-def _abftc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _abftc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import AdaptiveBacksteppingFTC
 
     ctrl = AdaptiveBacksteppingFTC(
@@ -63,7 +60,7 @@ def _abftc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> Built
     return BuiltController(ctrl, False)
 
 
-def _rmpc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import RMPC
 
     q, r = _weights(s)
@@ -80,7 +77,7 @@ def _rmpc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltC
     return BuiltController(_mapped(ctrl, "RMPC"), False)
 
 
-def _crmpc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import CRMPC
     from rmpc.mpc.adaptation import LyapunovRule
 
@@ -101,7 +98,7 @@ def _crmpc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> Built
     return BuiltController(_mapped(ctrl, "CRMPC"), False)
 
 
-def _gipc(model: WheelModel, scenario: Scenario, s: Mapping[str, Any]) -> BuiltController:
+def _gipc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc import GIPC
 
     constrained = scenario.saturation == "constraint"

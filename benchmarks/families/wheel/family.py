@@ -66,7 +66,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -84,9 +84,6 @@ from benchmarks.core.metrics import compute_metrics
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # the scenario module imports the families
-    from benchmarks.core.scenario import Scenario
 
 __all__ = ["WHEEL", "case_faults", "misaligned_axes", "simulate_case"]
 
@@ -204,7 +201,7 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
         raise ConfigError(name("fault_value"), "an effectiveness in [0, 1]", repr(values["fault_value"]))
 
 
-def case_faults(scenario: Scenario) -> list[Any]:
+def case_faults(scenario: Any) -> list[Any]:
     """The faults of a case: the paper scenario's, or the one ``fault_*`` describes, or none."""
     from models import WheelFault
 
@@ -258,7 +255,7 @@ def misaligned_axes(D: Any, angle_deg: float, seed: int) -> np.ndarray:
     return out
 
 
-def _label(scenario: Scenario) -> str:
+def _label(scenario: Any) -> str:
     parts = [scenario.controller, scenario.scenario]
     if scenario.fault_kind != "scenario":
         parts.append(
@@ -288,7 +285,7 @@ def _label(scenario: Scenario) -> str:
     return " ".join(parts)
 
 
-def simulate_case(scenario: Scenario, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
+def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) -> CaseResult:
     """Build paper W's satellite, the faults, the controller's polytope and the controller; run; measure."""
     from benchmarks.families.wheel.metrics import fault_metrics
     from benchmarks.families.wheel.plant import wheel_plant
