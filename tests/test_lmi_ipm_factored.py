@@ -259,3 +259,34 @@ def test_kothare_vertex_blocks_form_one_group():
     solver = prob._backend._solver
     sizes = np.diff(solver._groups[0])
     assert sorted(sizes.tolist())[-1] == 8 and sizes.sum() == len(solver.block_orders)
+
+
+def test_the_qr_switch_comes_later_only_where_the_qr_phase_is_expensive(monkeypatch):
+    """The pivot ratio that ends the Cholesky phase (:meth:`BlockLMISolver.qr_switch`):
+    :data:`~lmi.ipm.solver.QR_SWITCH_LATE` for the 14-state flexible problem (direct path, a QR
+    of ``2 m n^2`` = 2.1e8 operations), :data:`~lmi.ipm.solver.QR_SWITCH` for the 10-state
+    stress problem (direct, a smaller QR) and for a problem of the row path; and the solve hands
+    that value to the iteration kernel."""
+    from lmi.ipm import solver as solver_module
+
+    ipm, x0 = flexible_problem("ipm", {"fallback": False})
+    ipm.solve(x0)
+    big = ipm._backend._solver
+    small_prob = make_problem(10, 2, 3, "feasible", 0, "peak")
+    small = KothareProblem(backend="ipm", solver_options={"fallback": False}, **small_prob.kothare_kwargs())
+    small.solve(small_prob.x)
+    rows = BlockLMISolver([1.0], [(-np.diag([2.0, 1.0]), -np.eye(2)[None])])
+    assert big._direct and small._backend._solver._direct and not rows._direct
+    assert big.qr_switch() == solver_module.QR_SWITCH_LATE < solver_module.QR_SWITCH
+    assert small._backend._solver.qr_switch() == solver_module.QR_SWITCH
+    assert rows.qr_switch() == solver_module.QR_SWITCH
+    seen: list[float] = []
+    kernel = solver_module._kernels.grouped_iteration
+
+    def spy(*args):
+        seen.append(args[-4])  # (..., ref_scale, qr_switch, s_out, z_out, chol_out)
+        return kernel(*args)
+
+    monkeypatch.setattr(solver_module._kernels, "grouped_iteration", spy)
+    assert big.solve().status == "optimal"
+    assert seen and set(seen) == {solver_module.QR_SWITCH_LATE}

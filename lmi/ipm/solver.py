@@ -73,7 +73,8 @@ from toolkit_common.status import Status
 from toolkit_common.validation import as_vector, check_positive
 
 __all__ = [
-    "INFEASIBILITY_RADIUS", "OBJECTIVE_AGREEMENT", "QR_SWITCH", "REDUCED_TOL", "SOLVER_STATUS_MAP",
+    "INFEASIBILITY_RADIUS", "OBJECTIVE_AGREEMENT", "QR_LATE_FLOPS", "QR_SWITCH", "QR_SWITCH_LATE",
+    "REDUCED_TOL", "SOLVER_STATUS_MAP",
     "STALL_WINDOW", "BlockLMISolver", "IPMResult",
 ]
 
@@ -100,6 +101,22 @@ OBJECTIVE_AGREEMENT = REDUCED_TOL
 #: the cost; it does not square ``P``'s condition number). Measured on paper P: 1e-6 gave the
 #: fewest iterations; 1e-7 and below cost 2 more iterations per solve at 2 vertices.
 QR_SWITCH = 1e-6
+
+#: The switch (see :data:`QR_SWITCH`) on large problems of the direct path, where ``H`` is formed
+#: from the factored coefficients and the QR phase must also form ``P``: there a QR iteration
+#: costs many Cholesky iterations (the flexible satellite at 20 states, 487 variables, ``P`` of
+#: 3099 / 8019 rows at 2 / 8 vertices: 77-81 ms against 9-12 ms, 220-238 against 16-18 ms), and
+#: switching later saves more QR iterations than the Cholesky phase adds. Over 5 warm solves
+#: there (thread time): 1e-6 took a median 447 / 1339 ms (4-5 / 5-8 QR iterations), 1e-8 240 /
+#: 691 ms (1-4 / 1-3), gamma the same within 6e-9 relative; 1e-10 gave the iterations of 1e-8
+#: (where the switch then comes, Cholesky breaks down outright).
+QR_SWITCH_LATE = 1e-8
+
+#: The direct path uses :data:`QR_SWITCH_LATE` when the QR of ``P`` (``2 m n^2`` operations for
+#: ``m`` rows and ``n`` variables) costs at least this many: 2.1e8 for the flexible satellite at
+#: 14 states, 1.5e9 at 20; paper P's problems (2.6e6-7.4e6, with or without a peak bound) keep
+#: :data:`QR_SWITCH`, which gave them the fewest iterations.
+QR_LATE_FLOPS = 1e8
 
 #: A run stops as ``"insufficient_progress"`` when none of its measures (relative primal and
 #: dual residuals, gap) has halved over this many iterations. Infeasible problems stall like
@@ -276,6 +293,13 @@ class BlockLMISolver(BlockData):
         self._blas = SingleThreadBlas()
         _load_kernels()
 
+    def qr_switch(self) -> float:
+        """The pivot ratio below which the Newton system goes from Cholesky of ``H`` to the QR of
+        ``P`` for the rest of a solve: :data:`QR_SWITCH_LATE` on the direct path when the QR
+        costs at least :data:`QR_LATE_FLOPS`, :data:`QR_SWITCH` otherwise."""
+        qr_flops = 2.0 * self._layout.size * float(self.n) ** 2
+        return QR_SWITCH_LATE if self._direct and qr_flops >= QR_LATE_FLOPS else QR_SWITCH
+
     def reset_warm_start(self) -> None:
         """Forget the stored warm-start point (the next warm solve starts cold)."""
         self._warm = None
@@ -426,6 +450,7 @@ class BlockLMISolver(BlockData):
         pres = dres = gap = np.inf
         it = 0
         use_qr = False
+        qr_switch = self.qr_switch()
         no_qr = (np.zeros((0, 0)), np.zeros(0))  # no Householder factors (the Cholesky phase)
         best: tuple | None = None
         warm_next: tuple | None = None
@@ -507,11 +532,11 @@ class BlockLMISolver(BlockData):
                 out = _kernels.grouped_iteration(
                     s_chol, z, *packing, *sp, *self._fact, *self._groups, kk, lam, pt_mat, no_pt, h_mat,
                     h_work, r_fac, qr_h, qr_tau, *no_qr, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu,
-                    ref_scale, QR_SWITCH, s_new, z_new, chol_new)
+                    ref_scale, qr_switch, s_new, z_new, chol_new)
             else:
                 out = _kernels.rows_iteration(
                     s_chol, z, *packing, *sp, kk, lam, pt_mat, h_mat, h_work, r_fac, qr_h, qr_tau, *no_qr,
-                    use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, QR_SWITCH, s_new, z_new,
+                    use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_new, z_new,
                     chol_new)
             code, x_new, theta, a_aff, sigma, alpha, use_qr = out
             if debug:
