@@ -4,8 +4,9 @@ Build (warnings are errors)::
 
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
-The build needs no network: intersphinx is deliberately not enabled, and MathJax is only
-loaded by the browser when a page is viewed.
+The build needs no network: intersphinx is deliberately not enabled. Neither do the pages: the
+math is typeset in the browser by MathJax 3 served from ``_static/mathjax/`` (the package
+``sphinx-mathjax-offline``, in the ``docs`` extra, ships it and copies it into every build).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ version = ".".join(release.split(".")[:2])
 extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax from _static/mathjax/, not from a CDN (sets mathjax_path)
     "sphinx.ext.doctest",
     "numpydoc",
     "status_table",
@@ -49,6 +51,9 @@ default_role = "literal"  # a single-backtick `x` is code, as in the docstrings'
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 autodoc_preserve_defaults = True
+# Keep the name of numpy's array-like alias in the signatures (``x: ArrayLike``), not its
+# expansion into a union of numpy's private protocols.
+autodoc_type_aliases = {"ArrayLike": "numpy.typing.ArrayLike"}
 
 # -- numpydoc ------------------------------------------------------------------------
 # numpydoc's own member tables duplicate autodoc's :members: and warn about missing stubs.
@@ -90,5 +95,22 @@ def _write_figures(app: object) -> None:
         module.write(out / f"{name}.png")
 
 
+def _alias_names(
+    app: object, what: str, name: str, obj: object, options: object, signature: str | None,
+    return_annotation: str | None,
+) -> tuple[str | None, str | None]:
+    """Show an alias of ``autodoc_type_aliases`` by its name also inside a union or a subscript.
+
+    Sphinx prints ``x: ArrayLike | None`` as ``TypeAliasForwardRef('numpy.typing.ArrayLike') | None``.
+    """
+    import re
+
+    def plain(text: str | None) -> str | None:
+        return None if text is None else re.sub(r"TypeAliasForwardRef\('([\w.]+)'\)", r"\1", text)
+
+    return plain(signature), plain(return_annotation)
+
+
 def setup(app: object) -> None:
     app.connect("builder-inited", _write_figures)  # type: ignore[attr-defined]
+    app.connect("autodoc-process-signature", _alias_names)  # type: ignore[attr-defined]

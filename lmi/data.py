@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import (
@@ -91,7 +92,7 @@ def _bound_vector(value: Any, name: str, size: int) -> np.ndarray:
     return vec
 
 
-def input_bound_vector(input_constraint: InputConstraint, u_max: Any, m: int) -> np.ndarray:
+def input_bound_vector(input_constraint: InputConstraint, u_max: ArrayLike, m: int) -> np.ndarray:
     """The input bound of a problem as :class:`KothareData` holds it, checked against its kind.
 
     ``(1,)`` for ``"ellipsoid"`` (``u_max`` a scalar), ``(m,)`` for ``"peak"`` (a scalar for
@@ -126,16 +127,16 @@ def input_bound_vector(input_constraint: InputConstraint, u_max: Any, m: int) ->
 
 
 def build_kothare_data(
-    A: Any,
-    B: Any,
-    Q: Any,
-    R: Any,
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
     *,
     dt: float = 1.0,
     input_constraint: InputConstraint = "ellipsoid",
-    u_max: Any = None,
-    output_matrix: Any = None,
-    y_max: Any = None,
+    u_max: ArrayLike | None = None,
+    output_matrix: ArrayLike | None = None,
+    y_max: ArrayLike | None = None,
     formulation: Formulation = "delta_shared",
 ) -> KothareData:
     """Validate the problem data; every error names the argument.

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi.backends.base import KothareBackend, RawResult
 from lmi.backends.clarabel import ClarabelKothare
@@ -155,16 +156,16 @@ class KothareProblem:
 
     def __init__(
         self,
-        A: Any,
-        B: Any,
-        Q: Any,
-        R: Any,
+        A: ArrayLike,
+        B: ArrayLike,
+        Q: ArrayLike,
+        R: ArrayLike,
         *,
         dt: float = 1.0,
         input_constraint: InputConstraint = "ellipsoid",
-        u_max: Any = None,
-        output_matrix: Any = None,
-        y_max: Any = None,
+        u_max: ArrayLike | None = None,
+        output_matrix: ArrayLike | None = None,
+        y_max: ArrayLike | None = None,
         backend: str = "ipm",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
@@ -215,7 +216,7 @@ class KothareProblem:
         coordinates): the next solve gives what a freshly built problem gives."""
         self._backend.reset()
 
-    def solve(self, x: Any, u_max: Any = None) -> LMISolution:
+    def solve(self, x: ArrayLike, u_max: ArrayLike | None = None) -> LMISolution:
         """Solve at the state ``x`` (non-zero); failures come back as a status, never raised.
 
         Parameters
@@ -238,7 +239,7 @@ class KothareProblem:
         raw: RawResult = self._backend.solve(x / scale, data.u_max / scale, data.y_max / scale)
         return self._finish(raw, x, scale, data)
 
-    def input_bound(self, u_max: Any) -> np.ndarray:
+    def input_bound(self, u_max: ArrayLike) -> np.ndarray:
         """``u_max`` checked as an input bound of this problem's kind, as the problem holds it.
 
         The form :meth:`solve` takes for a per-solve bound: a scalar (or a one-element array) for

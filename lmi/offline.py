@@ -31,6 +31,7 @@ from typing import Any
 
 import cvxpy as cp
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi.backends.cvxpy import CvxpyKothare
 from lmi.certificate import Certificate, certify
@@ -204,16 +205,16 @@ class NestedKothareProblem:
 
     def __init__(
         self,
-        A: Any,
-        B: Any,
-        Q: Any,
-        R: Any,
+        A: ArrayLike,
+        B: ArrayLike,
+        Q: ArrayLike,
+        R: ArrayLike,
         *,
         dt: float = 1.0,
         input_constraint: InputConstraint = "ellipsoid",
-        u_max: Any = None,
-        output_matrix: Any = None,
-        y_max: Any = None,
+        u_max: ArrayLike | None = None,
+        output_matrix: ArrayLike | None = None,
+        y_max: ArrayLike | None = None,
         solver: str = "CLARABEL",
         solver_options: dict[str, Any] | None = None,
         formulation: Formulation = "delta_shared",
@@ -244,7 +245,7 @@ class NestedKothareProblem:
         return self._base.name
 
     # -- one design state ----------------------------------------------------------------
-    def solve(self, x: Any, outer: NestedEllipsoid | None = None) -> NestedEllipsoid:
+    def solve(self, x: ArrayLike, outer: NestedEllipsoid | None = None) -> NestedEllipsoid:
         """Solve at ``x`` (non-zero), nested inside ``outer`` when given.
 
         The problem is solved at ``x / ||x||`` with the bounds (and ``Q_outer``) rescaled, as
@@ -327,7 +328,7 @@ class NestedKothareProblem:
             failed_status=None if failed is None else failed.status, skipped=tuple(skipped),
         )
 
-    def design(self, states: Any) -> OfflineTable:
+    def design(self, states: ArrayLike) -> OfflineTable:
         """The nested sequence at the given design states (outermost first).
 
         A state that is not strictly inside the previous ellipsoid (level
@@ -358,7 +359,7 @@ class NestedKothareProblem:
             entries.append(sol)
         return self._table(entries, start, skipped=skipped)
 
-    def design_ray(self, x0: Any, n_ellipsoids: int, shrink: float = 0.5) -> OfflineTable:
+    def design_ray(self, x0: ArrayLike, n_ellipsoids: int, shrink: float = 0.5) -> OfflineTable:
         """Design states geometrically spaced along the ray of ``x0``: ``x_i = shrink^(i-1) x0``."""
         x0 = as_vector(x0, "x0", self.data.n)
         count = check_ellipsoid_count(n_ellipsoids, shrink)
@@ -366,7 +367,13 @@ class NestedKothareProblem:
         return self.design(np.array([x0 * shrink**i for i in range(count)]))
 
     def design_trajectory(
-        self, x0: Any, n_ellipsoids: int, shrink: float = 0.5, *, A: Any = None, B: Any = None,
+        self,
+        x0: ArrayLike,
+        n_ellipsoids: int,
+        shrink: float = 0.5,
+        *,
+        A: ArrayLike | None = None,
+        B: ArrayLike | None = None,
         max_steps: int = 100_000,
     ) -> OfflineTable:
         """Design states along a closed loop: ``x_{i+1}`` is the first state of the loop under

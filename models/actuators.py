@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import (
@@ -104,7 +105,7 @@ class ReactionWheelActuator:
         """The torque delivered during the current sample, ``c xa(k)``."""
         return self.c * self._state
 
-    def step(self, command: Any) -> np.ndarray:
+    def step(self, command: ArrayLike) -> np.ndarray:
         """Return the torque of this sample and advance the wheel states with ``command``."""
         ua = as_vector(command, "command", self.n_axes)
         torque = self.output()
@@ -130,7 +131,7 @@ class TorqueLimiter:
     [1.0, -0.5, -1.0]
     """
 
-    def __init__(self, u_max: Any, kind: Literal["box", "norm"] = "box") -> None:
+    def __init__(self, u_max: ArrayLike, kind: Literal["box", "norm"] = "box") -> None:
         self.kind = check_choice(kind, "kind", ("box", "norm"))
         if np.ndim(u_max) == 0:
             self.u_max: float | np.ndarray = check_positive(u_max, "u_max")
@@ -139,7 +140,7 @@ class TorqueLimiter:
                 raise InvalidArgumentError("u_max", "a scalar for kind='norm'", repr(u_max))
             self.u_max = as_positive_values(u_max, "u_max", None, per="axis", what="limits")
 
-    def __call__(self, u: Any) -> np.ndarray:
+    def __call__(self, u: ArrayLike) -> np.ndarray:
         """Return the clipped torque."""
         u = as_vector(u, "u")
         if self.kind == "box":
@@ -148,7 +149,7 @@ class TorqueLimiter:
         limit = float(self.u_max)
         return u if norm <= limit else u * (limit / norm)
 
-    def is_saturated(self, u: Any, tol: float = 1e-9) -> bool:
+    def is_saturated(self, u: ArrayLike, tol: float = 1e-9) -> bool:
         """Whether ``u`` reaches or exceeds the limit."""
         u = as_vector(u, "u")
         if self.kind == "box":

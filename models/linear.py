@@ -9,15 +9,19 @@ satellite's ``linearize``, ``discretize``, ``linear_model`` and ``polytope``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.linalg import expm
 
 from models.attitude.quaternion import quat_to_euler321
 from models.protocols import map_states
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_choice, check_positive
+
+if TYPE_CHECKING:  # python-control is imported where it is used
+    import control
 
 __all__ = [
     "ATTITUDE_FORMS",
@@ -34,7 +38,7 @@ AttitudeCoordinates = Literal["euler321", "quaternion_vector"]
 ATTITUDE_FORMS: tuple[str, ...] = ("euler321", "quaternion_vector")
 
 
-def operating_point(x_op: Any, size: int, default: Any = None) -> np.ndarray:
+def operating_point(x_op: ArrayLike | None, size: int, default: Any = None) -> np.ndarray:
     """The ``x_op`` argument of a linearisation: ``size`` finite values, or ``default`` for ``None``.
 
     A single number is refused with a message naming ``dt``: ``x_op`` comes first in every
@@ -290,7 +294,7 @@ class PolytopicModel:
         """What the first three states hold: ``"euler321"``, ``"quaternion_vector"`` or ``None``."""
         return self._attitude
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad, 3-2-1) of the attitude in the first three states of ``x``.
 
         Parameters
@@ -336,7 +340,7 @@ class PolytopicModel:
             )
         return self._a[index], self._b[index]
 
-    def combination(self, weights: Any) -> tuple[np.ndarray, np.ndarray]:
+    def combination(self, weights: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Return ``sum_j w_j (A_j, B_j)`` for convex weights ``w`` (non-negative, sum 1)."""
         w = as_vector(weights, "weights", self.n_vertices)
         if np.any(w < -1e-12) or abs(w.sum() - 1.0) > 1e-9:
@@ -346,7 +350,7 @@ class PolytopicModel:
         return np.tensordot(w, self._a, axes=1), np.tensordot(w, self._b, axes=1)
 
     # -- python-control ----------------------------------------------------------------
-    def to_statespace(self, vertex: int | None = None) -> Any:
+    def to_statespace(self, vertex: int | None = None) -> control.StateSpace:
         """Return a python-control ``StateSpace`` (full-state output) of a vertex or the nominal.
 
         Parameters
@@ -364,13 +368,16 @@ class PolytopicModel:
             outputs=[f"y_{s}" for s in self.state_names],
         )
 
-    def to_statespace_list(self) -> list[Any]:
+    def to_statespace_list(self) -> list[control.StateSpace]:
         """Return every vertex as a python-control ``StateSpace``."""
         return [self.to_statespace(j) for j in range(self.n_vertices)]
 
     @classmethod
     def from_statespace(
-        cls, systems: Any, nominal: Any | None = None, attitude: AttitudeCoordinates | None = None
+        cls,
+        systems: control.StateSpace | Sequence[control.StateSpace],
+        nominal: control.StateSpace | None = None,
+        attitude: AttitudeCoordinates | None = None,
     ) -> PolytopicModel:
         """Build a polytope from python-control discrete-time ``StateSpace`` vertices.
 

@@ -25,9 +25,10 @@ True
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector
@@ -67,11 +68,16 @@ class Plant(Protocol):
     state_names: tuple[str, ...]
     input_names: tuple[str, ...]
 
-    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:  # pragma: no cover
+    def dynamics(
+        self,
+        x: ArrayLike,
+        u: ArrayLike | None = None,
+        d: ArrayLike | None = None,
+    ) -> np.ndarray:  # pragma: no cover
         """The state derivative at ``x`` with input ``u`` and disturbance ``d`` (both default zero)."""
         ...
 
-    def attitude_euler(self, x: Any) -> np.ndarray:  # pragma: no cover
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:  # pragma: no cover
         """Roll, pitch and yaw (rad, 3-2-1 sequence) of the attitude held in the state ``x``.
 
         ``x`` is one state ``(n_states,)`` (the result has shape ``(3,)``) or a trajectory of
@@ -100,7 +106,7 @@ class InputStage(Protocol):
         ...
 
 
-def map_states(convert: Callable[[np.ndarray], np.ndarray], x: Any, n_states: int) -> np.ndarray:
+def map_states(convert: Callable[[np.ndarray], np.ndarray], x: ArrayLike, n_states: int) -> np.ndarray:
     """Apply ``convert`` (one state to a vector) to one state or to every row of a trajectory.
 
     The shared body of the plants' :meth:`Plant.attitude_euler`.

@@ -13,8 +13,9 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from rmpc.controller import StepInputs, check_step_inputs
+from rmpc.controller import Controller, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 __all__ = ["MappedController"]
@@ -59,7 +60,7 @@ class MappedController:
 
     def __init__(
         self,
-        controller: Any,
+        controller: Controller,
         measure: Sequence[int] | Callable[[np.ndarray], np.ndarray],
         output: Callable[[np.ndarray], np.ndarray] | None = None,
         name: str | None = None,
@@ -111,7 +112,7 @@ class MappedController:
         if callable(getattr(self.measure, "reset", None)):
             self.measure.reset()
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """``output(controller.step(measure(x), inputs))`` (``inputs`` only when given)."""
         if inputs is not None:
             check_step_inputs(inputs, self.accepts, self.name)

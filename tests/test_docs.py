@@ -126,6 +126,8 @@ def test_docs_build_without_warnings(tmp_path: Path) -> None:
     assert proc.returncode == 0, f"{' '.join(cmd)}\n{proc.stdout[-4000:]}\n{proc.stderr[-8000:]}"
     assert (tmp_path / "html" / "index.html").is_file()
     _check_gallery(tmp_path / "html")
+    _check_offline_math(tmp_path / "html")
+    _check_api_pages(tmp_path / "html")
 
 
 def _check_gallery(html: Path) -> None:
@@ -138,6 +140,66 @@ def _check_gallery(html: Path) -> None:
     assert sorted({name for name, _ in images}) == sorted(e.name for e in PLOTTING)
     for _, png in images:
         assert (html / "_images" / png).stat().st_size > 1000, png
+
+
+_SCRIPT = re.compile(r"<script\b[^>]*\bsrc=\"([^\"]+)\"", re.IGNORECASE)
+
+
+def _check_offline_math(html: Path) -> None:
+    """The pages load no script from the network, and the math is typeset by a local MathJax.
+
+    Every page that holds math loads ``_static/mathjax/tex-chtml.js`` by a relative path that
+    exists in the build, with the web fonts MathJax's CommonHTML output asks for beside it.
+    """
+    math_pages = 0
+    for page in sorted(html.rglob("*.html")):
+        text = page.read_text(encoding="utf-8")
+        sources = _SCRIPT.findall(text)
+        remote = [src for src in sources if re.match(r"(?:https?:)?//", src)]
+        assert not remote, f"{page.relative_to(html)} loads scripts from the network: {remote}"
+        if 'class="math' not in text:
+            continue
+        math_pages += 1
+        mathjax = [src for src in sources if "mathjax" in src.lower()]
+        assert mathjax, f"{page.relative_to(html)} holds math but loads no MathJax"
+        for src in mathjax:
+            script = (page.parent / src.split("?")[0]).resolve()
+            assert script.is_file() and script.stat().st_size > 100_000, f"{page.relative_to(html)}: {src}"
+    assert math_pages, "no page holds math"
+    fonts = html / "_static" / "mathjax" / "output" / "chtml" / "fonts" / "woff-v2"
+    assert any(fonts.glob("MathJax_Main-Regular.woff")), "MathJax's fonts are not in the build"
+
+
+API_PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common")
+
+
+def _check_api_pages(html: Path) -> None:
+    """The API reference: a page per import package, listed by ``api.html``; each module on its page.
+
+    Signatures name ``ArrayLike`` (``autodoc_type_aliases`` in ``docs/conf.py``).
+
+    The objects of a module are documented on the page of the package the module belongs to
+    (``models.wheels.faults`` on ``api/models.html``), read from the inventory of the build.
+    """
+    from sphinx.util.inventory import InventoryFile
+
+    index = (html / "api.html").read_text(encoding="utf-8")
+    for package in API_PACKAGES:
+        assert f'href="api/{package}.html"' in index, f"api.html does not list api/{package}.html"
+        page = (html / "api" / f"{package}.html").read_text(encoding="utf-8")
+        # array arguments read ``ArrayLike``, not numpy's expansion of the alias
+        assert "_SupportsArray" not in page, f"api/{package}.html spells out numpy's ArrayLike"
+        assert "TypeAliasForwardRef" not in page, f"api/{package}.html wraps an alias's name"
+    with (html / "objects.inv").open("rb") as stream:
+        inventory = InventoryFile.load(stream, "", lambda base, uri: uri)
+    modules = inventory["py:module"]
+    assert set(API_PACKAGES) <= set(modules)
+    misplaced = {
+        name: item.uri.split("#")[0]
+        for name, item in modules.items()
+        if item.uri.split("#")[0] != f"api/{name.split('.')[0]}.html"
+    }
+    assert not misplaced, f"modules documented off their package's page: {misplaced}"
 
 
 def test_every_example_is_shown_in_the_docs() -> None:

@@ -25,6 +25,7 @@ from numbers import Real
 from typing import Any, Literal, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
@@ -113,7 +114,7 @@ def as_array(value: Any, name: str) -> np.ndarray:
     return arr
 
 
-def as_vector(value: Any, name: str, size: int | None = None) -> np.ndarray:
+def as_vector(value: ArrayLike, name: str, size: int | None = None) -> np.ndarray:
     """Return ``value`` as a finite 1-D float array, checking its length.
 
     Parameters
@@ -309,7 +310,7 @@ def _positive_values(
 
 
 def as_positive_values(
-    value: Any,
+    value: ArrayLike,
     name: str,
     size: int | None,
     *,
@@ -387,7 +388,7 @@ def as_optional_limits(value: Any, name: str, size: int, *, per: str = "componen
 
 
 def as_square_matrix(
-    value: Any,
+    value: ArrayLike,
     name: str,
     size: int,
     *,

@@ -30,11 +30,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from toolkit_common.errors import ConfigError
+
+if TYPE_CHECKING:  # benchmarks.core.scenario imports this module
+    from benchmarks.core.scenario import Scenario
 
 __all__ = [
     "REQUIRED_FIELDS",
@@ -297,7 +300,7 @@ class PlantFamily:
             return f"'none' or 'limiter' for {controller} (it has no constraint)"
         return None
 
-    def build_controller(self, model: Any, scenario: Any) -> BuiltController:
+    def build_controller(self, model: Any, scenario: Scenario) -> BuiltController:
         """Build the scenario's controller on ``model`` with its effective settings."""
         settings = self.effective_settings(scenario.controller, scenario.settings)
         return self.controllers[scenario.controller].build(model, scenario, settings)

@@ -34,6 +34,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import ArgumentTypeError
 from toolkit_common.status import USABLE_STATUSES, Status
@@ -73,7 +74,7 @@ def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
     return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
 
 
-def iae(t: Any, e: Any) -> float:
+def iae(t: ArrayLike, e: ArrayLike) -> float:
     """Integral of ``|e|`` over ``t`` (trapezoidal rule).
 
     Examples
@@ -84,7 +85,7 @@ def iae(t: Any, e: Any) -> float:
     return _trapezoid(np.abs(np.asarray(e, dtype=float)), np.asarray(t, dtype=float))
 
 
-def ise(t: Any, e: Any) -> float:
+def ise(t: ArrayLike, e: ArrayLike) -> float:
     """Integral of ``e^2`` over ``t`` (trapezoidal rule on the squared samples).
 
     Examples
@@ -96,7 +97,7 @@ def ise(t: Any, e: Any) -> float:
     return _trapezoid(e * e, np.asarray(t, dtype=float))
 
 
-def settle_index(e: Any, limit: float) -> int:
+def settle_index(e: ArrayLike, limit: float) -> int:
     """The first sample index from which ``|e| <= limit`` holds to the end.
 
     ``0`` when ``|e|`` never exceeds ``limit``; ``len(e)`` when even the last sample does (not
@@ -116,7 +117,7 @@ def settle_index(e: Any, limit: float) -> int:
     return 0 if outside.size == 0 else int(outside[-1]) + 1
 
 
-def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
+def settling_time(t: ArrayLike, e: ArrayLike, band: float = 0.02) -> float | None:
     """First time after which ``|e|`` stays within ``band * |e(0)|`` (``None`` if never).
 
     A band relative to the start: the reference is ``|e(0)|``, or ``max |e|`` when
@@ -140,7 +141,7 @@ def settling_time(t: Any, e: Any, band: float = 0.02) -> float | None:
     return None if k == mag.size else float(t[k])
 
 
-def last_time_above(t: Any, e: Any, threshold: float) -> float:
+def last_time_above(t: ArrayLike, e: ArrayLike, threshold: float) -> float:
     """The last sample time at which ``|e|`` exceeds the absolute ``threshold``.
 
     ``0.0`` when it never does; ``inf`` when the last sample still does (not settled within the
@@ -163,7 +164,13 @@ def last_time_above(t: Any, e: Any, threshold: float) -> float:
     return float(np.asarray(t, dtype=float)[k - 1])
 
 
-def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = None) -> dict[str, Any]:
+def recovery(
+    t: ArrayLike,
+    e: ArrayLike,
+    t_on: float,
+    band: float,
+    t_off: float | None = None,
+) -> dict[str, Any]:
     """How a run recovers from an event at ``t_on`` (a disturbance step, a fault).
 
     Parameters
@@ -209,7 +216,7 @@ def recovery(t: Any, e: Any, t_on: float, band: float, t_off: float | None = Non
     }
 
 
-def recovery_time(t: Any, e: Any, t_on: float, band: float) -> float | None:
+def recovery_time(t: ArrayLike, e: ArrayLike, t_on: float, band: float) -> float | None:
     """Time from ``t_on`` after which ``|e|`` stays within the absolute ``band`` until the last sample.
 
     ``t`` and ``e`` are the samples of the window after the event; ``0.0`` when ``|e|`` never
@@ -258,7 +265,7 @@ def step_timing(traj: Any) -> dict[str, Any]:
     }
 
 
-def total_variation_rate(u: Any, length: float) -> float:
+def total_variation_rate(u: ArrayLike, length: float) -> float:
     """Total variation of a sampled signal per second: ``(1/L) sum_k ||u_(k+1) - u_k||_1``.
 
     The chattering measure of the suites: a torque that switches sign from sample to sample
@@ -285,7 +292,7 @@ def total_variation_rate(u: Any, length: float) -> float:
     return float(np.sum(np.abs(np.diff(arr, axis=0)))) / length if length > 0 else 0.0
 
 
-def overshoot(e: Any) -> float | None:
+def overshoot(e: ArrayLike) -> float | None:
     """Largest excursion past zero, opposite to ``e(0)``, in % of ``|e(0)|`` (``None`` if ``e(0) = 0``).
 
     Examples

@@ -39,9 +39,8 @@ True
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import SINGULARITY_COS_TOL
 from models.attitude.vectors import cross3, skew
@@ -105,11 +104,11 @@ def _error(s: np.ndarray, sr: np.ndarray) -> np.ndarray:
     return _switch(se)
 
 
-def _sigma(sigma: Any, name: str = "sigma") -> np.ndarray:
+def _sigma(sigma: ArrayLike, name: str = "sigma") -> np.ndarray:
     return as_vector(sigma, name, 3)
 
 
-def mrp_to_dcm(sigma: Any) -> np.ndarray:
+def mrp_to_dcm(sigma: ArrayLike) -> np.ndarray:
     """The direction cosine matrix ``C(sigma)``: frame-O components to body (B) components.
 
     Parameters
@@ -133,7 +132,7 @@ def mrp_to_dcm(sigma: Any) -> np.ndarray:
     return _dcm(_sigma(sigma))
 
 
-def mrp_kinematics_matrix(sigma: Any) -> np.ndarray:
+def mrp_kinematics_matrix(sigma: ArrayLike) -> np.ndarray:
     """``N(sigma) = ((1 - s's) I + 2 [sigma x] + 2 sigma sigma') / 4``, with ``sigma' = N(sigma) w``.
 
     ``w`` is the rate of B relative to O in B components. ``N' N = ((1 + s's) / 4)^2 I``, so ``N``
@@ -142,13 +141,13 @@ def mrp_kinematics_matrix(sigma: Any) -> np.ndarray:
     return _kinematics(_sigma(sigma))
 
 
-def mrp_kinematics_inverse(sigma: Any) -> np.ndarray:
+def mrp_kinematics_inverse(sigma: ArrayLike) -> np.ndarray:
     """``N(sigma)^-1 = (4 / (1 + s's))^2 N(sigma)'``: the rate that gives ``sigma'``."""
     s = _sigma(sigma)
     return (4.0 / (1.0 + float(s @ s))) ** 2 * _kinematics(s).T
 
 
-def mrp_shadow(sigma: Any) -> np.ndarray:
+def mrp_shadow(sigma: ArrayLike) -> np.ndarray:
     """The shadow set ``-sigma / (sigma' sigma)``, the other MRP of the same attitude.
 
     Raises
@@ -174,7 +173,7 @@ def mrp_shadow(sigma: Any) -> np.ndarray:
     return -s / ss
 
 
-def mrp_switch(sigma: Any, threshold: float = 1.0) -> np.ndarray:
+def mrp_switch(sigma: ArrayLike, threshold: float = 1.0) -> np.ndarray:
     """``sigma`` or its shadow: the shadow when ``sigma' sigma > threshold``.
 
     The attitude (:func:`mrp_to_dcm`) is the same either way. With ``threshold = 1`` the result
@@ -187,7 +186,7 @@ def mrp_switch(sigma: Any, threshold: float = 1.0) -> np.ndarray:
     return _switch(_sigma(sigma), thr)
 
 
-def mrp_error(sigma: Any, sigma_ref: Any) -> np.ndarray:
+def mrp_error(sigma: ArrayLike, sigma_ref: ArrayLike) -> np.ndarray:
     """The attitude error ``se`` of B relative to a reference frame R, both given relative to O.
 
     ``se = [(1 - |sr|^2) s - (1 - |s|^2) sr + 2 s x sr] / [1 + |sr|^2 |s|^2 + 2 sr's]``
@@ -206,7 +205,7 @@ def mrp_error(sigma: Any, sigma_ref: Any) -> np.ndarray:
     return _error(_sigma(sigma), _sigma(sigma_ref, "sigma_ref"))
 
 
-def mrp_angle(sigma: Any) -> np.ndarray | float:
+def mrp_angle(sigma: ArrayLike) -> np.ndarray | float:
     """The principal rotation angle ``4 atan(|sigma|)`` (rad) of an MRP, or of each row.
 
     For a short set (``|sigma| <= 1``) it lies in ``[0, pi]``. Accepts shape ``(3,)`` (returns a
@@ -221,12 +220,12 @@ def mrp_angle(sigma: Any) -> np.ndarray | float:
     return float(angle) if arr.ndim == 1 else angle
 
 
-def mrp_error_angle(sigma: Any, sigma_ref: Any) -> float:
+def mrp_error_angle(sigma: ArrayLike, sigma_ref: ArrayLike) -> float:
     """The error angle ``Phi_e = 4 atan|se|`` (rad, in ``[0, pi]``), ``se = mrp_error(sigma, sigma_ref)``."""
     return 4.0 * float(np.arctan(np.linalg.norm(mrp_error(sigma, sigma_ref))))
 
 
-def mrp_to_quaternion(sigma: Any) -> np.ndarray:
+def mrp_to_quaternion(sigma: ArrayLike) -> np.ndarray:
     """The unit quaternion ``(q_v, q_4)`` (scalar last) of an MRP: ``q_v = 2 s/(1 + s's)``,
     ``q_4 = (1 - s's)/(1 + s's)``."""
     s = _sigma(sigma)
@@ -234,7 +233,7 @@ def mrp_to_quaternion(sigma: Any) -> np.ndarray:
     return np.concatenate((2.0 * s, [1.0 - ss])) / (1.0 + ss)
 
 
-def mrp_from_quaternion(q: Any) -> np.ndarray:
+def mrp_from_quaternion(q: ArrayLike) -> np.ndarray:
     """The short MRP ``q_v / (1 + q_4)`` of a unit quaternion (scalar last; either sign of ``q``).
 
     Raises
@@ -252,7 +251,7 @@ def mrp_from_quaternion(q: Any) -> np.ndarray:
     return q[:3] / (1.0 + q[3])
 
 
-def mrp_from_dcm(dcm: Any) -> np.ndarray:
+def mrp_from_dcm(dcm: ArrayLike) -> np.ndarray:
     """The short MRP of a rotation matrix (O components to B components), via Shepperd's method.
 
     Raises
@@ -299,7 +298,7 @@ def mrp_from_dcm(dcm: Any) -> np.ndarray:
     return q[:3] / (1.0 + q[3])
 
 
-def dcm_from_euler321(angles: Any) -> np.ndarray:
+def dcm_from_euler321(angles: ArrayLike) -> np.ndarray:
     """``C = R1(roll) R2(pitch) R3(yaw)`` for 3-2-1 Euler angles ``(roll, pitch, yaw)`` in rad.
 
     The frame-O-to-body matrix; :func:`models.attitude.euler.rotation_matrix` is its transpose.
@@ -330,7 +329,7 @@ def _euler(c: np.ndarray) -> np.ndarray:
     return np.array([np.arctan2(c[1, 2], c[2, 2]), np.arctan2(sin_p, cos_p), np.arctan2(c[0, 1], c[0, 0])])
 
 
-def euler321_from_dcm(dcm: Any) -> np.ndarray:
+def euler321_from_dcm(dcm: ArrayLike) -> np.ndarray:
     """3-2-1 Euler angles ``(roll, pitch, yaw)`` (rad) of ``C = R1(roll) R2(pitch) R3(yaw)``.
 
     Pitch lies in ``[-pi/2, pi/2]``, roll and yaw in ``(-pi, pi]``.
@@ -344,6 +343,6 @@ def euler321_from_dcm(dcm: Any) -> np.ndarray:
     return _euler(as_matrix(dcm, "dcm", (3, 3)))
 
 
-def mrp_from_euler321(angles: Any) -> np.ndarray:
+def mrp_from_euler321(angles: ArrayLike) -> np.ndarray:
     """The short MRP of the attitude with 3-2-1 Euler angles ``(roll, pitch, yaw)`` (rad)."""
     return mrp_from_dcm(dcm_from_euler321(angles))

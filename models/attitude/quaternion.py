@@ -22,9 +22,8 @@ Examples
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import euler321_from_matrix
 from models.attitude.vectors import skew
@@ -49,12 +48,12 @@ __all__ = [
 UNIT_NORM_TOL = 1e-6
 
 
-def unit_quaternion(q: Any, name: str) -> np.ndarray:
+def unit_quaternion(q: ArrayLike, name: str) -> np.ndarray:
     """``q`` checked to be a unit quaternion (norm within :data:`UNIT_NORM_TOL` of 1), normalised."""
     return _unit(q, name)
 
 
-def _unit(q: Any, name: str) -> np.ndarray:
+def _unit(q: ArrayLike, name: str) -> np.ndarray:
     vec = as_vector(q, name, 4)
     norm = float(np.linalg.norm(vec))
     if abs(norm - 1.0) > UNIT_NORM_TOL:
@@ -62,7 +61,7 @@ def _unit(q: Any, name: str) -> np.ndarray:
     return vec / norm
 
 
-def quat_multiply(p: Any, q: Any) -> np.ndarray:
+def quat_multiply(p: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Hamilton product ``p * q`` (scalar first): the rotation ``q`` followed by ``p`` in body terms.
 
     Examples
@@ -78,13 +77,13 @@ def quat_multiply(p: Any, q: Any) -> np.ndarray:
     return np.concatenate(([p0 * q0 - pv @ qv], p0 * qv + q0 * pv + np.cross(pv, qv)))
 
 
-def quat_conjugate(q: Any) -> np.ndarray:
+def quat_conjugate(q: ArrayLike) -> np.ndarray:
     """``[q0, -q_v]``: the inverse rotation of a unit quaternion."""
     q = as_vector(q, "q", 4)
     return np.concatenate(([q[0]], -q[1:]))
 
 
-def quat_from_axis_angle(axis: Any, angle: float) -> np.ndarray:
+def quat_from_axis_angle(axis: ArrayLike, angle: float) -> np.ndarray:
     """The rotation by ``angle`` (rad) about ``axis`` (normalised here; must be non-zero)."""
     e = as_vector(axis, "axis", 3)
     norm = float(np.linalg.norm(e))
@@ -94,21 +93,21 @@ def quat_from_axis_angle(axis: Any, angle: float) -> np.ndarray:
     return np.concatenate(([np.cos(half)], np.sin(half) * e / norm))
 
 
-def quat_to_dcm(q: Any) -> np.ndarray:
+def quat_to_dcm(q: ArrayLike) -> np.ndarray:
     """``R(q) = (q0^2 - q_v'q_v) I + 2 q_v q_v' + 2 q0 [q_v x]`` (body to inertial components)."""
     q = as_vector(q, "q", 4)
     q0, qv = q[0], q[1:]
     return (q0 * q0 - qv @ qv) * np.eye(3) + 2.0 * np.outer(qv, qv) + 2.0 * q0 * skew(qv)
 
 
-def quat_kinematics_matrix(q: Any) -> np.ndarray:
+def quat_kinematics_matrix(q: ArrayLike) -> np.ndarray:
     """The ``4 x 3`` matrix ``E(q)`` with ``q' = E(q) w``: rows ``-q_v'/2`` and ``(q0 I + [q_v x])/2``."""
     q = as_vector(q, "q", 4)
     q0, qv = q[0], q[1:]
     return 0.5 * np.vstack((-qv, q0 * np.eye(3) + skew(qv)))
 
 
-def quat_error(q: Any, q_ref: Any = None) -> np.ndarray:
+def quat_error(q: ArrayLike, q_ref: ArrayLike | None = None) -> np.ndarray:
     """The attitude of the body relative to the reference, ``q_ref^-1 * q``, with ``q0 >= 0``.
 
     ``q_ref`` defaults to the identity ``[1, 0, 0, 0]``. Its vector part ``q_v`` is what the
@@ -123,7 +122,7 @@ def quat_error(q: Any, q_ref: Any = None) -> np.ndarray:
     return err if err[0] >= 0.0 else -err
 
 
-def rotation_angle(q: Any, q_ref: Any = None) -> float:
+def rotation_angle(q: ArrayLike, q_ref: ArrayLike | None = None) -> float:
     """The rotation angle (rad, in ``[0, pi]``) between ``q`` and ``q_ref`` (default identity).
 
     Computed as ``2 atan2(||q_v||, |q0|)``, accurate near zero where ``2 acos(q0)`` is not.
@@ -132,7 +131,7 @@ def rotation_angle(q: Any, q_ref: Any = None) -> float:
     return 2.0 * float(np.arctan2(np.linalg.norm(err[1:]), abs(err[0])))
 
 
-def euler321_to_quat(attitude: Any) -> np.ndarray:
+def euler321_to_quat(attitude: ArrayLike) -> np.ndarray:
     """The quaternion of 3-2-1 Euler angles ``[phi, theta, psi]`` (``R = Rz(psi) Ry(theta) Rx(phi)``)."""
     phi, theta, psi = as_vector(attitude, "attitude", 3) * 0.5
     cx, sx = np.cos(phi), np.sin(phi)
@@ -147,7 +146,7 @@ def euler321_to_quat(attitude: Any) -> np.ndarray:
     return q if q[0] >= 0.0 else -q
 
 
-def quat_to_euler321(q: Any) -> np.ndarray:
+def quat_to_euler321(q: ArrayLike) -> np.ndarray:
     """3-2-1 Euler angles ``[phi, theta, psi]`` (rad) of a unit quaternion.
 
     ``theta`` is in ``[-pi/2, pi/2]``, ``phi`` and ``psi`` in ``(-pi, pi]``. At gimbal lock

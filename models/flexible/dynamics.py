@@ -15,9 +15,8 @@ input split.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.vectors import cross3
 from models.flexible.parameters import HybridParameters
@@ -27,7 +26,11 @@ from toolkit_common.validation import as_vector
 __all__ = ["hybrid_rhs", "split_inputs"]
 
 
-def split_inputs(p: HybridParameters, u: Any, d: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def split_inputs(
+    p: HybridParameters,
+    u: ArrayLike,
+    d: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(hub torque incl. the hub disturbance, v, d_f)`` from the checked ``u`` and ``d``.
 
     ``u`` holds 3 hub torques, optionally followed by the ``n_a`` PZT commands (zero when left

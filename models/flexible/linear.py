@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import kinematics_matrix
 from models.attitude.vectors import skew
@@ -135,7 +136,7 @@ def linear_state_names(state_names: tuple[str, ...], attitude: AttitudeForm = "e
 
 def linearize(
     p: HybridParameters,
-    x_op: Any = None,
+    x_op: ArrayLike | None = None,
     *,
     pzt: bool = False,
     attitude: AttitudeForm = "euler",

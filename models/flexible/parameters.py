@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_array, as_matrix, check_pd
@@ -113,13 +114,13 @@ def _modal(value: Any, name: str, shape: tuple[int, int | None] | tuple[int]) ->
 
 
 def hybrid_parameters(
-    inertia: Any,
-    frequencies: Any,
-    damping: Any,
-    coupling: Any,
+    inertia: ArrayLike,
+    frequencies: ArrayLike,
+    damping: ArrayLike,
+    coupling: ArrayLike,
     *,
-    modal_mass: Any = None,
-    pzt_matrix: Any = None,
+    modal_mass: ArrayLike | None = None,
+    pzt_matrix: ArrayLike | None = None,
 ) -> HybridParameters:
     """Check the parameters of :class:`models.FlexibleSatellite` and derive the model's matrices.
 

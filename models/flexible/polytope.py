@@ -36,6 +36,7 @@ import itertools
 from typing import Any, Literal, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.flexible.linear import POLYTOPIC_ATTITUDE, AttitudeForm, ParameterPoint
 from models.linear import PolytopicModel, sample_time, zoh
@@ -94,7 +95,7 @@ class FlexibleLinearisation(Protocol):
     ) -> tuple[str, ...]: ...  # pragma: no cover
 
     def linearize(
-        self, x_op: Any = None, *, pzt: bool = False, attitude: AttitudeForm = "euler",
+        self, x_op: ArrayLike | None = None, *, pzt: bool = False, attitude: AttitudeForm = "euler",
         parameters: ParameterPoint | None = None,
     ) -> tuple[np.ndarray, np.ndarray]: ...  # pragma: no cover
 
@@ -111,10 +112,10 @@ def _interval(value: Any, name: str) -> tuple[float, float]:
 def vertex_parameters(
     sat: FlexibleLinearisation,
     mode: PolytopeMode = "groups",
-    inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
-    frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
-    damping_range: Any = DEFAULT_DAMPING_RANGE,
-    effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
+    inverse_inertia_range: ArrayLike = DEFAULT_INVERSE_INERTIA_RANGE,
+    frequency_range: ArrayLike = DEFAULT_FREQUENCY_RANGE,
+    damping_range: ArrayLike = DEFAULT_DAMPING_RANGE,
+    effectiveness_range: ArrayLike = DEFAULT_EFFECTIVENESS_RANGE,
 ) -> list[ParameterPoint]:
     """The parameter points at the corners of the uncertainty box, in vertex order.
 
@@ -149,14 +150,14 @@ def vertex_parameters(
 
 def flexible_polytope(
     sat: FlexibleLinearisation,
-    x_op: Any = None,
+    x_op: ArrayLike | None = None,
     dt: float | None = None,
     *,
     mode: PolytopeMode = "groups",
-    inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
-    frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
-    damping_range: Any = DEFAULT_DAMPING_RANGE,
-    effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
+    inverse_inertia_range: ArrayLike = DEFAULT_INVERSE_INERTIA_RANGE,
+    frequency_range: ArrayLike = DEFAULT_FREQUENCY_RANGE,
+    damping_range: ArrayLike = DEFAULT_DAMPING_RANGE,
+    effectiveness_range: ArrayLike = DEFAULT_EFFECTIVENESS_RANGE,
     attitude: AttitudeForm = "euler",
     pzt: bool = False,
 ) -> PolytopicModel:

@@ -29,9 +29,9 @@ public face.)
 
 from __future__ import annotations
 
-from typing import Any
-
+import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.actuators import TorqueLimiter
 from models.attitude.quaternion import quat_error, quat_to_dcm, quat_to_euler321, unit_quaternion
@@ -125,13 +125,13 @@ class FlexibleSatellite:
 
     def __init__(
         self,
-        inertia: Any,
-        frequencies: Any,
-        damping: Any,
-        coupling: Any,
+        inertia: ArrayLike,
+        frequencies: ArrayLike,
+        damping: ArrayLike,
+        coupling: ArrayLike,
         *,
-        modal_mass: Any = None,
-        pzt_matrix: Any = None,
+        modal_mass: ArrayLike | None = None,
+        pzt_matrix: ArrayLike | None = None,
         panel_disturbance: bool = False,
     ) -> None:
         self._p = hybrid_parameters(
@@ -171,7 +171,7 @@ class FlexibleSatellite:
             panel_disturbance=self._panel_disturbance,
         )
 
-    def input_limiter(self, u_max: Any = 2.0, v_max: Any = None) -> TorqueLimiter:
+    def input_limiter(self, u_max: ArrayLike = 2.0, v_max: ArrayLike | None = None) -> TorqueLimiter:
         """The saturation of the input ``[u; v]``: hub torques per axis, PZT commands optional.
 
         Paper V bounds the hub torque (**certain** that a bound exists, value lost); the
@@ -296,7 +296,11 @@ class FlexibleSatellite:
 
     # -- states ---------------------------------------------------------------------------
     def state(
-        self, attitude: Any = None, rates: Any = None, modal: Any = None, modal_rates: Any = None
+        self,
+        attitude: ArrayLike | None = None,
+        rates: ArrayLike | None = None,
+        modal: ArrayLike | None = None,
+        modal_rates: ArrayLike | None = None,
     ) -> np.ndarray:
         """Assemble a state ``[q, w, eta, eta']``; every part defaults to zero (``q`` to identity).
 
@@ -309,7 +313,7 @@ class FlexibleSatellite:
         eta_dot = np.zeros(n) if modal_rates is None else as_vector(modal_rates, "modal_rates", n)
         return np.concatenate((q, w, eta, eta_dot))
 
-    def split_state(self, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def split_state(self, x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(q, w, eta, eta')`` of a state."""
         x = as_vector(x, "x", self.n_states)
         n = self.n_modes
@@ -333,7 +337,7 @@ class FlexibleSatellite:
         out[:4] /= np.linalg.norm(out[:4])
         return out
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the inertial frame.
 
         The angles of the state's quaternion (``quat_to_euler321``, after rescaling it to unit
@@ -350,7 +354,12 @@ class FlexibleSatellite:
         """
         return map_states(lambda s: quat_to_euler321(s[:4] / np.linalg.norm(s[:4])), x, self.n_states)
 
-    def linear_state(self, x: Any, q_ref: Any = None, attitude: AttitudeForm = "quaternion") -> np.ndarray:
+    def linear_state(
+        self,
+        x: ArrayLike,
+        q_ref: ArrayLike | None = None,
+        attitude: AttitudeForm = "quaternion",
+    ) -> np.ndarray:
         """Map a nonlinear state to the ``6 + 2N`` linear state about the reference ``q_ref``.
 
         The attitude is the error quaternion ``q_ref^-1 * q`` (with ``q0 >= 0``): its vector part
@@ -363,7 +372,7 @@ class FlexibleSatellite:
         return np.concatenate((att, w, eta, eta_dot))
 
     # -- nonlinear model (models.flexible.dynamics, models.flexible.energy) ------------------
-    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
+    def dynamics(self, x: ArrayLike, u: ArrayLike | None = None, d: ArrayLike | None = None) -> np.ndarray:
         """``x'`` of the nonlinear model (solved form; :mod:`models.flexible.dynamics`).
 
         Parameters
@@ -384,27 +393,27 @@ class FlexibleSatellite:
             )
         return hybrid_rhs(self._p, x, *split_inputs(self._p, u, d))
 
-    def angular_momentum(self, x: Any) -> np.ndarray:
+    def angular_momentum(self, x: ArrayLike) -> np.ndarray:
         """Total angular momentum in body components, ``h = J w + delta' eta'`` (N m s)."""
         _, w, _, eta_dot = self.split_state(x)
         return _energy.angular_momentum(self._p, w, eta_dot)
 
-    def angular_momentum_inertial(self, x: Any) -> np.ndarray:
+    def angular_momentum_inertial(self, x: ArrayLike) -> np.ndarray:
         """``R(q) (J w + delta' eta')``: constant without external torques (PZT forces are internal)."""
         q = self.split_state(x)[0]
         return quat_to_dcm(q / np.linalg.norm(q)) @ self.angular_momentum(x)
 
-    def energy(self, x: Any) -> float:
+    def energy(self, x: ArrayLike) -> float:
         """``E = w'J w/2 + w' delta' eta' + eta'' M eta'/2 + eta' K eta/2`` (J): kinetic plus strain."""
         _, w, eta, eta_dot = self.split_state(x)
         return _energy.energy(self._p, w, eta, eta_dot)
 
-    def energy_rate(self, x: Any, u: Any = None, d: Any = None) -> float:
+    def energy_rate(self, x: ArrayLike, u: ArrayLike | None = None, d: ArrayLike | None = None) -> float:
         """``E' = w'(u + d) + eta''(Gamma_a v + d_f) - eta'' C eta'`` (W), the power balance."""
         _, w, _, eta_dot = self.split_state(x)
         return _energy.energy_rate(self._p, w, eta_dot, *split_inputs(self._p, u, d))
 
-    def modal_energy(self, x: Any) -> float:
+    def modal_energy(self, x: ArrayLike) -> float:
         """Energy of the modes alone, ``eta'' M eta'/2 + eta' K eta/2`` (J)."""
         _, _, eta, eta_dot = self.split_state(x)
         return _energy.modal_energy(self._p, eta, eta_dot)
@@ -412,7 +421,7 @@ class FlexibleSatellite:
     # -- linear model (models.flexible.linear, models.flexible.polytope) -----------------------
     def linearize(
         self,
-        x_op: Any = None,
+        x_op: ArrayLike | None = None,
         *,
         pzt: bool = False,
         attitude: AttitudeForm = "euler",
@@ -448,7 +457,7 @@ class FlexibleSatellite:
         return _linear.linearize(self._p, x_op, pzt=pzt, attitude=attitude, parameters=parameters)
 
     def discretize(
-        self, x_op: Any = None, dt: float | None = None, *, pzt: bool = False,
+        self, x_op: ArrayLike | None = None, dt: float | None = None, *, pzt: bool = False,
         attitude: AttitudeForm = "euler",
     ) -> tuple[np.ndarray, np.ndarray]:
         """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
@@ -456,7 +465,7 @@ class FlexibleSatellite:
         return zoh(a, b, sample_time(dt))
 
     def linear_model(
-        self, x_op: Any = None, dt: float | None = None, *, pzt: bool = False,
+        self, x_op: ArrayLike | None = None, dt: float | None = None, *, pzt: bool = False,
         attitude: AttitudeForm = "euler",
     ) -> PolytopicModel:
         """:meth:`discretize` as a one-vertex :class:`PolytopicModel`.
@@ -471,14 +480,14 @@ class FlexibleSatellite:
     @renamed_arguments(**RENAMED_RANGES)
     def polytope(
         self,
-        x_op: Any = None,
+        x_op: ArrayLike | None = None,
         dt: float | None = None,
         *,
         mode: PolytopeMode = "groups",
-        inverse_inertia_range: Any = DEFAULT_INVERSE_INERTIA_RANGE,
-        frequency_range: Any = DEFAULT_FREQUENCY_RANGE,
-        damping_range: Any = DEFAULT_DAMPING_RANGE,
-        effectiveness_range: Any = DEFAULT_EFFECTIVENESS_RANGE,
+        inverse_inertia_range: ArrayLike = DEFAULT_INVERSE_INERTIA_RANGE,
+        frequency_range: ArrayLike = DEFAULT_FREQUENCY_RANGE,
+        damping_range: ArrayLike = DEFAULT_DAMPING_RANGE,
+        effectiveness_range: ArrayLike = DEFAULT_EFFECTIVENESS_RANGE,
         attitude: AttitudeForm = "euler",
         pzt: bool = False,
     ) -> PolytopicModel:
@@ -528,7 +537,7 @@ class FlexibleSatellite:
         )
 
     # -- single axis, regime (models.flexible.single_axis) --------------------------------------
-    def single_axis_tf(self, axis: int = 0, *, cancel_uncoupled: bool = True) -> Any:
+    def single_axis_tf(self, axis: int = 0, *, cancel_uncoupled: bool = True) -> control.TransferFunction:
         """The python-control ``TransferFunction`` ``theta_a / u_a`` about body axis ``axis``.
 
         The other axes are locked; zeros are the constrained modes (``Lambda_i``, ``xi_i``),

@@ -18,10 +18,9 @@ appendage frequency (:func:`regime`).
 
 from __future__ import annotations
 
-from typing import Any
-
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.flexible.parameters import HybridParameters
 from toolkit_common.errors import InvalidArgumentError
@@ -77,7 +76,10 @@ def single_axis_polynomials(
 
 
 def flexible_factor(
-    constrained: Any, unconstrained: Any, zeta_constrained: Any, zeta_unconstrained: Any
+    constrained: ArrayLike,
+    unconstrained: ArrayLike,
+    zeta_constrained: ArrayLike,
+    zeta_unconstrained: ArrayLike,
 ) -> control.TransferFunction:
     """Paper S's flexible factor ``G_pf = prod ((s/w_c)^2 + 2 zeta_c s/w_c + 1) / prod (... w_u ...)``.
 

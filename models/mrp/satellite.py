@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import euler321_from_matrix
 from models.attitude.mrp import _dcm, _kinematics
@@ -92,7 +93,7 @@ class MRPSatellite:
 
     def __init__(
         self,
-        inertia: Any,
+        inertia: ArrayLike,
         altitude: float = PAPER_M_ALTITUDE,
         *,
         gravity_gradient: bool = False,
@@ -134,7 +135,7 @@ class MRPSatellite:
         """
         return cls(PAPER_M_INERTIA, PAPER_M_ALTITUDE, **options)
 
-    def with_inertia(self, inertia: Any) -> MRPSatellite:
+    def with_inertia(self, inertia: ArrayLike) -> MRPSatellite:
         """The same orbit and options with another inertia (the true plant of paper M's M3)."""
         return MRPSatellite(
             inertia, self.altitude, gravity_gradient=self.gravity_gradient,
@@ -165,7 +166,7 @@ class MRPSatellite:
         )
 
     # -- model ---------------------------------------------------------------------------
-    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
+    def dynamics(self, x: ArrayLike, u: ArrayLike | None = None, d: ArrayLike | None = None) -> np.ndarray:
         """``x'`` for the state ``x = [sigma, w]``, control torque ``u`` and external torque ``d``.
 
         ``sigma' = N(sigma) (w + n c2(sigma))``,
@@ -189,7 +190,7 @@ class MRPSatellite:
             total = total + 3.0 * self.mean_motion**2 * cross3(c3, self._inertia @ c3)
         return np.concatenate((_kinematics(s) @ w_bo, self._inertia_inv @ total))
 
-    def normalize_state(self, x: Any) -> np.ndarray:
+    def normalize_state(self, x: ArrayLike) -> np.ndarray:
         """The shadow-set switch: ``sigma := -sigma / sigma' sigma`` when ``sigma' sigma > threshold``.
 
         :class:`rmpc.sim.plants.SampledPlant` applies it after every integration step. The
@@ -202,7 +203,7 @@ class MRPSatellite:
             return x
         return np.concatenate((-s / ss, x[3:]))
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the **orbital (LVLH) frame O**.
 
         The angles of ``C(sigma)`` (:func:`models.attitude.mrp.mrp_to_dcm`, O to body
@@ -222,18 +223,18 @@ class MRPSatellite:
         """
         return map_states(lambda s: euler321_from_matrix(_dcm(s[:3]).T), x, self.n_states)
 
-    def relative_rate(self, x: Any) -> np.ndarray:
+    def relative_rate(self, x: ArrayLike) -> np.ndarray:
         """``w_BO = w + n c2(sigma)``: the body rate relative to the orbital frame (B components)."""
         x = as_vector(x, "x", 6)
         return x[3:6] + self.mean_motion * _dcm(x[:3])[:, 1]
 
-    def state_at_rest(self, sigma: Any, relative_rate: Any = None) -> np.ndarray:
+    def state_at_rest(self, sigma: ArrayLike, relative_rate: ArrayLike | None = None) -> np.ndarray:
         """The state ``[sigma, w]`` with the given rate relative to O (default 0: ``w = -n c2``)."""
         s = as_vector(sigma, "sigma", 3)
         w_bo = np.zeros(3) if relative_rate is None else as_vector(relative_rate, "relative_rate", 3)
         return np.concatenate((s, w_bo - self.mean_motion * _dcm(s)[:, 1]))
 
-    def gravity_gradient_torque(self, sigma: Any) -> np.ndarray:
+    def gravity_gradient_torque(self, sigma: ArrayLike) -> np.ndarray:
         """``T_g = 3 n^2 c3 x (J c3)`` (N m), whether or not the model includes it.
 
         Equal to ``3 mu / |R|^5  R x (J R)`` with ``R = -|R| c3`` the position of the satellite
@@ -242,7 +243,7 @@ class MRPSatellite:
         c3 = _dcm(as_vector(sigma, "sigma", 3))[:, 2]
         return 3.0 * self.mean_motion**2 * cross3(c3, self._inertia @ c3)
 
-    def kinetic_energy(self, x: Any) -> float:
+    def kinetic_energy(self, x: ArrayLike) -> float:
         """Rotational kinetic energy ``w' J w / 2`` (J), with ``w`` relative to inertial space."""
         w = as_vector(x, "x", 6)[3:6]
         return 0.5 * float(w @ self._inertia @ w)

@@ -25,6 +25,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.vectors import cross3
 from toolkit_common.errors import InvalidArgumentError
@@ -114,7 +115,7 @@ class SpinningDisk:
         speed_amplitude: float = PAPER_M_DISK["speed_amplitude"],
         speed_frequency: float = PAPER_M_DISK["speed_frequency"],
         phase: float = 0.0,
-        offset: Any = None,
+        offset: ArrayLike | None = None,
     ) -> None:
         self.mass = check_positive(mass, "mass")
         self.radius = check_positive(radius, "radius")
@@ -183,7 +184,7 @@ class SpinningDisk:
         return self.speed(t) * (self._jb @ self._axis)
 
     # -- torque ------------------------------------------------------------------------------
-    def torque_at_rate(self, t: float, w: Any) -> np.ndarray:
+    def torque_at_rate(self, t: float, w: ArrayLike) -> np.ndarray:
         """``Td = -(w x (Jb wb a) + Jb wb' a)`` for the body rate ``w`` (rad/s, inertial)."""
         w = as_vector(w, "w", 3)
         return self._torque(t, w)
@@ -192,7 +193,7 @@ class SpinningDisk:
         jb_a = self._jb @ self._axis
         return -(self.speed(t) * cross3(w, jb_a) + self.acceleration(t) * jb_a)
 
-    def torque(self, t: float, x: Any) -> np.ndarray:
+    def torque(self, t: float, x: ArrayLike) -> np.ndarray:
         """The true torque on the bus in the state ``x`` (body rate ``x[3:6]``), N m."""
         x = np.asarray(x, dtype=float)
         if x.ndim != 1 or x.shape[0] < 6:
@@ -200,7 +201,7 @@ class SpinningDisk:
             raise InvalidArgumentError("x", expected, f"shape {x.shape}")
         return self._torque(float(t), x[3:6])
 
-    def __call__(self, t: float, x: Any) -> np.ndarray:
+    def __call__(self, t: float, x: ArrayLike) -> np.ndarray:
         return self.torque(t, x)
 
     def breakpoints(self) -> tuple[float, ...]:

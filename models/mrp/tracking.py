@@ -12,9 +12,9 @@ plant state ``x = [sigma, w]`` of :class:`models.MRPSatellite` into
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 # the unchecked kernels of the MRP maths: the public wrappers check what these skip
 from models.attitude.mrp import _dcm, _error, _euler, _kinematics, _sigma
@@ -23,7 +23,7 @@ from toolkit_common.validation import as_vector, check_positive
 __all__ = ["MRPTrackingError", "RMPCStateMap", "rmpc_state", "tracking_error"]
 
 
-def rmpc_state(x: Any, sigma_ref: Any, mean_motion: float) -> np.ndarray:
+def rmpc_state(x: ArrayLike, sigma_ref: ArrayLike, mean_motion: float) -> np.ndarray:
     """The robust-MPC state ``X = [roll_e, pitch_e, yaw_e, w_BO]`` of an MRP state.
 
     Parameters
@@ -97,12 +97,12 @@ class RMPCStateMap:
     True
     """
 
-    def __init__(self, sigma_ref: Any, mean_motion: float) -> None:
+    def __init__(self, sigma_ref: ArrayLike, mean_motion: float) -> None:
         self.sigma_ref = _sigma(sigma_ref, "sigma_ref").copy()
         self.sigma_ref.setflags(write=False)
         self.mean_motion = check_positive(mean_motion, "mean_motion", allow_zero=True)
 
-    def __call__(self, x: Any) -> np.ndarray:
+    def __call__(self, x: ArrayLike) -> np.ndarray:
         return _rmpc_state(as_vector(x, "x", 6), self.sigma_ref, self.mean_motion)
 
     def __repr__(self) -> str:
@@ -131,7 +131,7 @@ class MRPTrackingError:
     relative_rate: np.ndarray
 
 
-def tracking_error(x: Any, sigma_ref: Any, mean_motion: float) -> MRPTrackingError:
+def tracking_error(x: ArrayLike, sigma_ref: ArrayLike, mean_motion: float) -> MRPTrackingError:
     """``se``, ``N(se)``, ``c2(sigma)`` and ``w_BO`` for the state ``x = [sigma, w]`` and a target.
 
     Paper M's reference is constant and relative to O (**likely**), so ``se' = N(se) w_BO``.

@@ -11,9 +11,10 @@ input ``u = [Mx, My, Mz]`` (control torques, N m) and an optional disturbance to
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import (
     SINGULARITY_COS_TOL,
@@ -27,6 +28,9 @@ from models.linear import PolytopicModel, operating_point, relative_spread, samp
 from models.protocols import map_states
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_inertia, as_vector, check_choice, check_real
+
+if TYPE_CHECKING:  # python-control is imported where it is used
+    import control
 
 __all__ = [
     "INPUT_NAMES",
@@ -89,7 +93,7 @@ class RigidSatellite:
     state_names = STATE_NAMES
     input_names = INPUT_NAMES
 
-    def __init__(self, inertia: Any) -> None:
+    def __init__(self, inertia: ArrayLike) -> None:
         self._inertia = as_inertia(inertia)
         self._inertia.setflags(write=False)
         self._inertia_inv = np.linalg.inv(self._inertia)
@@ -129,12 +133,12 @@ class RigidSatellite:
         return f"RigidSatellite(inertia={j.tolist()})"
 
     # -- nonlinear model ---------------------------------------------------------------
-    def _inputs(self, u: Any, d: Any) -> tuple[np.ndarray, np.ndarray]:
+    def _inputs(self, u: ArrayLike, d: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         u_vec = np.zeros(3) if u is None else as_vector(u, "u", 3)
         d_vec = np.zeros(3) if d is None else as_vector(d, "d", 3)
         return u_vec, d_vec
 
-    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
+    def dynamics(self, x: ArrayLike, u: ArrayLike | None = None, d: ArrayLike | None = None) -> np.ndarray:
         """Return ``x'`` for the state ``x``, control torque ``u`` and disturbance torque ``d``.
 
         Raises :class:`~toolkit_common.errors.SingularityError` at pitch = +-90 deg.
@@ -159,25 +163,29 @@ class RigidSatellite:
         w_dot = self._inertia_inv @ (torque - np.cross(w, jw))
         return np.concatenate((kinematics_matrix(x[0], x[1]) @ w, w_dot))
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad, 3-2-1) of the body relative to the inertial frame: ``x[:3]``.
 
         ``x`` is one state ``(6,)`` or states as rows ``(k, 6)``; see :class:`models.protocols.Plant`.
         """
         return map_states(lambda s: s[:3].copy(), x, self.n_states)
 
-    def kinetic_energy(self, x: Any) -> float:
+    def kinetic_energy(self, x: ArrayLike) -> float:
         """Rotational kinetic energy ``w' J w / 2`` (J)."""
         w = as_vector(x, "x", 6)[3:]
         return 0.5 * float(w @ self._inertia @ w)
 
-    def angular_momentum_inertial(self, x: Any) -> np.ndarray:
+    def angular_momentum_inertial(self, x: ArrayLike) -> np.ndarray:
         """Angular momentum in the inertial frame, ``R(phi, theta, psi) J w`` (N m s)."""
         x = as_vector(x, "x", 6)
         return rotation_matrix(x[:3]) @ (self._inertia @ x[3:])
 
     # -- linearisation -----------------------------------------------------------------
-    def linearize(self, x_op: Any = None, u_op: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def linearize(
+        self,
+        x_op: ArrayLike | None = None,
+        u_op: ArrayLike | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Continuous-time Jacobians ``(A, B)`` of the nonlinear model at ``(x_op, u_op)``.
 
         ``x_op`` (6 values) defaults to the rest state at zero attitude, ``np.zeros(6)``.
@@ -205,13 +213,13 @@ class RigidSatellite:
         return a, b
 
     def discretize(
-        self, x_op: Any = None, dt: float | None = None, u_op: Any = None
+        self, x_op: ArrayLike | None = None, dt: float | None = None, u_op: ArrayLike | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
         """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
         a, b = self.linearize(x_op, u_op)
         return zoh(a, b, sample_time(dt))
 
-    def linear_model(self, x_op: Any = None, dt: float | None = None) -> PolytopicModel:
+    def linear_model(self, x_op: ArrayLike | None = None, dt: float | None = None) -> PolytopicModel:
         """The discretised linearisation as a one-vertex :class:`PolytopicModel` (Euler attitude)."""
         ad, bd = self.discretize(x_op, dt)
         return PolytopicModel(
@@ -255,11 +263,11 @@ class RigidSatellite:
 
     def polytope(
         self,
-        x_op: Any = None,
+        x_op: ArrayLike | None = None,
         dt: float | None = None,
         spread: float | None = None,
         mode: PolytopeMode = "scalar",
-        attitude_range: Any = None,
+        attitude_range: ArrayLike | None = None,
     ) -> PolytopicModel:
         """The discrete-time polytope of linearisations over the inertia uncertainty.
 
@@ -330,7 +338,7 @@ class RigidSatellite:
         )
 
     def _covering_polytope(
-        self, x_op: np.ndarray, dt: float, spread: float, mode: PolytopeMode, attitude_range: Any
+        self, x_op: np.ndarray, dt: float, spread: float, mode: PolytopeMode, attitude_range: ArrayLike
     ) -> PolytopicModel:
         half = as_vector(attitude_range, "attitude_range", 3)
         if np.any(half < 0.0):
@@ -371,7 +379,7 @@ class RigidSatellite:
         )
 
     # -- python-control ----------------------------------------------------------------
-    def to_nlsys(self, with_disturbance: bool = False) -> Any:
+    def to_nlsys(self, with_disturbance: bool = False) -> control.NonlinearIOSystem:
         """The nonlinear model as a python-control ``NonlinearIOSystem`` (full-state output).
 
         Inputs are ``[Mx, My, Mz]``, followed by ``[dx, dy, dz]`` with ``with_disturbance``.

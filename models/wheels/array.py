@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_positive_values, as_vector, check_count
@@ -87,10 +88,10 @@ class WheelArray:
 
     def __init__(
         self,
-        D: Any,
-        torque_max: Any = PAPER_W_TORQUE_MAX,
-        momentum_max: Any = PAPER_W_MOMENTUM_MAX,
-        wheel_inertia: Any = PAPER_W_WHEEL_INERTIA,
+        D: ArrayLike,
+        torque_max: ArrayLike = PAPER_W_TORQUE_MAX,
+        momentum_max: ArrayLike = PAPER_W_MOMENTUM_MAX,
+        wheel_inertia: ArrayLike = PAPER_W_WHEEL_INERTIA,
     ) -> None:
         d = as_matrix(D, "D", (3, None))
         norms = np.linalg.norm(d, axis=0)
@@ -165,7 +166,7 @@ class WheelArray:
         return np.abs(self._d) @ self._momentum_max
 
     # -- redundancy ------------------------------------------------------------------------
-    def _effectiveness(self, effectiveness: Any) -> np.ndarray:
+    def _effectiveness(self, effectiveness: ArrayLike) -> np.ndarray:
         lam = as_vector(effectiveness, "effectiveness", self.n_wheels)
         if np.any((lam < 0.0) | (lam > 1.0)):
             raise InvalidArgumentError(
@@ -173,16 +174,16 @@ class WheelArray:
             )
         return lam
 
-    def effective_matrix(self, effectiveness: Any) -> np.ndarray:
+    def effective_matrix(self, effectiveness: ArrayLike) -> np.ndarray:
         """``D Lambda`` for the per-wheel effectiveness ``lambda_j`` in [0, 1]."""
         return self._d * self._effectiveness(effectiveness)
 
-    def rank(self, effectiveness: Any = None) -> int:
+    def rank(self, effectiveness: ArrayLike | None = None) -> int:
         """``rank(D Lambda)`` (default: all wheels healthy)."""
         lam = np.ones(self.n_wheels) if effectiveness is None else self._effectiveness(effectiveness)
         return _rank(self._d * lam)
 
-    def spans_three_axes(self, effectiveness: Any = None) -> bool:
+    def spans_three_axes(self, effectiveness: ArrayLike | None = None) -> bool:
         """Whether ``rank(D Lambda) = 3`` (paper W's redundancy condition, eq. 17)."""
         return self.rank(effectiveness) == 3
 

@@ -32,6 +32,7 @@ from itertools import pairwise
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.wheels.array import MAX_WHEELS, WheelArray, _rank, _wheel_count
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
@@ -313,7 +314,7 @@ class FaultSchedule:
                 b[f.wheel - 1] = f.additive_at(t)
         return b
 
-    def apply(self, t: float, u: Any) -> np.ndarray:
+    def apply(self, t: float, u: ArrayLike) -> np.ndarray:
         """``lambda(t) u + b(t)``: the wheels' torques for the commands ``u`` (before limits)."""
         u = np.asarray(u, dtype=float)
         if not self.faults:

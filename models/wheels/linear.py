@@ -19,9 +19,8 @@ cover the continuous-time set, and their discretisations approximate the discret
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.linear import PolytopicModel, operating_point, relative_spread, sample_time, zoh
 from models.wheels.array import WheelArray, _rank
@@ -40,7 +39,7 @@ __all__ = [
 LINEAR_STATE_NAMES: tuple[str, ...] = ("phi", "theta", "psi", "p", "q", "r")
 
 
-def level_operating_point(x_op: Any) -> np.ndarray:
+def level_operating_point(x_op: ArrayLike) -> np.ndarray:
     """``x_op`` (6 values ``[phi, theta, psi, p, q, r]``, default zero) checked to be level and at rest.
 
     The model is linearised at the level attitude with zero rates (any yaw: yaw enters neither
@@ -61,8 +60,8 @@ def linearize(
     wheels: WheelArray,
     inertia_inv: np.ndarray,
     gravity_stiffness: np.ndarray,
-    x_op: Any = None,
-    effectiveness: Any = None,
+    x_op: ArrayLike | None = None,
+    effectiveness: ArrayLike | None = None,
     inertia_scale: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Continuous ``(A, B)`` with ``J^-1 = inertia_inv``, ``K_g = gravity_stiffness``.
@@ -84,7 +83,7 @@ def linearize(
 
 
 def effectiveness_vertices(
-    n_wheels: int, effectiveness: Any = "single_outage", lambda_min: float = 0.2
+    n_wheels: int, effectiveness: ArrayLike = "single_outage", lambda_min: float = 0.2
 ) -> np.ndarray:
     """The wheel-effectiveness vertices; see :meth:`models.WheelSatellite.effectiveness_vertices`."""
     m = n_wheels
@@ -114,9 +113,9 @@ def wheel_polytope(
     wheels: WheelArray,
     inertia_inv: np.ndarray,
     gravity_stiffness: np.ndarray,
-    x_op: Any = None,
+    x_op: ArrayLike | None = None,
     dt: float | None = None,
-    effectiveness: Any = "single_outage",
+    effectiveness: ArrayLike = "single_outage",
     lambda_min: float = 0.2,
     spread: float | None = None,
 ) -> PolytopicModel:

@@ -10,6 +10,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.wheels.array import MAX_WHEELS, _wheel_count
 from toolkit_common.errors import ArgumentTypeError
@@ -143,7 +144,7 @@ class AttitudeNoiseSensor:
     (True, True)
     """
 
-    def __init__(self, sigma: Any = ANGLE_NOISE_SIGMA, seed: int | None = 0) -> None:
+    def __init__(self, sigma: ArrayLike = ANGLE_NOISE_SIGMA, seed: int | None = 0) -> None:
         self.sigma = as_positive_values(
             sigma, "sigma", 3, allow_zero=True, per="axis", what="standard deviations"
         )
@@ -154,7 +155,7 @@ class AttitudeNoiseSensor:
         """Re-seed the generator."""
         self._rng = np.random.default_rng(self.seed)
 
-    def __call__(self, t: float, x: Any) -> np.ndarray:
+    def __call__(self, t: float, x: ArrayLike) -> np.ndarray:
         """The measurement of the true state ``x`` at time ``t``."""
         y = np.array(x, dtype=float)
         y[:3] = y[:3] + self._rng.normal(0.0, 1.0, 3) * self.sigma

@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.euler import kinematics_matrix, rotation_matrix
 from models.attitude.vectors import skew
@@ -128,14 +129,14 @@ class WheelSatellite:
 
     def __init__(
         self,
-        inertia: Any,
+        inertia: ArrayLike,
         wheels: WheelArray,
-        imbalance: Any = PAPER_W_IMBALANCE,
+        imbalance: ArrayLike = PAPER_W_IMBALANCE,
         gravity: GravityMode = "pendulous",
         *,
         wheel_gyroscopic: bool = False,
-        viscous_friction: Any = 0.0,
-        coulomb_friction: Any = 0.0,
+        viscous_friction: ArrayLike = 0.0,
+        coulomb_friction: ArrayLike = 0.0,
     ) -> None:
         self._inertia = as_inertia(inertia)
         if not isinstance(wheels, WheelArray):
@@ -249,7 +250,7 @@ class WheelSatellite:
         """``g2 = J^-1 D`` (3 x m, read-only): the rate equation's input matrix (paper W's ``g2``)."""
         return self._g2
 
-    def nominal_gain(self, effectiveness: Any = None) -> np.ndarray:
+    def nominal_gain(self, effectiveness: ArrayLike | None = None) -> np.ndarray:
         """Paper W's ``G = (g2 Lambda g2')^-1`` (3 x 3); all wheels healthy by default (``G_nom``).
 
         Raises :class:`~toolkit_common.errors.InvalidArgumentError` naming ``effectiveness`` when
@@ -273,7 +274,12 @@ class WheelSatellite:
             f"imbalance={self._imbalance.tolist()}, wheel_gyroscopic={self._gyroscopic})"
         )
 
-    def state(self, attitude: Any, rates: Any = None, momenta: Any = None) -> np.ndarray:
+    def state(
+        self,
+        attitude: ArrayLike,
+        rates: ArrayLike | None = None,
+        momenta: ArrayLike | None = None,
+    ) -> np.ndarray:
         """The full state from the attitude (rad), rates (default 0) and wheel momenta (default 0)."""
         att = as_vector(attitude, "attitude", 3)
         w = np.zeros(3) if rates is None else as_vector(rates, "rates", 3)
@@ -281,18 +287,18 @@ class WheelSatellite:
         return np.concatenate((att, w, h))
 
     # -- nonlinear model -------------------------------------------------------------------
-    def gravity_torque(self, attitude: Any) -> np.ndarray:
+    def gravity_torque(self, attitude: ArrayLike) -> np.ndarray:
         """``d_g(eta) = s m g (r x k(eta))`` in body axes (N m); yaw does not enter."""
         att = np.asarray(attitude, dtype=float)
         # + 0.0 turns the -0.0 of a zero component into 0.0
         return self._sign * np.cross(self._imbalance, gravity_direction(att[0], att[1])) + 0.0
 
-    def friction_torque(self, momenta: Any) -> np.ndarray:
+    def friction_torque(self, momenta: ArrayLike) -> np.ndarray:
         """Bearing friction ``f_j`` on each wheel (N m), zero unless friction is switched on."""
         omega = np.asarray(momenta, dtype=float) / self._wheels.wheel_inertia
         return -self._viscous * omega - self._coulomb * np.sign(omega)
 
-    def dynamics(self, x: Any, u: Any = None, d: Any = None) -> np.ndarray:
+    def dynamics(self, x: ArrayLike, u: ArrayLike | None = None, d: ArrayLike | None = None) -> np.ndarray:
         """``x'`` for the state ``x``, applied wheel torques ``u`` (m) and body torque ``d`` (3).
 
         Raises :class:`~toolkit_common.errors.SingularityError` at pitch = +-90 deg.
@@ -312,7 +318,7 @@ class WheelSatellite:
         eta_dot = kinematics_matrix(x[0], x[1]) @ w
         return np.concatenate((eta_dot, self._inertia_inv @ torque, -wheel_torque))
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad, 3-2-1) of the platform relative to the level frame: ``x[:3]``.
 
         The level frame is the reference of the state's Euler angles (z down along gravity).
@@ -320,12 +326,12 @@ class WheelSatellite:
         """
         return map_states(lambda s: s[:3].copy(), x, self.n_states)
 
-    def angular_momentum_body(self, x: Any) -> np.ndarray:
+    def angular_momentum_body(self, x: ArrayLike) -> np.ndarray:
         """Total angular momentum in body axes, ``J w + D h`` (N m s)."""
         x = as_vector(x, "x", self.n_states)
         return self._inertia @ x[3:6] + self._wheels.D @ x[6:]
 
-    def angular_momentum_inertial(self, x: Any) -> np.ndarray:
+    def angular_momentum_inertial(self, x: ArrayLike) -> np.ndarray:
         """Total angular momentum in the inertial frame, ``R(eta) (J w + D h)`` (N m s)."""
         x = as_vector(x, "x", self.n_states)
         return rotation_matrix(x[:3]) @ self.angular_momentum_body(x)
@@ -337,7 +343,10 @@ class WheelSatellite:
         return -self._sign * skew(self._imbalance) @ dk
 
     def linearize(
-        self, x_op: Any = None, effectiveness: Any = None, inertia_scale: float = 1.0
+        self,
+        x_op: ArrayLike | None = None,
+        effectiveness: ArrayLike | None = None,
+        inertia_scale: float = 1.0,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Continuous ``(A, B)`` of the attitude and rates at level attitude, zero rates and momenta.
 
@@ -354,14 +363,22 @@ class WheelSatellite:
         )
 
     def discretize(
-        self, x_op: Any = None, dt: float | None = None, effectiveness: Any = None, inertia_scale: float = 1.0
+        self,
+        x_op: ArrayLike | None = None,
+        dt: float | None = None,
+        effectiveness: ArrayLike | None = None,
+        inertia_scale: float = 1.0,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Zero-order-hold discretisation of :meth:`linearize` at sample time ``dt`` (required)."""
         a, b = self.linearize(x_op, effectiveness, inertia_scale)
         return zoh(a, b, sample_time(dt))
 
     def linear_model(
-        self, x_op: Any = None, dt: float | None = None, effectiveness: Any = None, inertia_scale: float = 1.0
+        self,
+        x_op: ArrayLike | None = None,
+        dt: float | None = None,
+        effectiveness: ArrayLike | None = None,
+        inertia_scale: float = 1.0,
     ) -> PolytopicModel:
         """:meth:`discretize` as a one-vertex :class:`PolytopicModel` (Euler attitude, ``m`` wheel inputs)."""
         ad, bd = self.discretize(x_op, dt, effectiveness, inertia_scale)
@@ -371,7 +388,7 @@ class WheelSatellite:
         )
 
     def effectiveness_vertices(
-        self, effectiveness: Any = "single_outage", lambda_min: float = 0.2
+        self, effectiveness: ArrayLike = "single_outage", lambda_min: float = 0.2
     ) -> np.ndarray:
         """The wheel-effectiveness vertices ``lambda`` (one row per vertex, ``(k, m)``).
 
@@ -390,9 +407,9 @@ class WheelSatellite:
     @renamed_arguments(inertia_spread="spread")
     def polytope(
         self,
-        x_op: Any = None,
+        x_op: ArrayLike | None = None,
         dt: float | None = None,
-        effectiveness: Any = "single_outage",
+        effectiveness: ArrayLike = "single_outage",
         *,
         lambda_min: float = 0.2,
         spread: float | None = None,

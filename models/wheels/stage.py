@@ -24,6 +24,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.wheels.array import WheelArray
 from models.wheels.faults import FaultSchedule, WheelFault, _as_schedule
@@ -118,7 +119,7 @@ class WheelInputStage:
             )
         return h
 
-    def faulty_torque(self, t: float, u_cmd: Any) -> np.ndarray:
+    def faulty_torque(self, t: float, u_cmd: ArrayLike) -> np.ndarray:
         """Stages 1-2: the torques the wheels would give without limits."""
         u = np.asarray(u_cmd, dtype=float)
         if self.wheel_disturbance is not None:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from rmpc.sim.rhs import model_dynamics, plant_derivative
@@ -68,7 +69,7 @@ class ContinuousTimeController:
     accepts: ClassVar[frozenset[str]] = frozenset()
     n_internal = 0
 
-    def __init__(self, dt: float, u_max: Any, n_states: int = 6) -> None:
+    def __init__(self, dt: float, u_max: ArrayLike | None, n_states: int = 6) -> None:
         self.dt = check_positive(dt, "dt")
         self.u_max = as_optional_limits(u_max, "u_max", 3, per="axis")
         self.n_states = n_states
@@ -76,7 +77,7 @@ class ContinuousTimeController:
         self.last: StepInfo | None = None
 
     # -- to implement ------------------------------------------------------------------------
-    def initial_internal(self, x: Any) -> np.ndarray:  # pragma: no cover - abstract
+    def initial_internal(self, x: ArrayLike) -> np.ndarray:  # pragma: no cover - abstract
         """The internal state at the first sample, given the measured state."""
         raise NotImplementedError
 
@@ -104,19 +105,19 @@ class ContinuousTimeController:
     def _clip(self, u0: np.ndarray) -> np.ndarray:
         return u0 if self.u_max is None else np.clip(u0, -self.u_max, self.u_max)
 
-    def _checked(self, x: Any, z: Any) -> tuple[np.ndarray, np.ndarray]:
+    def _checked(self, x: ArrayLike, z: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         return as_vector(x, "x", self.n_states), as_vector(z, "z", self.n_internal)
 
-    def evaluate(self, x: Any, z: Any) -> LawOutput:
+    def evaluate(self, x: ArrayLike, z: ArrayLike) -> LawOutput:
         """The law at ``(x, z)`` with its details (pure)."""
         x, z = self._checked(x, z)
         return self._evaluate(x, z, self._geometry(x))
 
-    def law(self, x: Any, z: Any) -> np.ndarray:
+    def law(self, x: ArrayLike, z: ArrayLike) -> np.ndarray:
         """The applied torque ``u = law(x, z)`` (pure; clipped to ``u_max``)."""
         return self.evaluate(x, z).u
 
-    def internal_derivative(self, x: Any, z: Any, u: Any) -> np.ndarray:
+    def internal_derivative(self, x: ArrayLike, z: ArrayLike, u: ArrayLike) -> np.ndarray:
         """``z'`` for the measured state ``x``, internal state ``z`` and applied torque ``u`` (pure)."""
         x, z = self._checked(x, z)
         return self._derivative(x, z, as_vector(u, "u", 3), self._geometry(x))
@@ -158,7 +159,7 @@ class ContinuousTimeController:
         self._z = None
         self.last = None
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``u_k`` for the measured ``x_k``, then advance the internal state by ``dt``.
 
         The advance is one classical RK4 step of :meth:`internal_derivative` with ``x_k`` and

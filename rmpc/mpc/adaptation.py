@@ -37,9 +37,10 @@ from __future__ import annotations
 import copy
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any, ClassVar, Self
+from typing import ClassVar, Self
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi import LMISolution
 from rmpc.mpc.mras import ParameterIntegrator, SensitivityFilter
@@ -115,7 +116,7 @@ class AdaptationRule(ABC):
 
     _estimate: ParameterIntegrator | None = None
 
-    def bind(self, a: Any, b: Any, dt: float, bound: Any = None) -> Self:
+    def bind(self, a: ArrayLike, b: ArrayLike, dt: float, bound: ArrayLike | None = None) -> Self:
         """A copy of this rule bound to a nominal model ``z(k+1) = A z(k) + B u(k)``.
 
         Parameters
@@ -244,7 +245,7 @@ class LyapunovRule(AdaptationRule):
     def __init__(self, gain: float = DEFAULT_GAIN_LYAPUNOV) -> None:
         self.gain = check_positive(gain, "gain", allow_zero=True)
 
-    def rate(self, error: Any, b_delta: Any, p_mat: Any) -> np.ndarray:
+    def rate(self, error: ArrayLike, b_delta: ArrayLike, p_mat: ArrayLike) -> np.ndarray:
         """``dtheta/dt = g (B' P B)^-1 B' P e`` for the error, input matrix and Lyapunov matrix.
 
         Parameters
@@ -357,8 +358,8 @@ class MITRule(AdaptationRule):
         normalized: bool = True,
         alpha: float = DEFAULT_ALPHA,
         reset_period: float | None = DEFAULT_RESET_PERIOD,
-        reference_gain: Any = None,
-        error_output: Any = None,
+        reference_gain: ArrayLike | None = None,
+        error_output: ArrayLike | None = None,
     ) -> None:
         self.normalized = check_bool(normalized, "normalized")
         self.alpha = check_positive(alpha, "alpha")
@@ -369,7 +370,7 @@ class MITRule(AdaptationRule):
         if self.error_output is not None and not np.any(self.error_output):
             raise InvalidArgumentError("error_output", "a non-zero output matrix C_e", "all zeros")
 
-    def rate(self, error: Any, sensitivity: Any) -> np.ndarray:
+    def rate(self, error: ArrayLike, sensitivity: ArrayLike) -> np.ndarray:
         """``dtheta/dt`` of the (plain or normalised) MIT rule for this error and sensitivity.
 
         Parameters

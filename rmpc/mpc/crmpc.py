@@ -50,6 +50,7 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi.data import input_bound_vector
 from models import PolytopicModel
@@ -173,13 +174,13 @@ class CRMPC:
     def __init__(
         self,
         plant: PolytopicModel,
-        Q: Any,
-        R: Any,
-        u_max: Any = None,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
         input_constraint: str | None = "auto",
         *,
         adaptation: AdaptationRule | None = None,
-        theta_bound: Any = "auto",
+        theta_bound: ArrayLike | None = "auto",
         torque_budget: str = "auto",
         rmpc_options: Mapping[str, Any] | None = None,
     ) -> None:
@@ -266,7 +267,7 @@ class CRMPC:
         self.adaptation.reset()
         self.last = None
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Adapt ``theta`` from the measured state, then return ``u = u_rmpc - theta``.
 
         ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).

@@ -42,6 +42,7 @@ from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -219,15 +220,15 @@ class GIPC:
         plant: PolytopicModel,
         Np: int = 400,
         Nc: int = 4,
-        Qy: Any = 1.0,
-        R_du: Any = 1.0,
-        u_max: Any = 1.0,
-        du_max: Any = 0.01,
-        C: Any = None,
+        Qy: ArrayLike = 1.0,
+        R_du: ArrayLike = 1.0,
+        u_max: ArrayLike | None = 1.0,
+        du_max: ArrayLike | None = 0.01,
+        C: ArrayLike | None = None,
         backend: str | QPBackend = "proxqp",
         solver_options: Mapping[str, Any] | None = None,
-        x_ref: Any = None,
-        u0: Any = None,
+        x_ref: ArrayLike | None = None,
+        u0: ArrayLike | None = None,
         max_horizon: int = MAX_HORIZON,
         max_prediction_entries: int = MAX_PREDICTION_ENTRIES,
     ) -> None:
@@ -324,7 +325,7 @@ class GIPC:
         shift = self._repeat @ u_prev
         return {"g": g, "l": -self._umax_rep - shift, "u": self._umax_rep - shift, "lb": lb, "ub": ub}
 
-    def qp_at(self, x: Any, x_prev: Any = None, u_prev: Any = None) -> QP:
+    def qp_at(self, x: ArrayLike, x_prev: ArrayLike | None = None, u_prev: ArrayLike | None = None) -> QP:
         """The (validated) QP the controller solves at state ``x`` with the given memory.
 
         ``x_prev`` defaults to ``x`` (at rest) and ``u_prev`` to ``u0``. For tests and
@@ -348,7 +349,7 @@ class GIPC:
         """The input applied at the previous step (``u0`` after :meth:`reset`)."""
         return self._u_prev.copy()
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``u(k) = u(k-1) + du(k)`` for the measured state ``x``."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -60,10 +61,10 @@ class LQR:
     def __init__(
         self,
         plant: PolytopicModel,
-        Q: Any,
-        R: Any,
+        Q: ArrayLike,
+        R: ArrayLike,
         vertex: int | None = None,
-        x_ref: Any = None,
+        x_ref: ArrayLike | None = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
@@ -97,7 +98,7 @@ class LQR:
         """Nothing to forget but the last step's info."""
         self.last = None
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``F (x - x_ref)``; ``last.status`` is ``"ok"`` (a fixed gain: nothing is solved)."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)

@@ -9,9 +9,8 @@ reproduction of Astrom & Wittenmark's example 5.2 (*Adaptive Control*, 2nd ed.).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_optional_limits, as_vector, check_positive, check_real
@@ -42,7 +41,14 @@ class ParameterIntegrator:
     [0.2, -1.0]
     """
 
-    def __init__(self, n_params: int, dt: float, *, bound: Any = None, theta0: Any = None) -> None:
+    def __init__(
+        self,
+        n_params: int,
+        dt: float,
+        *,
+        bound: ArrayLike | None = None,
+        theta0: ArrayLike | None = None,
+    ) -> None:
         if isinstance(n_params, bool) or not isinstance(n_params, int | np.integer) or n_params < 1:
             raise InvalidArgumentError("n_params", "a positive integer", repr(n_params))
         self.n_params = int(n_params)
@@ -65,7 +71,7 @@ class ParameterIntegrator:
         """Return to ``theta0``."""
         self._theta = self.theta0.copy()
 
-    def step(self, rate: Any) -> np.ndarray:
+    def step(self, rate: ArrayLike) -> np.ndarray:
         """One step, ``theta(k+1) = Proj[theta(k) + Ts rate]``; returns ``theta(k+1)`` (a copy)."""
         self._integrate(as_vector(rate, "rate", self.n_params))
         return self._theta.copy()
@@ -113,7 +119,15 @@ class SensitivityFilter:
     1.0
     """
 
-    def __init__(self, a: Any, b: Any, c: Any = None, d: Any = None, *, columns: int | None = None) -> None:
+    def __init__(
+        self,
+        a: ArrayLike,
+        b: ArrayLike,
+        c: ArrayLike | None = None,
+        d: ArrayLike | None = None,
+        *,
+        columns: int | None = None,
+    ) -> None:
         self.a = as_matrix(a, "a")
         n = self.a.shape[0]
         self.a = as_matrix(self.a, "a", (n, n))
@@ -148,13 +162,13 @@ class SensitivityFilter:
         """Zero the state."""
         self._state = np.zeros(self._shape)
 
-    def _input(self, v: Any) -> np.ndarray:
+    def _input(self, v: ArrayLike) -> np.ndarray:
         r = self.b.shape[1]
         if self.columns is None:
             return as_vector(v, "v", r)
         return as_matrix(v, "v", (r, self.columns))
 
-    def output(self, v: Any = None) -> np.ndarray:
+    def output(self, v: ArrayLike | None = None) -> np.ndarray:
         """``C s(k) + D v(k)`` (``v`` may be left out when ``D = 0``)."""
         out = self.c @ self._state
         if v is not None:
@@ -163,7 +177,7 @@ class SensitivityFilter:
             raise InvalidArgumentError("v", "the input v(k) (the filter has a direct term D)", "None")
         return out
 
-    def advance(self, v: Any, a: Any = None) -> None:
+    def advance(self, v: ArrayLike, a: ArrayLike | None = None) -> None:
         """``s(k+1) = A s(k) + B v(k)``; ``a`` replaces ``A`` for this step only."""
         n = self.a.shape[0]
         a_k = self.a if a is None else as_matrix(a, "a", (n, n))

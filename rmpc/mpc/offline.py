@@ -17,6 +17,7 @@ import time
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi.status import INFEASIBLE, OPTIMAL
 from models import PolytopicModel
@@ -109,14 +110,14 @@ class OfflineRMPC:
     def __init__(
         self,
         plant: PolytopicModel,
-        Q: Any,
-        R: Any,
-        u_max: Any = None,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
         input_constraint: Literal["ellipsoid", "peak"] | str | None = "auto",
         *,
-        output_matrix: Any = None,
-        y_max: Any = None,
-        x_design: Any = None,
+        output_matrix: ArrayLike | None = None,
+        y_max: ArrayLike | None = None,
+        x_design: ArrayLike | None = None,
         n_ellipsoids: int = 15,
         shrink: float = 0.5,
         path: Literal["ray", "trajectory"] = "ray",
@@ -174,7 +175,7 @@ class OfflineRMPC:
             self._store(self.table)
 
     # -- off-line ----------------------------------------------------------------------------
-    def design(self, x_design: Any) -> OfflineTable:
+    def design(self, x_design: ArrayLike) -> OfflineTable:
         """Compute (and store) the table from one state (along ``path``) or from ``(k, n)`` states.
 
         A table designed here is kept until the next call (no automatic redesign).
@@ -183,7 +184,7 @@ class OfflineRMPC:
         self._auto = False
         return table
 
-    def _design(self, x_design: Any) -> OfflineTable:
+    def _design(self, x_design: ArrayLike) -> OfflineTable:
         arr = np.asarray(x_design, dtype=float) if not isinstance(x_design, str) else None
         if arr is None or arr.ndim not in (1, 2):
             raise InvalidArgumentError(
@@ -231,7 +232,7 @@ class OfflineRMPC:
         self._fresh = True
 
     # -- on-line -----------------------------------------------------------------------------
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Look up the gain for ``x`` and return ``u = F x``."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any, ClassVar, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi import KothareProblem, LMISolution
 from models import PolytopicModel
@@ -20,7 +21,7 @@ from toolkit_common.validation import as_vector, check_positive
 __all__ = ["RMPC", "input_constraint_kind"]
 
 
-def input_constraint_kind(input_constraint: str | None, u_max: Any) -> str | None:
+def input_constraint_kind(input_constraint: str | None, u_max: ArrayLike) -> str | None:
     """The input constraint ``"auto"`` stands for: ``"ellipsoid"`` with a bound ``u_max``, else none.
 
     Any other value is returned as it is (the LMI problem checks it).
@@ -101,14 +102,14 @@ class RMPC:
     def __init__(
         self,
         plant: PolytopicModel,
-        Q: Any,
-        R: Any,
-        u_max: Any = None,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
         input_constraint: Literal["ellipsoid", "peak"] | str | None = "auto",
         *,
-        output_matrix: Any = None,
-        y_max: Any = None,
-        x_ref: Any = None,
+        output_matrix: ArrayLike | None = None,
+        y_max: ArrayLike | None = None,
+        x_ref: ArrayLike | None = None,
         backend: str = "ipm",
         solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
@@ -169,7 +170,7 @@ class RMPC:
         self.certified.reset()
         self.problem.reset()
 
-    def solve(self, x: Any, u_max: Any = None) -> LMISolution:
+    def solve(self, x: ArrayLike, u_max: ArrayLike | None = None) -> LMISolution:
         """Solve the LMI problem at ``x`` (the deviation ``x - x_ref`` is used); no side effects.
 
         ``u_max`` replaces the input bound for this solve (see :meth:`lmi.KothareProblem.solve`).
@@ -177,13 +178,13 @@ class RMPC:
         x = as_vector(x, "x", self.plant.n_states)
         return self.problem.solve(x - self.x_ref, u_max=u_max)
 
-    def in_ellipsoid(self, x: Any) -> bool:
+    def in_ellipsoid(self, x: ArrayLike) -> bool:
         """Whether ``x - x_ref`` lies in the invariant ellipsoid of the current gain."""
         if self.certified.solution is None:
             return False
         return self.certified.contains(as_vector(x, "x", self.plant.n_states) - self.x_ref)
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Solve at ``x`` and return ``u = F (x - x_ref)``; see the class notes on failures.
 
         Parameters

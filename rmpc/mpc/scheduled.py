@@ -22,6 +22,7 @@ from collections.abc import Callable
 from typing import Any, ClassVar, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from lmi import KothareProblem, LMISolution
 from models import PolytopicModel, RigidSatellite
@@ -83,9 +84,9 @@ class ScheduledRMPC:
     def __init__(
         self,
         polytope_at: Callable[[np.ndarray], PolytopicModel],
-        Q: Any,
-        R: Any,
-        u_max: Any = None,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
         input_constraint: Literal["ellipsoid", "peak"] | str | None = "auto",
         *,
         backend: str = "ipm",
@@ -115,9 +116,9 @@ class ScheduledRMPC:
         satellite: RigidSatellite,
         dt: float,
         spread: float,
-        Q: Any,
-        R: Any,
-        u_max: Any = None,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
         input_constraint: str | None = "auto",
         *,
         mode: Literal["scalar", "box"] = "scalar",
@@ -155,7 +156,7 @@ class ScheduledRMPC:
         self.last = None
         self.certified.reset()
 
-    def problem_at(self, x: Any) -> KothareProblem:
+    def problem_at(self, x: ArrayLike) -> KothareProblem:
         """The Kothare problem on the polytope at ``x``."""
         poly = self.polytope_at(np.asarray(x, dtype=float))
         if not isinstance(poly, PolytopicModel):
@@ -170,12 +171,12 @@ class ScheduledRMPC:
             )
         return KothareProblem(poly.A, poly.B, dt=poly.dt, **self.options)
 
-    def solve(self, x: Any) -> LMISolution:
+    def solve(self, x: ArrayLike) -> LMISolution:
         """Solve on the polytope at ``x``; no side effects on the controller."""
         x = as_vector(x, "x")
         return self.problem_at(x).solve(x)
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Rebuild the polytope at ``x``, solve, and return ``u = F x``.
 
         ``inputs`` must be ``None`` or an empty :class:`~rmpc.controller.StepInputs` (:attr:`accepts`).

@@ -20,6 +20,7 @@ from numbers import Integral, Real
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rmpc.qp.problem import QP, QPResult, SolverResiduals
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
@@ -160,11 +161,11 @@ class QPBackend(ABC):
     def update(
         self,
         *,
-        g: Any = None,
-        l: Any = None,  # noqa: E741 - the solvers' own name for the lower bound
-        u: Any = None,
-        lb: Any = None,
-        ub: Any = None,
+        g: ArrayLike | None = None,
+        l: ArrayLike | None = None,  # noqa: E741 - the solvers' own name for the lower bound
+        u: ArrayLike | None = None,
+        lb: ArrayLike | None = None,
+        ub: ArrayLike | None = None,
     ) -> None:
         """Replace some of the vectors ``g, l, u, lb, ub`` (``None`` keeps the current one).
 
@@ -244,9 +245,9 @@ class QPBackend(ABC):
         self,
         status: Status,
         raw_status: str,
-        x: Any,
-        y_c: Any,
-        y_box: Any,
+        x: ArrayLike,
+        y_c: ArrayLike,
+        y_box: ArrayLike,
         iterations: int,
         solve_time: float,
         residuals: SolverResiduals,

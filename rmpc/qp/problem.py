@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.status import Status, as_status
@@ -162,7 +163,7 @@ class QP:
         """Number of general constraint rows ``m`` (rows of ``C``)."""
         return int(self.C.shape[0])
 
-    def objective(self, z: Any) -> float:
+    def objective(self, z: ArrayLike) -> float:
         """``1/2 z'Hz + g'z`` at ``z``."""
         z = as_vector(z, "z", self.n_vars)
         return float(0.5 * z @ self.H @ z + self.g @ z)
@@ -281,7 +282,12 @@ def _viol(values: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> float:
     return float(np.max(np.maximum(np.maximum(lower - values, values - upper), 0.0)))
 
 
-def kkt_residuals(qp: QP, x: Any, y_C: Any = None, y_box: Any = None) -> KKTResiduals:
+def kkt_residuals(
+    qp: QP,
+    x: ArrayLike,
+    y_C: ArrayLike | None = None,
+    y_box: ArrayLike | None = None,
+) -> KKTResiduals:
     """Primal, dual and complementarity residuals of ``(x, y_C, y_box)`` for ``qp``.
 
     Parameters

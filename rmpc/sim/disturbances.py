@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive, check_real
@@ -93,7 +94,7 @@ class SineDisturbance:
         return ()
 
 
-def as_disturbance(value: Any, size: int, x0: Any = None) -> Callable[..., np.ndarray] | None:
+def as_disturbance(value: Any, size: int, x0: ArrayLike | None = None) -> Callable[..., np.ndarray] | None:
     """Accept ``None``, a profile object or any callable ``d(t)`` returning ``size`` values.
 
     A disturbance whose attribute ``state_dependent`` is true is called as ``d(t, x)`` (the

@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from rmpc.sim.disturbances import DisturbanceFn, disturbance_at
@@ -62,7 +63,7 @@ class LinearPlant:
 
     kind = "linear"
 
-    def __init__(self, a: Any, b: Any, dt: float, attitude_euler: Any = None) -> None:
+    def __init__(self, a: ArrayLike, b: ArrayLike, dt: float, attitude_euler: Any = None) -> None:
         self.A = as_matrix(a, "A")
         n = self.A.shape[0]
         self.A = as_matrix(self.A, "A", (n, n))
@@ -80,7 +81,7 @@ class LinearPlant:
         """Whether :meth:`attitude_euler` gives the attitude of a state."""
         return self._attitude_euler is not None
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """Roll, pitch and yaw (rad) of the state ``x``; an error for a plant without attitude."""
         if self._attitude_euler is None:
             raise _no_attitude(self)
@@ -179,7 +180,7 @@ class SampledPlant:
         """Whether the model offers ``attitude_euler(x)``."""
         return self._attitude_euler is not None
 
-    def attitude_euler(self, x: Any) -> np.ndarray:
+    def attitude_euler(self, x: ArrayLike) -> np.ndarray:
         """The model's roll, pitch and yaw (rad) of the state ``x``; an error for a model without."""
         if self._attitude_euler is None:
             raise _no_attitude(self.model)

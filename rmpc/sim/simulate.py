@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from models import ReactionWheelActuator, TorqueLimiter
+from models import PolytopicModel, ReactionWheelActuator, TorqueLimiter
+from models.protocols import Plant
+from rmpc.controller import Controller
 from rmpc.sim.disturbances import as_disturbance, disturbance_at
-from rmpc.sim.plants import as_sampled_plant
+from rmpc.sim.plants import SampledPlant, as_sampled_plant
 from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
@@ -22,22 +26,22 @@ MAX_STEPS = 10_000_000
 
 
 def simulate(
-    controller: Any,
-    plant: Any,
-    x0: Any,
+    controller: Controller,
+    plant: PolytopicModel | Plant | SampledPlant,
+    x0: ArrayLike,
     duration: float | None = None,
     *,
     n_steps: int | None = None,
     dt: float | None = None,
-    true_plant: Any = None,
+    true_plant: int | ArrayLike | tuple[ArrayLike, ArrayLike] | None = None,
     actuator: ReactionWheelActuator | None = None,
     limiter: TorqueLimiter | None = None,
-    disturbance: Any = None,
+    disturbance: Callable[..., ArrayLike] | None = None,
     rtol: float = 1e-10,
     atol: float = 1e-12,
     reset: bool = True,
-    progress: Any = None,
-    sensor: Any = None,
+    progress: Callable[[int, int], object] | None = None,
+    sensor: Callable[[float, np.ndarray], ArrayLike] | None = None,
     max_steps: int = MAX_STEPS,
 ) -> Trajectory:
     """Run ``controller`` in closed loop on ``plant`` from ``x0``.

@@ -43,6 +43,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from benchmarks.core.metrics import check_trajectory, last_time_above, total_variation_rate
 from models import FlexibleSatellite
@@ -219,7 +220,7 @@ def flexible_metrics(
     traj: Trajectory,
     satellite: FlexibleSatellite,
     *,
-    q_ref: Any = None,
+    q_ref: ArrayLike | None = None,
     threshold: float = np.deg2rad(1.0),
     tail: float = 10.0,
     bandwidth: float | None = None,

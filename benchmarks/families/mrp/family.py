@@ -44,6 +44,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from benchmarks.core.family import (
     CaseResult,
@@ -86,7 +87,7 @@ def late_window_start(steady_start: float) -> float:
     return min(LATE_WINDOW_START, steady_start)
 
 
-def chattering(t: Any, u: Any, d: Any, start: float) -> dict[str, float | None]:
+def chattering(t: ArrayLike, u: ArrayLike, d: ArrayLike, start: float) -> dict[str, float | None]:
     """The chattering metric of a run: the torque's total variation per second on ``t >= start``.
 
     ``chatter_tv_rate`` is :func:`benchmarks.core.metrics.total_variation_rate` of the applied

@@ -18,12 +18,15 @@ defaults of :data:`benchmarks.families.rigid.defaults.CONTROLLER_DEFAULTS` updat
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from benchmarks.core.family import BuiltController, check_ellipsoid_count, check_horizon
 from toolkit_common.errors import ConfigError
+
+if TYPE_CHECKING:
+    from models import PolytopicModel
 
 __all__ = ["CONSTRAINED", "CONTROLLERS", "settings_check"]
 
@@ -32,7 +35,7 @@ def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
     return np.diag(settings["Q_diag"]), np.diag(settings["R_diag"])
 
 
-def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.robust_mpc import RMPC
 
     q, r = _weights(s)
@@ -63,7 +66,12 @@ def _rmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], adaptation: Any) -> BuiltController:
+def _crmpc_common(
+    poly: PolytopicModel,
+    scenario: Any,
+    s: Mapping[str, Any],
+    adaptation: Any,
+) -> BuiltController:
     from rmpc.mpc.crmpc import CRMPC
 
     q, r = _weights(s)
@@ -86,14 +94,14 @@ def _crmpc_common(poly: Any, scenario: Any, s: Mapping[str, Any], adaptation: An
     return BuiltController(ctrl, limiter)
 
 
-def _crmpc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.adaptation import LyapunovRule
 
     # the setting adaptation_gain is the Lyapunov rule's gain g
     return _crmpc_common(poly, scenario, s, LyapunovRule(gain=s["adaptation_gain"]))
 
 
-def _crmpc_mit(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _crmpc_mit(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.adaptation import MITRule
 
     # the settings mit_gain, normalized, alpha and reset_period are the MIT rule's
@@ -103,7 +111,7 @@ def _crmpc_mit(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltControlle
     return _crmpc_common(poly, scenario, s, rule)
 
 
-def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _gipc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.gipc import GIPC
 
     constrained = scenario.saturation == "constraint"
@@ -120,7 +128,7 @@ def _gipc(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _offline(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _offline(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.offline import OfflineRMPC
 
     q, r = _weights(s)
@@ -138,7 +146,7 @@ def _offline(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
 
-def _lqr(poly: Any, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+def _lqr(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
     from rmpc.mpc.lqr import LQR
 
     q, r = _weights(s)

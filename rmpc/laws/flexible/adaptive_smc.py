@@ -18,9 +18,10 @@ CSMC's), ``s_b = 0.01 rad/s``, ``n0 = n1 = 10``, ``e0 = e1 = 0.1``, ``b0h(0) = 0
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -74,9 +75,9 @@ class AdaptiveSMC:
         plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
-        q_ref: Any = None,
+        q_ref: ArrayLike | None = None,
         lam: float = 0.1,
-        K_s: Any = 20.0,
+        K_s: ArrayLike = 20.0,
         s_b: float = 0.01,
         n0: float = 10.0,
         e0: float = 0.1,
@@ -106,7 +107,13 @@ class AdaptiveSMC:
         self._p1 = self.p1_init
         self.last = None
 
-    def law(self, x: Any, b0: float, p1: float, v: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def law(
+        self,
+        x: ArrayLike,
+        b0: float,
+        p1: float,
+        v: ArrayLike | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The continuous-time law, a pure function: ``(u, s)`` at ``x`` for gains ``b0, p1``.
 
         ``v`` is this sample's PZT command (its reaction on the hub is cancelled; ``None``: 0).
@@ -122,7 +129,7 @@ class AdaptiveSMC:
         u_ad = -(s / max(norm, self.s_b)) * gain
         return u_eq + u_ad, s
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``[u; v]`` for the measured state (``v = inputs.pzt``, this sample's PZT command, or 0)."""
         start = time.perf_counter()
         pzt = check_step_inputs(inputs, self.accepts, self.name).pzt

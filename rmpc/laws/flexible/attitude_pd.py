@@ -22,6 +22,7 @@ import time
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from models.attitude.vectors import cross3
@@ -71,9 +72,9 @@ class AttitudePD:
         plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
-        q_ref: Any = None,
-        K_p: Any = 2.0,
-        K_d: Any = 30.0,
+        q_ref: ArrayLike | None = None,
+        K_p: ArrayLike = 2.0,
+        K_d: ArrayLike = 30.0,
         disturbance_observer: bool = False,
         L_o: float = 0.5,
         u_max: float | None = None,
@@ -98,14 +99,14 @@ class AttitudePD:
         """The observer's ``d_hat`` for the current ``z`` and rate ``w``."""
         return self._z + self.L_o * (self.terms.hub_inertia @ w)
 
-    def law(self, x: Any, d_hat: Any = None) -> np.ndarray:
+    def law(self, x: ArrayLike, d_hat: ArrayLike | None = None) -> np.ndarray:
         """The continuous-time law, a pure function: hub torque at ``x`` given ``d_hat`` (default 0)."""
         q, w, _, _ = self.terms.split(x)
         err = self.terms.error(q, w)
         u = -self.K_d @ w - self.K_p @ err.qv
         return u if d_hat is None else u - np.asarray(d_hat, dtype=float)
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``[u; v]`` for the measured state (``v = inputs.pzt``, this sample's PZT command, or 0).
 
         The law ignores ``v`` (PD cancels nothing); it is passed through so that

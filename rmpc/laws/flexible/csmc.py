@@ -18,9 +18,10 @@ all **assumed**). The torque is not saturated here (the plant's limiter clips it
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -75,9 +76,9 @@ class CSMC:
         plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
-        q_ref: Any = None,
+        q_ref: ArrayLike | None = None,
         lam: float = 0.1,
-        K_s: Any = 20.0,
+        K_s: ArrayLike = 20.0,
         W_0: float = 1.0,
         switch: SwitchKind = "sign",
         eps: float = 0.01,
@@ -96,7 +97,7 @@ class CSMC:
         """Nothing to forget but the last step's info (the law is static)."""
         self.last = None
 
-    def law(self, x: Any, v: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    def law(self, x: ArrayLike, v: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The continuous-time law, a pure function: ``(u, sigma)`` at ``x`` (``v``: PZT command)."""
         q, w, eta, eta_dot = self.terms.split(x)
         err = self.terms.error(q, w)
@@ -107,7 +108,7 @@ class CSMC:
         )
         return u, sigma
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[u; v]`` (``3 + n_a``) for the measured state.
 
         ``inputs.pzt`` is this sample's PZT command ``v`` (from the vibration controller;

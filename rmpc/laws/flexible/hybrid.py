@@ -12,6 +12,7 @@ import time
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError
@@ -59,7 +60,7 @@ class FlexibleHybrid:
 
     accepts: ClassVar[frozenset[str]] = frozenset()
 
-    def __init__(self, attitude: Any, vibration: Any = None) -> None:
+    def __init__(self, attitude: ArrayLike, vibration: Any = None) -> None:
         if not callable(getattr(attitude, "step", None)):
             expected = "a controller with step(x, inputs=None)"
             raise ArgumentTypeError("attitude", expected, type(attitude).__name__)
@@ -80,7 +81,7 @@ class FlexibleHybrid:
             self.vibration.reset()
         self.last = None
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return ``[u; v]``: ``v`` from the vibration law, then ``u`` given ``v``."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)

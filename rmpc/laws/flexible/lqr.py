@@ -13,9 +13,8 @@ frequency ~0.06 rad/s, damping 0.7 at ``J ~ 250 kg m^2``.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from rmpc.mpc.lqr import LQR
@@ -30,9 +29,9 @@ def flexible_lqr(
     plant: FlexibleSatellite,
     dt: float = 0.01,
     *,
-    Q: Any = None,
-    R: Any = None,
-    q_ref: Any = None,
+    Q: ArrayLike | None = None,
+    R: ArrayLike | None = None,
+    q_ref: ArrayLike | None = None,
 ) -> MappedController:
     """LQR designed on the 6 + 2N model, wrapped to run on the nonlinear plant (name "LQR").
 

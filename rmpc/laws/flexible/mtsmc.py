@@ -37,9 +37,10 @@ input stage clips it (``u_max = 2 N m`` per axis in paper V's scenario).
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -102,7 +103,7 @@ class MTSMC:
         plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
-        q_ref: Any = None,
+        q_ref: ArrayLike | None = None,
         alpha_law: AlphaLaw = "schedule",
         alpha_f: float = 0.1,
         tau_a: float = 15.0,
@@ -111,7 +112,7 @@ class MTSMC:
         k2: float = 0.0,
         alpha_min: float = 0.005,
         alpha_max: float = 0.5,
-        K_s: Any = 20.0,
+        K_s: ArrayLike = 20.0,
         W_0: float = 1.0,
         eps: float = 0.01,
         k_I: float = 0.0,
@@ -172,10 +173,10 @@ class MTSMC:
     def law(
         self,
         t: float,
-        x: Any,
-        v: Any = None,
+        x: ArrayLike,
+        v: ArrayLike | None = None,
         *,
-        z: Any = None,
+        z: ArrayLike | None = None,
         alpha: float | None = None,
         w_s: float | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -205,7 +206,7 @@ class MTSMC:
         u = self.terms.sliding_torque(w, eta, eta_dot, v_vec, sigma, rate, self.K_s, w_s, self.eps, "tanh")
         return u, sigma
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[u; v]`` (``3 + n_a``) for the measured state.
 
         ``inputs.pzt`` is this sample's PZT command ``v`` (from the vibration controller;

@@ -26,9 +26,10 @@ from __future__ import annotations
 
 import time
 import warnings
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
@@ -81,8 +82,8 @@ class RobustAVC:
         plant: FlexibleSatellite,
         dt: float = 0.01,
         *,
-        Lam: Any = 1.0,
-        K_v: Any = 2.0,
+        Lam: ArrayLike = 1.0,
+        K_v: ArrayLike = 2.0,
         b0: float = 0.01,
         b1: float = 0.1,
         b2: float = 0.1,
@@ -142,7 +143,7 @@ class RobustAVC:
         return max(self.e1 * float(np.exp(-self.e2 * t)), self.e_min)
 
     def law(
-        self, t: float, x: Any, eta0: Any = None, wdot_prev: Any = None
+        self, t: float, x: ArrayLike, eta0: ArrayLike | None = None, wdot_prev: ArrayLike | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
         """The continuous-time law, a pure function: ``(v, s)`` at ``(t, x)``.
 
@@ -165,7 +166,7 @@ class RobustAVC:
         force = psi - self.K_v * s - rho**2 * s / (rho * float(np.linalg.norm(s)) + self.smoothing(t))
         return self._gamma_inv @ force, s
 
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the plant input ``[0 (3 hub torques); v]`` for the measured state."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import FlexibleSatellite
 from models.attitude.quaternion import quat_error, unit_quaternion
@@ -83,7 +84,12 @@ class FlexibleTerms:
         cancel the modal reaction; ``False`` drops every ``eta`` term.
     """
 
-    def __init__(self, plant: FlexibleSatellite, q_ref: Any = None, flex_feedforward: bool = True) -> None:
+    def __init__(
+        self,
+        plant: FlexibleSatellite,
+        q_ref: ArrayLike | None = None,
+        flex_feedforward: bool = True,
+    ) -> None:
         if not isinstance(plant, FlexibleSatellite):
             raise ArgumentTypeError("plant", "a models.FlexibleSatellite", type(plant).__name__)
         self.plant = plant
@@ -100,7 +106,7 @@ class FlexibleTerms:
         self._k = np.diag(plant.stiffness)
         self._gamma = plant.pzt_matrix
 
-    def split(self, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def split(self, x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(q, w, eta, eta')`` of a measured state (checked: length ``7 + 2N``, finite)."""
         x = as_vector(x, "x", self.plant.n_states)
         n = self.n_modes

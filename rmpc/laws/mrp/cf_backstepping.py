@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import MRPSatellite
 from models.attitude.vectors import cross3
@@ -103,13 +104,13 @@ class CFBackstepping(ContinuousTimeController):
     def __init__(
         self,
         plant: MRPSatellite,
-        target: Any = None,
+        target: ArrayLike | None = None,
         *,
         c1: float = 0.5,
         c2: float = 2.0,
         command_filter: CommandFilter | None = None,
         dt: float = 0.01,
-        u_max: Any = None,
+        u_max: ArrayLike | None = None,
     ) -> None:
         super().__init__(dt, u_max)
         if not isinstance(plant, MRPSatellite):
@@ -172,7 +173,7 @@ class CFBackstepping(ContinuousTimeController):
             u0 = u0 + extra
         return _Pieces(alpha1=alpha1, x0=alpha1 - chi2, z2=z2, zb1=zb1, zb2=zb2, u0=u0)
 
-    def initial_internal(self, x: Any) -> np.ndarray:
+    def initial_internal(self, x: ArrayLike) -> np.ndarray:
         """``[S_M(alpha1(x)), 0, 0, 0]``: the filter at rest on its first input, ``chi = 0``."""
         x = as_vector(x, "x", 6)
         alpha1 = self.virtual_rate(self._geometry(x))
@@ -201,13 +202,13 @@ class CFBackstepping(ContinuousTimeController):
         return np.concatenate((q_dot, chi1_dot, chi2_dot))
 
     # -- analysis ----------------------------------------------------------------------------------
-    def compensated_errors(self, x: Any, z: Any) -> tuple[np.ndarray, np.ndarray]:
+    def compensated_errors(self, x: ArrayLike, z: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(zb1, zb2)``: the tracking errors with the filter's effect removed."""
         x, z = self._checked(x, z)
         p = self._pieces(x, z, self._geometry(x))
         return p.zb1, p.zb2
 
-    def lyapunov(self, x: Any, z: Any) -> float:
+    def lyapunov(self, x: ArrayLike, z: ArrayLike) -> float:
         """``V = (|zb1|^2 + |zb2|^2) / 2``."""
         zb1, zb2 = self.compensated_errors(x, z)
         return 0.5 * float(zb1 @ zb1 + zb2 @ zb2)

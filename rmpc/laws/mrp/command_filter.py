@@ -25,6 +25,7 @@ import time
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rmpc.controller import StepInfo
 from toolkit_common.errors import InvalidArgumentError
@@ -74,8 +75,8 @@ class CommandFilter:
         natural_frequency: float = 2.0,
         damping: float = 0.5,
         *,
-        magnitude_limit: Any = None,
-        rate_limit: Any = None,
+        magnitude_limit: ArrayLike | None = None,
+        rate_limit: ArrayLike | None = None,
         size: int = 3,
         dt: float = 0.01,
     ) -> None:
@@ -117,7 +118,7 @@ class CommandFilter:
         m = self.magnitude_limit
         return x0 if m is None else np.clip(x0, -m, m)
 
-    def initial_state(self, x0: Any) -> np.ndarray:
+    def initial_state(self, x0: ArrayLike) -> np.ndarray:
         """``[S_M(x0), 0]``: at rest on the input."""
         x0 = as_vector(x0, "x0", self.size)
         return np.concatenate((self.clip_input(x0), np.zeros(self.size)))
@@ -145,7 +146,7 @@ class CommandFilter:
             raise InvalidArgumentError("state", "a filter that has been stepped once", "a reset filter")
         return self._state[: self.size].copy(), self._state[self.size :].copy()
 
-    def step(self, x0: Any) -> np.ndarray:
+    def step(self, x0: ArrayLike) -> np.ndarray:
         """Return ``x_c`` for this sample, then advance one RK4 step of ``dt`` with ``x0`` held.
 
         ``last.extra`` holds ``"rate"`` (``x_c'`` at this sample).

@@ -22,6 +22,7 @@ from __future__ import annotations
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import MRPSatellite
 from models.mrp.tracking import MRPTrackingError
@@ -44,7 +45,7 @@ class TorqueEstimator(Protocol):
 
     n_states: int
 
-    def initial_state(self, w: Any) -> np.ndarray:  # pragma: no cover - protocol
+    def initial_state(self, w: ArrayLike) -> np.ndarray:  # pragma: no cover - protocol
         """The estimator state at the first sample, given the measured rate."""
         ...
 
@@ -111,7 +112,7 @@ class MAB(CFBackstepping):
     def __init__(
         self,
         plant: MRPSatellite,
-        target: Any = None,
+        target: ArrayLike | None = None,
         *,
         c1: float = 0.5,
         c2: float = 2.0,
@@ -119,7 +120,7 @@ class MAB(CFBackstepping):
         estimator: Any = "neso",
         command_filter: CommandFilter | None = None,
         dt: float = 0.01,
-        u_max: Any = None,
+        u_max: ArrayLike | None = None,
     ) -> None:
         super().__init__(plant, target, c1=c1, c2=c2, command_filter=command_filter, dt=dt, u_max=u_max)
         self.kappa = check_positive(kappa, "kappa")
@@ -149,7 +150,7 @@ class MAB(CFBackstepping):
         ))
         return out
 
-    def torque_estimate(self, z: Any) -> np.ndarray:
+    def torque_estimate(self, z: ArrayLike) -> np.ndarray:
         """``Tdhat`` for the internal state ``z`` (zero without an estimator)."""
         z = as_vector(z, "z", self.n_internal)
         return self._estimate(z)
@@ -162,7 +163,7 @@ class MAB(CFBackstepping):
     def _extra_torque(self, x: np.ndarray, z: np.ndarray, zb2: np.ndarray) -> np.ndarray:
         return -self.kappa * (self._j0_inv.T @ zb2) - self._estimate(z)
 
-    def initial_internal(self, x: Any) -> np.ndarray:
+    def initial_internal(self, x: ArrayLike) -> np.ndarray:
         """:class:`CFBackstepping`'s start, then the estimator's ``initial_state(w(0))``."""
         x = as_vector(x, "x", 6)
         z = super().initial_internal(x)

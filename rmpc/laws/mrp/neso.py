@@ -36,6 +36,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models.attitude.vectors import cross3
 from toolkit_common.errors import InvalidArgumentError
@@ -51,7 +52,7 @@ def _exponent(value: Any, name: str) -> float:
     return alpha
 
 
-def fal(e: Any, alpha: float, delta: float) -> np.ndarray:
+def fal(e: ArrayLike, alpha: float, delta: float) -> np.ndarray:
     """Han's ``fal``: ``|e|^alpha sign(e)`` for ``|e| > delta``, ``e / delta^(1 - alpha)`` inside.
 
     Continuous at ``|e| = delta``, odd, and the identity for ``alpha = 1``.
@@ -114,14 +115,14 @@ class NESO:
 
     def __init__(
         self,
-        inertia: Any,
-        gain1: Any,
-        gain2: Any,
+        inertia: ArrayLike,
+        gain1: ArrayLike,
+        gain2: ArrayLike,
         *,
         alpha1: float = 0.5,
         alpha2: float = 0.25,
         delta: float = 0.01,
-        bound: Any = 0.05,
+        bound: ArrayLike = 0.05,
     ) -> None:
         self._inertia = as_inertia(inertia)
         self._inertia_inv = np.linalg.inv(self._inertia)
@@ -138,7 +139,7 @@ class NESO:
     @classmethod
     def from_bandwidth(
         cls,
-        inertia: Any,
+        inertia: ArrayLike,
         bandwidth: float = 10.0,
         *,
         alpha1: float = 0.5,
@@ -162,7 +163,7 @@ class NESO:
         return obs
 
     @classmethod
-    def linear(cls, inertia: Any, bandwidth: float = 10.0, *, bound: Any = 0.05) -> NESO:
+    def linear(cls, inertia: ArrayLike, bandwidth: float = 10.0, *, bound: Any = 0.05) -> NESO:
         """The linear extended state observer (``alpha1 = alpha2 = 1``), poles at ``-bandwidth``."""
         return cls.from_bandwidth(inertia, bandwidth, alpha1=1.0, alpha2=1.0, delta=1.0, bound=bound)
 
@@ -191,7 +192,7 @@ class NESO:
             "bound": self.bound.tolist(),
         }
 
-    def initial_state(self, w: Any) -> np.ndarray:
+    def initial_state(self, w: ArrayLike) -> np.ndarray:
         """``[w(0), 0]``."""
         return np.concatenate((as_vector(w, "w", 3), np.zeros(3)))
 
@@ -214,7 +215,7 @@ class NESO:
         """``Tdhat = J0 dhat`` (N m)."""
         return self._inertia @ z[3:6]
 
-    def advance(self, z: Any, w: Any, torque: Any, dt: float) -> np.ndarray:
+    def advance(self, z: ArrayLike, w: ArrayLike, torque: ArrayLike, dt: float) -> np.ndarray:
         """One RK4 step of length ``dt`` with ``w`` and ``torque`` held, then the projection."""
         z = as_vector(z, "z", 6)
         w = as_vector(w, "w", 3)

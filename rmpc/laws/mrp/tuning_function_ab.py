@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import MRPSatellite
 from models.attitude.vectors import cross3
@@ -74,13 +75,13 @@ class TuningFunctionAB(ContinuousTimeController):
     def __init__(
         self,
         plant: MRPSatellite,
-        target: Any = None,
+        target: ArrayLike | None = None,
         *,
         c1: float = 0.5,
         c2: float = 2.0,
-        gamma: Any = 10.0,
+        gamma: ArrayLike = 10.0,
         dt: float = 0.01,
-        u_max: Any = None,
+        u_max: ArrayLike | None = None,
     ) -> None:
         super().__init__(dt, u_max)
         if not isinstance(plant, MRPSatellite):
@@ -127,7 +128,7 @@ class TuningFunctionAB(ContinuousTimeController):
         )
         return alpha1, alpha1_dot
 
-    def initial_internal(self, x: Any) -> np.ndarray:
+    def initial_internal(self, x: ArrayLike) -> np.ndarray:
         """``Tdhat(0) = 0``."""
         as_vector(x, "x", 6)
         return np.zeros(3)
@@ -156,13 +157,13 @@ class TuningFunctionAB(ContinuousTimeController):
         return self.gamma * (self._j0_inv.T @ z2)
 
     # -- analysis ----------------------------------------------------------------------------------
-    def errors(self, x: Any) -> tuple[np.ndarray, np.ndarray]:
+    def errors(self, x: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """``(z1, z2) = (se, w - alpha1)``."""
         x = as_vector(x, "x", 6)
         g = self._geometry(x)
         return g.se, self._z2(x, g)[0]
 
-    def lyapunov(self, x: Any, z: Any, true_torque: Any) -> float:
+    def lyapunov(self, x: ArrayLike, z: ArrayLike, true_torque: ArrayLike) -> float:
         """``V = (|z1|^2 + |z2|^2 + Tt' Gamma^-1 Tt) / 2`` with ``Tt = true_torque - Tdhat``."""
         z = as_vector(z, "z", 3)
         tt = as_vector(true_torque, "true_torque", 3) - z

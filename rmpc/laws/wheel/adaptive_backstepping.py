@@ -51,6 +51,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from models import WheelSatellite
 from models.attitude.euler import kinematics_matrix
@@ -180,11 +181,11 @@ class AdaptiveBacksteppingFTC:
         *,
         c1: float = 0.5,
         c2: float = 3.0,
-        gamma_g: Any = 0.1,
-        gamma_theta: Any = 0.1,
+        gamma_g: ArrayLike = 0.1,
+        gamma_theta: ArrayLike = 0.1,
         dt: float = 0.04,
-        basis_frequencies: Any = (0.2,),
-        g_hat0: Any = None,
+        basis_frequencies: ArrayLike = (0.2,),
+        g_hat0: ArrayLike | None = None,
         projection: float | tuple[float, float] | None = None,
         leakage: float = 0.0,
         freeze: bool = False,
@@ -302,7 +303,7 @@ class AdaptiveBacksteppingFTC:
         alpha1_dot = -self.c1 * (k_inv_dot @ e1 + w)
         return e1, e2, alpha1, alpha1_dot, f2, k_mat
 
-    def law(self, t: float, x: Any, g_hat: Any, theta_hat: Sequence[Any]) -> ABFTCRates:
+    def law(self, t: float, x: ArrayLike, g_hat: ArrayLike, theta_hat: Sequence[Any]) -> ABFTCRates:
         """The continuous-time law at ``(t, x)`` for the estimates ``G_hat``, ``Theta_hat_j``.
 
         A pure function of its arguments (and the constructor's parameters): nothing is stored.
@@ -335,7 +336,12 @@ class AdaptiveBacksteppingFTC:
         return ABFTCRates(nu, nu0, g_dot, tuple(th_dot), e1, e2, alpha1, alpha1_dot, f2)
 
     def lyapunov(
-        self, x: Any, g_hat: Any, theta_hat: Sequence[Any], g_true: Any, theta_true: Sequence[Any]
+        self,
+        x: ArrayLike,
+        g_hat: ArrayLike,
+        theta_hat: Sequence[Any],
+        g_true: ArrayLike,
+        theta_true: Sequence[Any],
     ) -> float:
         """Paper W's ``V2`` (eq. 40) for the true ``G`` and ``Theta_j`` of the current fault state."""
         x = np.asarray(x, dtype=float)
@@ -349,7 +355,7 @@ class AdaptiveBacksteppingFTC:
         return float(v)
 
     def true_parameters(
-        self, sigma: Any, ubar: Sequence[Any] | None = None
+        self, sigma: ArrayLike, ubar: Sequence[Any] | None = None
     ) -> tuple[np.ndarray, list[np.ndarray]]:
         """Paper W's ``G = (g2 sigma g2')^-1`` and ``Theta_j = G g2_j (1 - sigma_j) delta_j'``.
 
@@ -375,7 +381,7 @@ class AdaptiveBacksteppingFTC:
         return g_true, thetas
 
     # -- the sampled controller ----------------------------------------------------------------------
-    def step(self, x: Any, inputs: StepInputs | None = None) -> np.ndarray:
+    def step(self, x: ArrayLike, inputs: StepInputs | None = None) -> np.ndarray:
         """Return the wheel commands for the measured state and advance the estimates over ``Ts``."""
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)
