@@ -118,15 +118,14 @@ class AdaptivePD:
         pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         q, w, _, _ = self.terms.split(x)
         qv = self.terms.error(q, w).qv
-        u = self.law(x, self._k_p, self._k_d)
+        u = -self._k_d * w - self._k_p * qv  # self.law(x, k_p, k_d) without splitting x again
         extra = {"k_p": self._k_p, "k_d": self._k_d}
         k_p = self._k_p + self.dt * (self.gamma_p * float(qv @ qv) - self.sigma * (self._k_p - self.k_p0))
         k_d = self._k_d + self.dt * (self.gamma_d * float(w @ w) - self.sigma * (self._k_d - self.k_d0))
         self._k_p = min(max(k_p, self.k_p0), self.k_p_max)
         self._k_d = min(max(k_d, self.k_d0), self.k_d_max)
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return f"AdaptivePD(k_p={self._k_p:g}, k_d={self._k_d:g}, dt={self.dt:g})"

@@ -140,8 +140,7 @@ class AdaptiveSMC:
         self._b0 = max(0.0, self._b0 + self.dt * self.n0 * (norm - self.e0 * self._b0))
         self._p1 = max(0.0, self._p1 + self.dt * self.n1 * (norm * (1.0 + float(w @ w)) - self.e1 * self._p1))
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return f"AdaptiveSMC(lam={self.lam:g}, s_b={self.s_b:g}, dt={self.dt:g})"

@@ -126,8 +126,7 @@ class AttitudePD:
             self._z = self._z + self.dt * z_dot
             extra["d_hat"] = d_hat
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return f"AttitudePD(name={self.name!r}, L_o={self.L_o:g}, dt={self.dt:g})"

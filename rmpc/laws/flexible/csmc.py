@@ -119,8 +119,7 @@ class CSMC:
         pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         u, sigma = self.law(x, pzt)
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra={"sigma": sigma})
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return (

@@ -218,8 +218,7 @@ class ShapedPD:
         u = -self.K_d @ w - self.K_p @ qv
         extra = {"fraction": self.fraction(t)}
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return f"ShapedPD(kind={self.kind!r}, frequency={self.frequency:g}, damping={self.damping:g})"

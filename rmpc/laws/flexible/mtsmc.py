@@ -233,8 +233,7 @@ class MTSMC:
             self._w_s = self._w_s + self.dt * w_rate
         self._k += 1
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start, extra=extra)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return (

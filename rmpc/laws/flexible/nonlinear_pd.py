@@ -101,8 +101,7 @@ class NonlinearPD:
         pzt = check_step_inputs(inputs, self.accepts, self.name).pzt
         u = self.law(x)
         self.last = StepInfo(status=Status.OK, solve_time=time.perf_counter() - start)
-        v_out = np.zeros(self.terms.n_pzt) if pzt is None else self.terms.pzt(pzt)
-        return np.concatenate((u, v_out))
+        return self.terms.command(u, pzt)
 
     def __repr__(self) -> str:
         return f"NonlinearPD(q_s={self.q_s:g}, dt={self.dt:g})"

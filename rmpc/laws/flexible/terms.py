@@ -171,6 +171,12 @@ class FlexibleTerms:
             return None
         return as_vector(pzt, "pzt", self.n_pzt)
 
+    def command(self, u: np.ndarray, pzt: Any) -> np.ndarray:
+        """``[u; v]``: the hub torque ``u`` and this sample's PZT command ``v`` (checked by
+        :meth:`pzt`; zeros when there is none), the output of every flexible law's ``step``."""
+        v_out = np.zeros(self.n_pzt) if pzt is None else self.pzt(pzt)
+        return np.concatenate((u, v_out))
+
 
 def check_switch(value: Any) -> SwitchKind:
     """``"sign"`` or ``"tanh"``."""
