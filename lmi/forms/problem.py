@@ -202,7 +202,7 @@ class FormProblem:
             input_constraint=data.input_constraint,
             C_out=None if data.C_out is None else data.C_out * t[None, :],
             E=None if self._E is None else ti[:, None] * self._E,
-            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam,
+            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam, dt=data.dt,
         )
 
     # -- solve ---------------------------------------------------------------------------------
