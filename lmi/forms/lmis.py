@@ -224,7 +224,6 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
                 prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)
     _bound_blocks(prog, opts, fd, top, y_sign, signs, lyap)
-    _slack_signs(prog, fd)
     return prog
 
 
@@ -249,11 +248,24 @@ def delta_congruence(n: int, extra: int, dt: float, rest_scale: float) -> np.nda
     return lmat
 
 
-def _slack_signs(prog: Program, fd: FormData) -> None:
-    """``s >= 0``, certified relative to the squared bound the slack enlarges."""
-    for name, bounds in (("s_u", fd.u_max), ("s_y", fd.y_max)):
-        if name in prog.layout:
-            prog.add(f"{name}_nonnegative", prog.var(name), floor=float(np.max(bounds)) ** 2)
+def _with_slacks(prog: Program, block: AffineMatrix) -> AffineMatrix:
+    """``block`` with the soft constraints' slacks ``s_u, s_y >= 0`` appended on its diagonal.
+
+    A slack is zero at the optimum wherever the hard bound holds; on a ``1 x 1`` block of its
+    own, the solver's block-wise residual test (relative to the block's size, then about zero)
+    could never pass, so the slacks share the state block, whose size is one.
+    """
+    slacks = [prog.var(name) for name in ("s_u", "s_y") if name in prog.layout]
+    if not slacks:
+        return block
+    rows: list[list[AffineMatrix | None]] = [[block] + [None] * len(slacks)]
+    for k, slack in enumerate(slacks):
+        rows.append([None] * (k + 1) + [slack] + [None] * (len(slacks) - k - 1))
+    rows[0][1] = AffineMatrix.zeros(block.shape[0], 1, prog.n_vars)
+    for k in range(1, len(slacks)):
+        rows[k][0] = AffineMatrix.zeros(1, block.shape[1], prog.n_vars)
+    rows[-1][0] = AffineMatrix.zeros(1, block.shape[1], prog.n_vars)
+    return prog.bmat(rows)
 
 
 def _soft_square(prog: Program, bound: float, name: str) -> AffineMatrix:
@@ -268,7 +280,8 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
     if not opts.free_moves:
         xc = prog.const(fd.x[:, None])
         for j, q in enumerate(lyap):
-            prog.add(f"state_{j}", prog.bmat([[one, xc.T], [xc, q]]))
+            block = prog.bmat([[one, xc.T], [xc, q]])
+            prog.add(f"state_{j}", _with_slacks(prog, block) if j == 0 else block)
         return
     u0 = prog.var("u0")
     # every vertex's prediction x(k+1) = A_i x + B_i u0 inside the ellipsoid of Q_j
@@ -283,7 +296,8 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
         prog.add(f"prediction_{tag}", prog.bmat([[one, pred.T], [pred, q]]))
     stage = float(fd.x @ fd.Q1h.T @ fd.Q1h @ fd.x)
     s0 = prog.var("s0") - prog.const(stage)
-    prog.add("stage_cost", prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]]))
+    stage_block = prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]])
+    prog.add("stage_cost", _with_slacks(prog, stage_block))
 
 
 def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, signs,

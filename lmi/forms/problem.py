@@ -350,8 +350,8 @@ class FormProblem:
             prog = self._symbolic(fd)
             z = cp.Variable(self.layout.size)
             params, cons = [], []
-            for block in prog.blocks.values():
-                coef = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+            for name in prog.blocks:
+                coef = prog.solver_coef(name)  # the data the other back-ends get
                 k = coef.shape[1]
                 const = cp.Parameter((k, k), symmetric=True)
                 lin = coef[1:].reshape(self.layout.size, k * k).T @ z

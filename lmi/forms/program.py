@@ -114,7 +114,6 @@ class Program:
         self._values = dict(values or {})
         self.n_vars = 0 if self.numeric else layout.size
         self.blocks: dict[str, AffineMatrix] = {}
-        self._floors: dict[str, float] = {}
         self._congruences: dict[str, np.ndarray] = {}
 
     def var(self, name: str) -> AffineMatrix:
@@ -134,25 +133,20 @@ class Program:
     def bmat(self, rows: list[list[AffineMatrix | None]]) -> AffineMatrix:
         return AffineMatrix.bmat(rows, self.n_vars)
 
-    def add(self, name: str, block: AffineMatrix, floor: float = 0.0,
-            congruence: np.ndarray | None = None) -> None:
+    def add(self, name: str, block: AffineMatrix, congruence: np.ndarray | None = None) -> None:
         """Require ``block >= 0`` (its symmetric part).
 
-        ``floor``: the certificate divides the block's smallest eigenvalue by its largest absolute
-        eigenvalue or by ``floor``, whichever is larger (a scalar block ``s >= 0`` needs a scale
-        of its own: relative to itself its margin is only ever ``+1`` or ``-1``).
         ``congruence``: an invertible ``L``; the solvers get ``L M L'`` (the same LMI, better
         conditioned), and the certificate checks both ``M`` and ``L M L'`` (``name + "_delta"``).
         """
         if name in self.blocks:
             raise ValueError(f"block {name!r} added twice")
         self.blocks[name] = block
-        if floor > 0.0:
-            self._floors[name] = floor
         if congruence is not None:
             self._congruences[name] = congruence
 
-    def _solver_coef(self, name: str) -> np.ndarray:
+    def solver_coef(self, name: str) -> np.ndarray:
+        """Block ``name``'s symmetric coefficients ``(n_vars + 1, k, k)`` as the solvers get them."""
         coef = self.blocks[name].coef
         lmat = self._congruences.get(name)
         if lmat is not None:
@@ -164,21 +158,21 @@ class Program:
         """``(C_j, A_j)`` with ``M_j(z) = C_j - sum_i z_i A_ij`` (:class:`lmi.BlockLMISolver`)."""
         out = []
         for name in self.blocks:
-            coef = self._solver_coef(name)
+            coef = self.solver_coef(name)
             out.append((coef[0], -coef[1:]))
         return out
 
     def constants(self) -> list[np.ndarray]:
         """The constant part of each block as the solvers get it (a numeric program: the blocks'
         values)."""
-        return [self._solver_coef(name)[0] for name in self.blocks]
+        return [self.solver_coef(name)[0] for name in self.blocks]
 
     def conic_rows(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
         """``(A, b, orders)`` with ``svec(M_j(z)) = b_j - A_j z`` stacked over the blocks
         (Clarabel's ``PSDTriangleConeT`` convention)."""
         a_rows, b_rows, orders = [], [], []
         for name, block in self.blocks.items():
-            sv = svec_matrix(self._solver_coef(name))
+            sv = svec_matrix(self.solver_coef(name))
             a_rows.append(-sv[1:].T)
             b_rows.append(sv[0])
             orders.append(block.shape[0])
@@ -188,18 +182,17 @@ class Program:
         """Of a numeric program: each block's smallest eigenvalue relative to its largest."""
         out = {}
         for name, block in self.blocks.items():
-            out[name] = relative_margin(block.coef[0], self._floors.get(name, 0.0))
+            out[name] = relative_margin(block.coef[0])
             if name in self._congruences:
-                out[name + "_delta"] = relative_margin(self._solver_coef(name)[0])
+                out[name + "_delta"] = relative_margin(self.solver_coef(name)[0])
         return out
 
 
-def relative_margin(mat: np.ndarray, floor: float = 0.0) -> float:
-    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue (or
-    by ``floor`` if that is larger)."""
+def relative_margin(mat: np.ndarray) -> float:
+    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue."""
     sym = 0.5 * (mat + mat.T)
     if not np.all(np.isfinite(sym)):
         return -np.inf
     lam = np.linalg.eigvalsh(sym)
-    scale = max(float(np.max(np.abs(lam))), floor, np.finfo(float).tiny)
+    scale = max(float(np.max(np.abs(lam))), np.finfo(float).tiny)
     return float(lam[0] / scale)
