@@ -37,6 +37,15 @@ def _psd_sqrt(M: np.ndarray) -> np.ndarray:
     return (V * np.sqrt(np.clip(w, 0.0, None))) @ V.T
 
 
+def _symmetrised(M: Any) -> np.ndarray:
+    M = np.asarray(M, float)
+    return (M + M.T) / 2
+
+
+def _r(expr: Any, shape: tuple[int, int]) -> Any:
+    return cp.reshape(expr, shape, order="C")
+
+
 def _sym(M: Any) -> Any:
     """Symmetric part of a block expression that is symmetric by construction (for cvxpy)."""
     return (M + M.T) / 2
@@ -69,7 +78,7 @@ def reference_gamma(
     solver: str = "CLARABEL",
     solver_options: dict[str, Any] | None = None,
     level: float | None = None,
-    relax: Any = None,
+    at: dict[str, Any] | None = None,
 ) -> tuple[str, float, dict[str, Any]]:
     """Solve one robust MPC form in cvxpy from raw matrices.
 
@@ -103,11 +112,11 @@ def reference_gamma(
         Passed to ``problem.solve``.
     level : float, optional
         Instead of minimising the objective, keep it ``<= level`` and maximise the smallest
-        eigenvalue ``margin`` of every LMI (used by :func:`reference_bracket`).
-    relax : callable, optional
-        ``relax(lmis)`` gives, per LMI, a shift ``eps_k >= 0``: the problem is solved with
-        ``LMI_k >= -eps_k I`` (a relaxation, whose optimum is a lower bound; see
-        :func:`reference_relaxed`).
+        eigenvalue ``margin`` of every LMI (used by :func:`reference_upper`).
+    at : dict, optional
+        Do not solve: evaluate every LMI at these values (``gamma`` (the whole bound), ``Y``,
+        ``Q`` or ``G`` and ``Q_vertices``, ``Z``, ``u0``, ``slack``) and return status
+        ``"evaluated"`` with ``lmis``, ``residual`` and ``abs_min_eig``.
 
     Returns
     -------
@@ -121,7 +130,7 @@ def reference_gamma(
         smallest eigenvalue over them), ``abs_min_eig`` (the worst absolute one) and ``margin``
         (with ``level``).
     """
-    if disturbance is not None and len(disturbance) == 2 and float(disturbance[1]) > 0.0:
+    if disturbance is not None and len(disturbance) == 2 and float(disturbance[1]) > 0.0 and at is None:
         E, w_max = disturbance
 
         def at(lam: float) -> tuple[str, float, dict[str, Any]]:
@@ -226,23 +235,23 @@ def reference_gamma(
         u0 = cp.Variable(m, name="u0")
         s0 = cp.Variable(name="s0")
         lmis.append(cp.bmat([
-            [cp.reshape(s0 - float(x @ Q1 @ x), (1, 1)), cp.reshape(Rh @ u0, (1, m))],
-            [cp.reshape(Rh @ u0, (m, 1)), np.eye(m)],
+            [_r(s0 - float(x @ Q1 @ x), (1, 1)), _r(Rh @ u0, (1, m))],
+            [_r(Rh @ u0, (m, 1)), np.eye(m)],
         ]))
         objective = objective + s0
         for i, j in pairs:
-            xp = cp.reshape(A_list[i] @ x + B_list[i] @ u0, (n, 1))
+            xp = _r(A_list[i] @ x + B_list[i] @ u0, (n, 1))
             lmis.append(cp.bmat([[np.ones((1, 1)), xp.T], [xp, Qs[j]]]))
         # the bound on u0
         if input_constraint == "ellipsoid":
             top = float(umax[0] ** 2) + (s_u if s_u is not None else 0.0)
-            lmis.append(cp.bmat([[cp.reshape(top, (1, 1)), cp.reshape(u0, (1, m))],
-                                 [cp.reshape(u0, (m, 1)), np.eye(m)]]))
+            lmis.append(cp.bmat([[_r(top, (1, 1)), _r(u0, (1, m))],
+                                 [_r(u0, (m, 1)), np.eye(m)]]))
         else:
-            for l in range(m):
-                top = float(umax[l] ** 2) + (s_u if s_u is not None else 0.0)
-                lmis.append(cp.bmat([[cp.reshape(top, (1, 1)), cp.reshape(u0[l], (1, 1))],
-                                     [cp.reshape(u0[l], (1, 1)), np.ones((1, 1))]]))
+            for k in range(m):
+                top = float(umax[k] ** 2) + (s_u if s_u is not None else 0.0)
+                lmis.append(cp.bmat([[_r(top, (1, 1)), _r(u0[k], (1, 1))],
+                                     [_r(u0[k], (1, 1)), np.ones((1, 1))]]))
     else:
         raise ValueError(free_moves)
 
@@ -253,10 +262,10 @@ def reference_gamma(
             top = float(umax[0] ** 2) * np.eye(m) + (s_u * np.eye(m) if s_u is not None else 0.0)
             lmis.append(cp.bmat([[top, Yb], [Yb.T, Tj]]))
         elif input_constraint == "peak":
-            for l in range(m):
-                top = float(umax[l] ** 2) + (s_u if s_u is not None else 0.0)
-                yl = cp.reshape(Yb[l, :], (1, n))
-                lmis.append(cp.bmat([[cp.reshape(top, (1, 1)), yl], [yl.T, Tj]]))
+            for k in range(m):
+                top = float(umax[k] ** 2) + (s_u if s_u is not None else 0.0)
+                yl = _r(Yb[k, :], (1, n))
+                lmis.append(cp.bmat([[_r(top, (1, 1)), yl], [yl.T, Tj]]))
         else:
             raise ValueError(input_constraint)
 
@@ -265,6 +274,8 @@ def reference_gamma(
         E = np.asarray(disturbance[0], float).reshape(n, -1)
         w_max = float(disturbance[1])
         lam = float(disturbance[2]) if len(disturbance) > 2 else 1.0
+        if at is not None and at.get("lam") is not None:
+            lam = float(at["lam"])
 
     if output_matrix is not None:
         C = np.atleast_2d(np.asarray(output_matrix, float))
@@ -276,11 +287,11 @@ def reference_gamma(
             top = float(ymax[r] ** 2) + (s_y if s_y is not None else 0.0)
             for i in range(N):
                 for Yk in Ys:
-                    row = cp.reshape(C[r] @ (A_list[i] @ G + B_list[i] @ Yk), (1, n))
-                    lmis.append(cp.bmat([[cp.reshape(top, (1, 1)), row], [row.T, T[i]]]))
+                    row = _r(C[r] @ (A_list[i] @ G + B_list[i] @ Yk), (1, n))
+                    lmis.append(cp.bmat([[_r(top, (1, 1)), row], [row.T, T[i]]]))
                 if free_moves == 1:
-                    yp = cp.reshape(C[r] @ (A_list[i] @ x + B_list[i] @ u0), (1, 1))
-                    lmis.append(cp.bmat([[cp.reshape(top, (1, 1)), yp], [yp, np.ones((1, 1))]]))
+                    yp = _r(C[r] @ (A_list[i] @ x + B_list[i] @ u0), (1, 1))
+                    lmis.append(cp.bmat([[_r(top, (1, 1)), yp], [yp, np.ones((1, 1))]]))
 
     if E is not None and w_max > 0.0:
         q = E.shape[1]
@@ -299,13 +310,34 @@ def reference_gamma(
     if s_y is not None:
         objective = objective + float(soft["y"]) * s_y
 
+    if at is not None:
+        # evaluate every LMI at given values (a numpy check of another solver's answer)
+        gamma.value = float(at["gamma"])
+        Y.value = np.asarray(at["Y"], float).reshape(m, n)
+        if lyapunov == "common":
+            Qs[0].value = _symmetrised(at["Q"])
+        else:
+            G.value = np.asarray(at["G"], float)
+            for Qj, val in zip(Qs, at["Q_vertices"], strict=True):
+                Qj.value = _symmetrised(val)
+        if Z is not None:
+            Z.value = np.asarray(at["Z"], float).reshape(m, n)
+        if u0 is not None:
+            u0.value = np.asarray(at["u0"], float).reshape(m)
+            s0.value = float(x @ Q1 @ x + u0.value @ R @ u0.value)
+            gamma.value = float(at["gamma"]) - float(s0.value)
+        for key, var in (("u", s_u), ("y", s_y)):
+            if var is not None:
+                var.value = float(at["slack"][key])
+        values = [np.asarray(M.value) for M in lmis]
+        return "evaluated", float(at["gamma"]), {
+            "lmis": values, "residual": min(relative_min_eig(M) for M in values),
+            "abs_min_eig": min(float(np.linalg.eigvalsh((M + M.T) / 2)[0]) for M in values),
+        }
+
     margin = None
     if level is None:
-        shifts = [0.0] * len(lmis) if relax is None else relax(lmis)
-        problem = cp.Problem(
-            cp.Minimize(objective),
-            [_sym(M) + shift * np.eye(M.shape[0]) >> 0 for M, shift in zip(lmis, shifts)],
-        )
+        problem = cp.Problem(cp.Minimize(objective), [_sym(M) >> 0 for M in lmis])
     else:
         margin = cp.Variable(name="margin")
         problem = cp.Problem(
@@ -344,73 +376,49 @@ def reference_gamma(
     return status, total, variables
 
 
-def reference_bracket(
-    *args: Any, rtol: float = 1e-7, max_steps: int = 60, **kwargs: Any
-) -> tuple[float, float]:
-    """A bracket ``(lo, hi)`` of the optimal objective of one form, by bisection on its level.
+def reference_upper(*args: Any, rtol: float = 1e-7, max_steps: int = 40, **kwargs: Any) -> float:
+    """The smallest level found at which the form has a strictly feasible point, checked in numpy.
 
-    ``hi`` is certified in numpy: at the returned point every LMI has a positive smallest
-    eigenvalue and the objective is ``<= hi``, so the optimum is ``<= hi`` whatever the solver's
-    accuracy. ``lo`` is a level at which Clarabel reports the largest margin negative (an
-    ``optimal`` answer of a well-posed, strictly feasible problem: every LMI can be violated by
-    a margin, so the maximal-margin problem has an interior); it rests on the solver's
-    optimality. Arguments as :func:`reference_gamma` (with ``lam`` given for a disturbance).
+    Bisection between Clarabel's minimum (not trusted: its point may violate the LMIs slightly)
+    and a level at which the maximal-margin problem returns a point where every LMI has a
+    positive smallest eigenvalue and the objective is below the level: the optimum is ``<=`` the
+    returned value whatever the solver's accuracy. Arguments as :func:`reference_gamma` (with
+    ``lam`` given for a disturbance).
     """
     status, g0, _ = reference_gamma(*args, **kwargs)
     if not np.isfinite(g0):
         raise RuntimeError(f"reference not solved: {status}")
 
-    def certified(level: float) -> bool | None:
+    def certified(level: float) -> bool:
         status, _, var = reference_gamma(*args, level=level, **kwargs)
-        if status not in ("optimal", "optimal_inaccurate"):
-            return None
-        if var["abs_min_eig"] > 0.0 and var["objective"] <= level:
-            return True
-        return False if status == "optimal" and var["margin"] < 0.0 else None
+        ok = status in ("optimal", "optimal_inaccurate")
+        return ok and var["abs_min_eig"] > 0.0 and var["objective"] <= level
 
-    hi = g0
-    for _ in range(40):
+    lo, hi = g0, g0
+    for _ in range(60):
         if certified(hi):
             break
-        hi *= 1.0 + 1e-3
+        hi += max(abs(hi), 1e-12) * 1e-4
     else:
-        raise RuntimeError("no certified upper level")
-    lo = g0
-    for _ in range(40):
-        if certified(lo) is False:
-            break
-        lo *= 1.0 - 1e-3
-    else:
-        raise RuntimeError("no lower level")
+        raise RuntimeError("no certified level")
     for _ in range(max_steps):
         if hi - lo <= rtol * abs(hi):
             break
         mid = 0.5 * (lo + hi)
-        verdict = certified(mid)
-        if verdict is True:
+        if certified(mid):
             hi = mid
-        elif verdict is False:
+        else:
             lo = mid
-        else:  # undecided: the level is within the solver's accuracy of the optimum
-            break
-    return lo, hi
+    return hi
 
 
-def reference_relaxed(*args: Any, tol: float, **kwargs: Any) -> float:
-    """The optimum with every LMI relaxed to ``min eig >= -tol * ||LMI||`` (norms at the optimum).
-
-    A certificate that accepts relative violations down to ``-tol`` accepts any point of this
-    relaxed set, so no certified answer lies below its optimum (the norms are taken at the
-    unrelaxed optimum and scaled up by 2, a margin for their change between the two points).
-    """
-    status, _, var = reference_gamma(*args, **kwargs)
-    if not var.get("lmis"):
-        raise RuntimeError(f"reference not solved: {status}")
-    norms = [max(1.0, float(np.linalg.norm(M, 2))) for M in var["lmis"]]
-    status, g, _ = reference_gamma(*args, relax=lambda lmis: [2.0 * tol * v for v in norms], **kwargs)
-    if status != "optimal":
-        raise RuntimeError(f"relaxed reference: {status}")
-    return g
+def solution_values(sol: Any) -> dict[str, Any]:
+    """The variables of an :class:`lmi.LMISolution` in the form ``reference_gamma(at=...)`` takes."""
+    G = sol.G if sol.G is not None else sol.Q
+    return {
+        "gamma": sol.gamma, "Y": sol.Y, "Q": sol.Q, "G": sol.G, "Q_vertices": sol.Q_vertices,
+        "Z": None if sol.H is None else sol.H @ G, "u0": sol.u0, "slack": sol.slack, "lam": sol.lam,
+    }
 
 
 def realised_cost(
@@ -422,7 +430,7 @@ def realised_cost(
     x = np.asarray(x0, float)
     total = 0.0
     u_peak = 0.0
-    for k, (A, B) in enumerate(zip(A_seq, B_seq)):
+    for k, (A, B) in enumerate(zip(A_seq, B_seq, strict=True)):
         u = np.atleast_1d(law(x, k))
         total += float(x @ Q1 @ x + u @ R @ u)
         u_peak = max(u_peak, float(np.max(np.abs(u))))
