@@ -328,7 +328,7 @@ def reference_gamma(
             gamma.value = float(at["gamma"]) - float(s0.value)
         for key, var in (("u", s_u), ("y", s_y)):
             if var is not None:
-                var.value = float(at["slack"][key])
+                var.value = max(0.0, float(at["slack"][key]))
         values = [np.asarray(M.value) for M in lmis]
         return "evaluated", float(at["gamma"]), {
             "lmis": values, "residual": min(relative_min_eig(M) for M in values),
@@ -395,10 +395,11 @@ def reference_upper(*args: Any, rtol: float = 1e-7, max_steps: int = 40, **kwarg
         return ok and var["abs_min_eig"] > 0.0 and var["objective"] <= level
 
     lo, hi = g0, g0
-    for _ in range(60):
+    for k in range(30):
         if certified(hi):
             break
-        hi += max(abs(hi), 1e-12) * 1e-4
+        lo = hi
+        hi = g0 + max(abs(g0), 1e-12) * 1e-6 * 2.0**k
     else:
         raise RuntimeError("no certified level")
     for _ in range(max_steps):
