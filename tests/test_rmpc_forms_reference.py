@@ -8,10 +8,11 @@ the LMIs of ``docs/rmpc_forms.rst``. Three checks per problem and form:
   as strict as the papers'. Measured worst relative smallest eigenvalue -4.9e-15 without soft
   bounds, -2.5e-9 with them (the toolkit's slacks come out at -5e-7 squared units, within its
   certificate tolerance, and the reference evaluates them clipped at 0); bound -1e-8;
-- where Clarabel's answer is not accurate, the toolkit's gamma is ``<=`` a level at which the reference has a strictly feasible point
-  checked in numpy (:func:`reference_forms.reference_upper`, bisected to 1e-6): so the toolkit's
-  LMIs are no stricter than the papers'. Measured on Kothare's example 2: the toolkit is below
-  that level by 7e-6 (common), 3.5e-5 (vertex) and 1.3e-4 (vertex_pairs); bound 1e-7 relative;
+- where Clarabel's answer is not accurate, the toolkit's gamma is ``<=`` a level at which the
+  reference has a strictly feasible point checked in numpy (:func:`reference_forms.reference_upper`,
+  bisected to 1e-6): so the toolkit's LMIs are no stricter than the papers'. Measured on
+  Kothare's example 2: the toolkit is below that level by 7e-6 (common), 3.5e-5 (vertex) and
+  1.3e-4 (vertex_pairs); bound 1e-7 relative;
 - where Clarabel's own answer is accurate (status optimal, its point violates its LMIs by no
   more than 1e-9 relative), the two gammas agree: measured at most 1.8e-6 relative over
   Kothare's example 1 and MUP's demo (most under 4e-7; 1e-9 on MUP's demo); bound 1e-5.
