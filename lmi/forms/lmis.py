@@ -156,10 +156,10 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
     def cost_block(a: np.ndarray, b: np.ndarray, t: AffineMatrix, qn: AffineMatrix,
                    ys: AffineMatrix) -> AffineMatrix:
         mid = g_var.lmul(a) + ys.lmul(b)
-        u_eye = AffineMatrix(np.kron(gamma.coef, np.eye(m)))
+        u_eye = prog.times(gamma, np.eye(m))
         if p == 0:  # Q1 = 0: no state cost rows
             return prog.bmat([[t, mid.T, ys.T.rmul(rh.T)], [mid, qn, None], [ys.lmul(rh), None, u_eye]])
-        g_eye = AffineMatrix(np.kron(gamma.coef, np.eye(p)))
+        g_eye = prog.times(gamma, np.eye(p))
         return prog.bmat([
             [t, mid.T, g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)],
             [mid, qn, None, None],
@@ -197,8 +197,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
         if shared:
             w_dt = prog.var(f"W{k}") * fd.dt
             cost_rows = [g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)] if p else [ys.T.rmul(rh.T)]
-            gam_blocks = ([AffineMatrix(np.kron(gamma.coef, np.eye(p)))] if p else []) + [
-                AffineMatrix(np.kron(gamma.coef, np.eye(m)))]
+            gam_blocks = ([prog.times(gamma, np.eye(p))] if p else []) + [prog.times(gamma, np.eye(m))]
             size = len(cost_rows)
             rows: list[list[AffineMatrix | None]] = [[w_dt, *cost_rows]]
             for r, (row, gam_eye) in enumerate(zip(cost_rows, gam_blocks, strict=True)):
@@ -261,10 +260,10 @@ def _with_slacks(prog: Program, block: AffineMatrix) -> AffineMatrix:
     rows: list[list[AffineMatrix | None]] = [[block] + [None] * len(slacks)]
     for k, slack in enumerate(slacks):
         rows.append([None] * (k + 1) + [slack] + [None] * (len(slacks) - k - 1))
-    rows[0][1] = AffineMatrix.zeros(block.shape[0], 1, prog.n_vars)
+    rows[0][1] = prog.zeros(block.shape[0], 1)
     for k in range(1, len(slacks)):
-        rows[k][0] = AffineMatrix.zeros(1, block.shape[1], prog.n_vars)
-    rows[-1][0] = AffineMatrix.zeros(1, block.shape[1], prog.n_vars)
+        rows[k][0] = prog.zeros(1, block.shape[1])
+    rows[-1][0] = prog.zeros(1, block.shape[1])
     return prog.bmat(rows)
 
 
@@ -309,11 +308,11 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
         t = top(j)
         if kind == "ellipsoid":
             square = _soft_square(prog, float(fd.u_max[0]), "s_u")
-            prog.add(f"input_{j}", prog.bmat([[AffineMatrix(np.kron(square.coef, np.eye(m))), bounded],
+            prog.add(f"input_{j}", prog.bmat([[prog.times(square, np.eye(m)), bounded],
                                                [bounded.T, t]]))
         elif kind == "peak":
             for ell in range(m):
-                row = AffineMatrix(bounded.coef[:, ell : ell + 1, :])
+                row = bounded.lmul(np.eye(m)[ell : ell + 1])
                 square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
                 prog.add(f"input_{ell}_{j}", prog.bmat([[square, row], [row.T, t]]))
     if opts.free_moves and kind is not None:
@@ -323,7 +322,7 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
             prog.add("input_u0", prog.bmat([[square, u0.T], [u0, prog.eye(m)]]))
         else:
             for ell in range(m):
-                comp = AffineMatrix(u0.coef[:, ell : ell + 1, :])
+                comp = u0.lmul(np.eye(m)[ell : ell + 1])
                 square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
                 prog.add(f"input_u0_{ell}", prog.bmat([[square, comp], [comp, prog.const(1.0)]]))
     if fd.C_out is None:

@@ -130,6 +130,13 @@ class Program:
     def eye(self, size: int, scale: float = 1.0) -> AffineMatrix:
         return self.const(scale * np.eye(size))
 
+    def zeros(self, rows: int, cols: int) -> AffineMatrix:
+        return AffineMatrix.zeros(rows, cols, self.n_vars)
+
+    def times(self, scalar: AffineMatrix, matrix: np.ndarray) -> AffineMatrix:
+        """A ``1 x 1`` expression times a constant matrix."""
+        return AffineMatrix(np.kron(scalar.coef, np.atleast_2d(matrix)))
+
     def bmat(self, rows: list[list[AffineMatrix | None]]) -> AffineMatrix:
         return AffineMatrix.bmat(rows, self.n_vars)
 
