@@ -251,7 +251,8 @@ class FormProblem:
 
         def value(lam: float) -> float:
             nonlocal total_time, total_its
-            sol = self._solve_at(x, scale, xs, us, ys, w_max, lam)
+            # the grid's solvers are kept (warm starts at the next state); the refinement's are not
+            sol = self._solve_at(x, scale, xs, us, ys, w_max, lam, keep=lam in LAMBDA_GRID)
             tried[lam] = sol
             total_time += sol.solve_time
             total_its += sol.iterations or 0
@@ -289,10 +290,10 @@ class FormProblem:
         return sol.gamma + sum(w * slack.get(key, 0.0) for key, w in (self.options.soft or {}).items())
 
     def _solve_at(self, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
-                  w_max: float, lam: float) -> LMISolution:
+                  w_max: float, lam: float, keep: bool = True) -> LMISolution:
         fd = self._form_data(xs, us, ys, w_max, lam)
         if self.backend == "ipm":
-            solved = self._solve_ipm(fd)
+            solved = self._solve_ipm(fd, keep)
             proved = solved.infeasibility is not None and solved.infeasibility.ok
             if solved.status != OPTIMAL and not proved and self._settings["fallback"]:
                 first = solved
@@ -302,13 +303,13 @@ class FormProblem:
         elif self.backend == "clarabel":
             solved = self._solve_clarabel(fd)
         else:
-            solved = self._solve_cvxpy(fd)
+            solved = self._solve_cvxpy(fd, keep)
         return self._finish(solved, x, scale, xs, us, ys, w_max, lam)
 
     def _symbolic(self, fd: FormData) -> Program:
         return write(Program(self.layout), self.options, fd)
 
-    def _solve_ipm(self, fd: FormData) -> _Solved:
+    def _solve_ipm(self, fd: FormData, keep: bool = True) -> _Solved:
         settings = {k: v for k, v in self._settings.items() if k not in ("fallback", "warm_start")}
         key = ("ipm", fd.lam)
         solver = self._solvers.get(key)
@@ -317,7 +318,8 @@ class FormProblem:
             if solver is None:
                 prog = self._symbolic(fd)
                 solver = BlockLMISolver(self._c, prog.solver_blocks(), **settings)
-                self._solvers[key] = solver
+                if keep:
+                    self._solvers[key] = solver
                 warm = False
             else:
                 consts = write(Program(self.layout, {}), self.options, fd).constants()
@@ -365,7 +367,7 @@ class FormProblem:
         z = None if status == INFEASIBLE else np.asarray(sol.x)
         return _Solved(status, raw, z, int(sol.iterations), time.perf_counter() - start)
 
-    def _solve_cvxpy(self, fd: FormData) -> _Solved:
+    def _solve_cvxpy(self, fd: FormData, keep: bool = True) -> _Solved:
         import cvxpy as cp
 
         key = ("cvxpy", fd.lam)
@@ -383,7 +385,8 @@ class FormProblem:
                 cons.append(0.5 * (expr + expr.T) >> 0)
                 params.append(const)
             built = (cp.Problem(cp.Minimize(self._c @ z), cons), z, params)
-            self._solvers[key] = built
+            if keep:
+                self._solvers[key] = built
         problem, z, params = built
         consts = write(Program(self.layout, {}), self.options, fd).constants()
         for param, const in zip(params, consts, strict=True):
