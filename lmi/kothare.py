@@ -55,6 +55,13 @@ class LMISolution:
         phase one found, checked on the conic data of the problem as solved (normalised state,
         balanced coordinates; see :mod:`lmi.infeasibility`). ``ok`` is always true here: an
         unchecked proof never makes a status ``"infeasible"``.
+    G, Q_vertices, u0, H, slack, lam
+        What the robust MPC forms of :mod:`lmi.forms` add (``None`` where the form has none):
+        the slack matrix ``G`` and the per-vertex ``Q_j`` of the vertex Lyapunov forms (then
+        ``F = Y G^-1`` and ``Q`` is an ellipsoid inside every ``{x' Q_j^-1 x <= 1}``), the free
+        first move ``u0``, the auxiliary gain ``H`` of the saturation-aware form, the soft
+        constraints' slacks ``{"u": s_u, "y": s_y}`` (squared units) and the disturbance
+        form's contraction factor ``lam``.
     """
 
     status: str
@@ -69,6 +76,12 @@ class LMISolution:
     backend: str
     x: np.ndarray = field(repr=False)
     infeasibility: InfeasibilityCertificate | None = field(default=None, repr=False)
+    G: np.ndarray | None = field(default=None, repr=False)
+    Q_vertices: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
+    u0: np.ndarray | None = field(default=None, repr=False)
+    H: np.ndarray | None = field(default=None, repr=False)
+    slack: dict[str, float] | None = field(default=None, repr=False)
+    lam: float | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

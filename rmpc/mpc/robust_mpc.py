@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from lmi import KothareProblem, LMISolution
+from lmi.forms import FormProblem, form_options
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
 from rmpc.mpc.fallback import CertifiedGain
@@ -53,7 +54,30 @@ class RMPC:
         Reference state; it must be an equilibrium of every vertex with zero input
         (``A_j x_ref = x_ref``). The controller regulates ``x - x_ref`` to zero.
     backend, solver, solver_options, formulation, certificate_tol
-        Passed to :class:`lmi.KothareProblem`.
+        Passed to :class:`lmi.KothareProblem` (with the default form) or
+        :class:`lmi.forms.FormProblem` (any other form: ``backend`` ``"ipm"``, ``"clarabel"`` or
+        ``"cvxpy"``, ``formulation`` and ``solver`` unused).
+    lyapunov : {"common", "vertex", "vertex_pairs"}
+        One quadratic Lyapunov function (Kothare), one ``Q_j`` per vertex with a slack ``G``
+        (uncertainty constant in time), or every vertex pair (uncertainty that may change at
+        every sample).
+    cost : {"worst_case", "nominal"}
+        The cost bound over every vertex, or on ``plant.nominal`` with robust invariance on
+        every vertex (``lyapunov="common"`` only).
+    free_moves : {0, 1}
+        With 1 the first move ``u(k)`` is a free variable (applied by :meth:`step`) and the
+        feedback law acts from ``k + 1`` on.
+    saturation : {None, "auxiliary"}
+        ``"auxiliary"``: the law ``sat(F x)`` (componentwise, ``input_constraint="peak"``) with an
+        auxiliary gain ``H`` that carries the bound; :meth:`step` applies the saturated input.
+    soft : dict, optional
+        ``{"u": w_u, "y": w_y}``: soft input and output bounds, their squared excess paid at
+        these weights.
+    disturbance : (E, w_max) or (E, w_max, lam), optional
+        ``x+ = A x + B u + E w`` with ``||w|| <= w_max``; the ellipsoid is kept invariant under
+        it (``lam``, the S-procedure's contraction factor, searched when not given).
+        The LMIs of every form and the combinations that exist: the page "The field's robust MPC
+        forms" of the docs (:mod:`lmi.forms`). The defaults give Kothare's problem.
     on_failure : {"fallback", "raise"}
         What to do when a solve gives no usable (certified) answer: keep the last certified
         gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`
@@ -118,16 +142,41 @@ class RMPC:
         on_failure: Literal["fallback", "raise"] = "fallback",
         hold_radius: float = 1e-9,
         resolve_threshold: float = 1.0,
+        lyapunov: Literal["common", "vertex", "vertex_pairs"] = "common",
+        cost: Literal["worst_case", "nominal"] = "worst_case",
+        free_moves: int = 0,
+        saturation: Literal["auxiliary"] | None = None,
+        soft: dict[str, float] | None = None,
+        disturbance: Any = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
         input_constraint = input_constraint_kind(input_constraint, u_max)
         self.plant = plant
-        self.problem = KothareProblem(
-            plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
-            output_matrix=output_matrix, y_max=y_max, backend=backend, solver=solver,
-            solver_options=solver_options, formulation=formulation, certificate_tol=certificate_tol,
+        self.form = form_options(
+            n_states=plant.n_states, input_constraint=input_constraint, has_output=output_matrix is not None,
+            lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
+            disturbance=disturbance,
         )
+        self.problem: KothareProblem | FormProblem
+        if self.form.is_kothare:
+            self.problem = KothareProblem(
+                plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
+                output_matrix=output_matrix, y_max=y_max, backend=backend, solver=solver,
+                solver_options=solver_options, formulation=formulation, certificate_tol=certificate_tol,
+            )
+        else:
+            if solver not in (None, "CLARABEL", "clarabel"):
+                raise InvalidArgumentError(
+                    "solver", "None (the forms solve with the ipm, Clarabel or cvxpy: see backend)",
+                    repr(solver),
+                )
+            self.problem = FormProblem(
+                plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
+                output_matrix=output_matrix, y_max=y_max, nominal=plant.nominal, lyapunov=lyapunov,
+                cost=cost, free_moves=free_moves, saturation=saturation, soft=soft, disturbance=disturbance,
+                backend=backend, solver_options=solver_options, certificate_tol=certificate_tol,
+            )
         self.certified = CertifiedGain("RMPC", on_failure, hold_radius)
         self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
         if self.resolve_threshold > 1.0:
@@ -206,7 +255,7 @@ class RMPC:
         kept = self.certified
         if kept.near_origin(z):
             u, self.last = kept.reuse(z, shape, "near origin")
-            return u
+            return self._saturate(u, bound)
         tighter = (
             bound is not None and kept.bound is not None
             and bool(np.any(bound < kept.bound * (1.0 - 1e-12)))
@@ -216,10 +265,19 @@ class RMPC:
             level = float(z @ q_inv @ z)
             if self.resolve_threshold < level <= 1.0:
                 u, self.last = kept.reuse(z, shape, "inside ellipsoid", level=level)
-                return u
+                return self._saturate(u, bound)
         sol = self.problem.solve(z, u_max=bound)
         u, self.last = kept.take(
             sol, z, shape, x=x, bound=self.problem.data.u_max if bound is None else bound,
             failure_extra={"inside_ellipsoid": kept.contains(z)},
         )
-        return u
+        if sol.u0 is not None and not self.last.fallback:
+            u = sol.u0.copy()  # the free first move
+        return self._saturate(u, bound)
+
+    def _saturate(self, u: np.ndarray, bound: np.ndarray | None) -> np.ndarray:
+        """The componentwise saturation of the auxiliary-gain form (other forms: ``u`` as it is)."""
+        if self.form.saturation != "auxiliary":
+            return u
+        limit = self.problem.data.u_max if bound is None else bound
+        return np.clip(u, -limit, limit)

@@ -1,0 +1,269 @@
+"""The LMIs of every robust MPC form, written once against a :class:`~lmi.forms.program.Program`.
+
+The statements are those of the page "The field's robust MPC forms" of the docs (the notation:
+``T_i = Q`` and ``G = Q`` for the common Lyapunov function, ``T_i = G + G' - Q_i`` for the vertex
+forms; ``Y_s = D_s Y + (I - D_s) Z`` with the auxiliary saturation). :func:`declare` lays out the
+variables of a form, :func:`write` adds its blocks. The same code gives the solver's data
+(symbolic program), the constants at a new state and the certificate (numeric programs).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from lmi.affine import AffineMatrix
+from lmi.forms.options import FormOptions
+from lmi.forms.program import Layout, Program
+
+__all__ = ["FormData", "declare", "objective", "pairs", "write"]
+
+
+@dataclass(frozen=True)
+class FormData:
+    """The numbers one solve's LMIs are written with (in the solver's coordinates).
+
+    ``x`` is the state, ``u_max``/``y_max`` the bounds (``(1,)`` ellipsoid or ``(m,)`` peak;
+    empty without), ``w_max`` the disturbance bound and ``lam`` its contraction factor (``1.0``
+    without a disturbance), all at the scale of ``x``.
+    """
+
+    A: np.ndarray  # (N, n, n)
+    B: np.ndarray  # (N, n, m)
+    A0: np.ndarray | None  # nominal model, cost="nominal"
+    B0: np.ndarray | None
+    Q1h: np.ndarray  # (p, n)
+    Rh: np.ndarray  # (m, m)
+    input_constraint: str | None
+    C_out: np.ndarray | None
+    E: np.ndarray | None
+    x: np.ndarray
+    u_max: np.ndarray
+    y_max: np.ndarray
+    w_max: float
+    lam: float
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[1]
+
+    @property
+    def m(self) -> int:
+        return self.B.shape[2]
+
+    @property
+    def n_vertices(self) -> int:
+        return self.A.shape[0]
+
+
+def pairs(opts: FormOptions, n_vertices: int) -> list[tuple[int, int]]:
+    """The ``(i, j)`` pairs of the cost and invariance LMIs: plant ``i`` now, ``Q_j`` next."""
+    if opts.lyapunov == "common":
+        return [(i, 0) for i in range(n_vertices)]
+    if opts.lyapunov == "vertex":
+        return [(i, i) for i in range(n_vertices)]
+    return list(itertools.product(range(n_vertices), repeat=2))
+
+
+def _lyapunov_names(opts: FormOptions, n_vertices: int) -> list[str]:
+    return ["Q"] if opts.lyapunov == "common" else [f"Q{j}" for j in range(n_vertices)]
+
+
+def declare(opts: FormOptions, fd: FormData) -> Layout:
+    """The variables of the form: ``gamma``, the ``Q``/``Q_j``, ``G``, ``Y``, ``Z``, ``u0``,
+    ``s0``, ``s_u``, ``s_y``."""
+    n, m = fd.n, fd.m
+    lay = Layout()
+    lay.full("gamma", 1, 1)
+    for name in _lyapunov_names(opts, fd.n_vertices):
+        lay.symmetric(name, n)
+    if opts.vertex_lyapunov:
+        lay.full("G", n, n)
+    lay.full("Y", m, n)
+    if opts.saturation == "auxiliary":
+        lay.full("Z", m, n)
+    if opts.free_moves:
+        lay.full("u0", m, 1)
+        lay.full("s0", 1, 1)
+    soft = opts.soft or {}
+    if "u" in soft:
+        lay.full("s_u", 1, 1)
+    if "y" in soft:
+        lay.full("s_y", 1, 1)
+    return lay
+
+
+def objective(opts: FormOptions, lay: Layout) -> np.ndarray:
+    """``c`` of ``min c'z``: ``gamma`` (+ ``s0``) + the soft constraints' penalties."""
+    c = np.zeros(lay.size)
+    c[lay.index("gamma")] = 1.0
+    if "s0" in lay:
+        c[lay.index("s0")] = 1.0
+    for key, weight in (opts.soft or {}).items():
+        c[lay.index(f"s_{key}")] = weight
+    return c
+
+
+def _signs(opts: FormOptions, m: int) -> list[np.ndarray | None]:
+    if opts.saturation != "auxiliary":
+        return [None]
+    return [np.array(bits, dtype=float) for bits in itertools.product((1.0, 0.0), repeat=m)]
+
+
+def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
+    """Add every block of the form to ``prog`` (names say which LMI and which vertex)."""
+    m, nv = fd.m, fd.n_vertices
+    lyap = [prog.var(name) for name in _lyapunov_names(opts, nv)]
+    common = opts.lyapunov == "common"
+    g_var = lyap[0] if common else prog.var("G")
+
+    def top(i: int) -> AffineMatrix:  # T_i
+        return lyap[0] if common else g_var + g_var.T - lyap[i]
+
+    def q_next(j: int) -> AffineMatrix:
+        return lyap[0] if common else lyap[j]
+
+    y_var = prog.var("Y")
+    z_var = prog.var("Z") if opts.saturation == "auxiliary" else None
+
+    def y_sign(sign: np.ndarray | None) -> AffineMatrix:
+        if sign is None:
+            return y_var
+        assert z_var is not None
+        return y_var.lmul(np.diag(sign)) + z_var.lmul(np.diag(1.0 - sign))
+
+    gamma = prog.var("gamma")
+    signs = _signs(opts, m)
+    q1h, rh = fd.Q1h, fd.Rh
+    p = q1h.shape[0]
+
+    def cost_block(a: np.ndarray, b: np.ndarray, t: AffineMatrix, qn: AffineMatrix,
+                   ys: AffineMatrix) -> AffineMatrix:
+        mid = g_var.lmul(a) + ys.lmul(b)
+        u_eye = AffineMatrix(np.kron(gamma.coef, np.eye(m)))
+        if p == 0:  # Q1 = 0: no state cost rows
+            return prog.bmat([[t, mid.T, ys.T.rmul(rh.T)], [mid, qn, None], [ys.lmul(rh), None, u_eye]])
+        g_eye = AffineMatrix(np.kron(gamma.coef, np.eye(p)))
+        return prog.bmat([
+            [t, mid.T, g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)],
+            [mid, qn, None, None],
+            [g_var.lmul(q1h), None, g_eye, None],
+            [ys.lmul(rh), None, None, u_eye],
+        ])
+
+    def invariance_block(a: np.ndarray, b: np.ndarray, t: AffineMatrix, qn: AffineMatrix,
+                         ys: AffineMatrix) -> AffineMatrix:
+        mid = g_var.lmul(a) + ys.lmul(b)
+        if fd.E is None or fd.w_max == 0.0:
+            return prog.bmat([[t, mid.T], [mid, qn]])
+        q = fd.E.shape[1]
+        we = prog.const(fd.w_max * fd.E)
+        return prog.bmat([
+            [t * fd.lam, None, mid.T],
+            [None, prog.eye(q, 1.0 - fd.lam), we.T],
+            [mid, we, qn],
+        ])
+
+    vertex_pairs = pairs(opts, nv)
+    disturbed = fd.E is not None and fd.w_max > 0.0
+    for k, sign in enumerate(signs):
+        tag = "" if sign is None else f"_s{k}"
+        ys = y_sign(sign)
+        if opts.cost == "worst_case":
+            for i, j in vertex_pairs:
+                prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys))
+        else:
+            assert fd.A0 is not None and fd.B0 is not None
+            prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys))
+        if disturbed or opts.cost == "nominal":
+            for i, j in vertex_pairs:
+                block = invariance_block(fd.A[i], fd.B[i], top(i), q_next(j), ys)
+                prog.add(f"invariance_{i}_{j}{tag}", block)
+    _state_blocks(prog, opts, fd, lyap, vertex_pairs)
+    _bound_blocks(prog, opts, fd, top, y_sign, signs, lyap)
+    _slack_signs(prog, fd)
+    return prog
+
+
+def _slack_signs(prog: Program, fd: FormData) -> None:
+    """``s >= 0``, certified relative to the squared bound the slack enlarges."""
+    for name, bounds in (("s_u", fd.u_max), ("s_y", fd.y_max)):
+        if name in prog.layout:
+            prog.add(f"{name}_nonnegative", prog.var(name), floor=float(np.max(bounds)) ** 2)
+
+
+def _soft_square(prog: Program, bound: float, name: str) -> AffineMatrix:
+    """``bound^2 (+ s_name)`` as a ``1 x 1`` affine matrix."""
+    square = prog.const(bound**2)
+    return square + prog.var(name) if name in prog.layout else square
+
+
+def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[AffineMatrix],
+                  vertex_pairs: list[tuple[int, int]]) -> None:
+    one = prog.const(1.0)
+    if not opts.free_moves:
+        xc = prog.const(fd.x[:, None])
+        for j, q in enumerate(lyap):
+            prog.add(f"state_{j}", prog.bmat([[one, xc.T], [xc, q]]))
+        return
+    u0 = prog.var("u0")
+    # every vertex's prediction x(k+1) = A_i x + B_i u0 inside the ellipsoid of Q_j
+    models = [
+        (f"{i}_{j}", fd.A[i], fd.B[i], lyap[0] if len(lyap) == 1 else lyap[j]) for i, j in vertex_pairs
+    ]
+    if opts.cost == "nominal":
+        assert fd.A0 is not None and fd.B0 is not None
+        models.append(("nominal", fd.A0, fd.B0, lyap[0]))
+    for tag, a, b, q in models:
+        pred = u0.lmul(b) + prog.const((a @ fd.x)[:, None])
+        prog.add(f"prediction_{tag}", prog.bmat([[one, pred.T], [pred, q]]))
+    stage = float(fd.x @ fd.Q1h.T @ fd.Q1h @ fd.x)
+    s0 = prog.var("s0") - prog.const(stage)
+    prog.add("stage_cost", prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]]))
+
+
+def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, signs,
+                  lyap: list[AffineMatrix]) -> None:
+    m = fd.m
+    kind = fd.input_constraint
+    bounded = prog.var("Z") if opts.saturation == "auxiliary" else prog.var("Y")
+    for j in range(len(lyap)):
+        t = top(j)
+        if kind == "ellipsoid":
+            square = _soft_square(prog, float(fd.u_max[0]), "s_u")
+            prog.add(f"input_{j}", prog.bmat([[AffineMatrix(np.kron(square.coef, np.eye(m))), bounded],
+                                               [bounded.T, t]]))
+        elif kind == "peak":
+            for ell in range(m):
+                row = AffineMatrix(bounded.coef[:, ell : ell + 1, :])
+                square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
+                prog.add(f"input_{ell}_{j}", prog.bmat([[square, row], [row.T, t]]))
+    if opts.free_moves and kind is not None:
+        u0 = prog.var("u0")
+        if kind == "ellipsoid":
+            square = _soft_square(prog, float(fd.u_max[0]), "s_u")
+            prog.add("input_u0", prog.bmat([[square, u0.T], [u0, prog.eye(m)]]))
+        else:
+            for ell in range(m):
+                comp = AffineMatrix(u0.coef[:, ell : ell + 1, :])
+                square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
+                prog.add(f"input_u0_{ell}", prog.bmat([[square, comp], [comp, prog.const(1.0)]]))
+    if fd.C_out is None:
+        return
+    g_var = lyap[0] if opts.lyapunov == "common" else prog.var("G")
+    for r, c_row in enumerate(fd.C_out):
+        square_bound = float(fd.y_max[r])
+        for i in range(fd.n_vertices):
+            for k, sign in enumerate(signs):
+                tag = "" if sign is None else f"_s{k}"
+                ys = y_sign(sign)
+                out = (g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])).lmul(c_row[None, :])
+                square = _soft_square(prog, square_bound, "s_y")
+                prog.add(f"output_{r}_{i}{tag}", prog.bmat([[square, out], [out.T, top(i)]]))
+            if opts.free_moves:
+                u0 = prog.var("u0")
+                pred = (u0.lmul(fd.B[i]) + prog.const((fd.A[i] @ fd.x)[:, None])).lmul(c_row[None, :])
+                square = _soft_square(prog, square_bound, "s_y")
+                prog.add(f"output_{r}_{i}_u0", prog.bmat([[square, pred], [pred.T, prog.const(1.0)]]))

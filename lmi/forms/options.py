@@ -1,0 +1,182 @@
+"""The options that select a robust MPC form, validated once, and the combinations that exist.
+
+Each option is one idea of the field (see the page "The field's robust MPC forms" of the docs):
+the Lyapunov function (``lyapunov``), what the cost bound is taken on (``cost``), a free first move
+(``free_moves``), saturation-aware gains (``saturation``), soft bounds (``soft``) and a bounded
+disturbance (``disturbance``). :func:`form_options` checks each value and each combination and
+names the arguments of an error.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+
+__all__ = ["COSTS", "LYAPUNOV_FORMS", "SATURATIONS", "Disturbance", "FormOptions", "form_options"]
+
+#: ``"common"``: one quadratic Lyapunov function (Kothare 1996); ``"vertex"``: one ``Q_j`` per
+#: vertex and a slack ``G`` (uncertainty constant in time); ``"vertex_pairs"``: every vertex pair
+#: (uncertainty that may change at every sample).
+LYAPUNOV_FORMS: tuple[str, ...] = ("common", "vertex", "vertex_pairs")
+#: The cost bound over every vertex, or on the nominal model with robust invariance.
+COSTS: tuple[str, ...] = ("worst_case", "nominal")
+#: ``None`` (the law ``F x`` meets the bound) or ``"auxiliary"`` (``sat(F x)`` with an auxiliary gain).
+SATURATIONS: tuple[str | None, ...] = (None, "auxiliary")
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """``x+ = A x + B u + E w`` with ``||w|| <= w_max``; ``lam`` the S-procedure's contraction
+    factor in ``(0, 1)``, or ``None`` to search it."""
+
+    E: np.ndarray
+    w_max: float
+    lam: float | None = None
+
+
+@dataclass(frozen=True)
+class FormOptions:
+    """A validated choice of form (see :func:`form_options`)."""
+
+    lyapunov: Literal["common", "vertex", "vertex_pairs"] = "common"
+    cost: Literal["worst_case", "nominal"] = "worst_case"
+    free_moves: int = 0
+    saturation: Literal["auxiliary"] | None = None
+    soft: Mapping[str, float] | None = None
+    disturbance: Disturbance | None = None
+
+    @property
+    def is_kothare(self) -> bool:
+        """Whether these are Kothare's LMIs (the defaults; a zero disturbance counts as none)."""
+        return (
+            self.lyapunov == "common" and self.cost == "worst_case" and self.free_moves == 0
+            and self.saturation is None and self.soft is None
+            and (self.disturbance is None or self.disturbance.w_max == 0.0)
+        )
+
+    @property
+    def vertex_lyapunov(self) -> bool:
+        """One ``Q_j`` per vertex and a slack ``G``."""
+        return self.lyapunov != "common"
+
+
+def _choice(value: Any, allowed: tuple, name: str) -> Any:
+    if not any(value is a or (isinstance(value, str) and value == a) for a in allowed):
+        raise InvalidArgumentError(name, "one of " + ", ".join(repr(a) for a in allowed), repr(value))
+    return value
+
+
+def _soft(soft: Any, has_input: bool, has_output: bool) -> dict[str, float] | None:
+    if soft is None:
+        return None
+    if not isinstance(soft, Mapping):
+        raise ArgumentTypeError("soft", 'None or a dict of weights {"u": w_u, "y": w_y}', type(soft).__name__)
+    unknown = sorted(str(k) for k in soft if k not in ("u", "y"))
+    if unknown:
+        raise InvalidArgumentError("soft", 'weights for "u" and/or "y"', f"unknown keys {unknown}")
+    if not soft:
+        raise InvalidArgumentError("soft", 'at least one weight ("u" or "y")', "an empty dict")
+    out: dict[str, float] = {}
+    for key, weight in soft.items():
+        if isinstance(weight, bool) or not isinstance(weight, int | float | np.floating | np.integer):
+            raise ArgumentTypeError(f"soft[{key!r}]", "a number > 0", type(weight).__name__)
+        if not (np.isfinite(weight) and weight > 0.0):
+            raise InvalidArgumentError(f"soft[{key!r}]", "a finite weight > 0", repr(weight))
+        if key == "u" and not has_input:
+            expected = 'no "u" weight without an input bound (u_max)'
+            raise InvalidArgumentError("soft", expected, repr(dict(soft)))
+        if key == "y" and not has_output:
+            raise InvalidArgumentError(
+                "soft", 'no "y" weight without output bounds (output_matrix, y_max)', repr(dict(soft))
+            )
+        out[key] = float(weight)
+    return out
+
+
+def _disturbance(disturbance: Any, n: int) -> Disturbance | None:
+    if disturbance is None:
+        return None
+    if isinstance(disturbance, Disturbance):
+        disturbance = (disturbance.E, disturbance.w_max, disturbance.lam)
+    if not isinstance(disturbance, tuple | list) or len(disturbance) not in (2, 3):
+        expected = "None, (E, w_max) or (E, w_max, lam)"
+        raise ArgumentTypeError("disturbance", expected, type(disturbance).__name__)
+    try:
+        e_mat = np.asarray(disturbance[0], dtype=float)
+    except (TypeError, ValueError) as err:
+        raise InvalidArgumentError("disturbance E", "a numeric (n, q) matrix", repr(disturbance[0])) from err
+    if e_mat.ndim == 1:
+        e_mat = e_mat[:, None]
+    if e_mat.ndim != 2 or e_mat.shape[0] != n or e_mat.shape[1] < 1:
+        expected = f"an ({n}, q) matrix (n = {n} states)"
+        raise InvalidArgumentError("disturbance E", expected, f"shape {e_mat.shape}")
+    if not np.all(np.isfinite(e_mat)):
+        raise InvalidArgumentError("disturbance E", "finite values", "NaN or inf")
+    w_max = disturbance[1]
+    if isinstance(w_max, bool) or not isinstance(w_max, int | float | np.floating | np.integer):
+        raise ArgumentTypeError("disturbance w_max", "a number >= 0", type(w_max).__name__)
+    if not (np.isfinite(w_max) and w_max >= 0.0):
+        raise InvalidArgumentError("disturbance w_max", "a finite bound >= 0", repr(w_max))
+    lam = disturbance[2] if len(disturbance) == 3 else None
+    if lam is not None:
+        if isinstance(lam, bool) or not isinstance(lam, int | float | np.floating | np.integer):
+            raise ArgumentTypeError("disturbance lam", "None or a number in (0, 1)", type(lam).__name__)
+        if not 0.0 < lam < 1.0:
+            raise InvalidArgumentError("disturbance lam", "a contraction factor in (0, 1)", repr(lam))
+        lam = float(lam)
+    e_mat.setflags(write=False)
+    return Disturbance(e_mat, float(w_max), lam)
+
+
+def form_options(
+    *,
+    n_states: int,
+    input_constraint: str | None,
+    has_output: bool,
+    lyapunov: Any = "common",
+    cost: Any = "worst_case",
+    free_moves: Any = 0,
+    saturation: Any = None,
+    soft: Any = None,
+    disturbance: Any = None,
+) -> FormOptions:
+    """Check every option and every combination; return the :class:`FormOptions`.
+
+    Raises
+    ------
+    InvalidArgumentError, ArgumentTypeError
+        Naming the option (and, for a combination that does not exist, both options).
+    """
+    _choice(lyapunov, LYAPUNOV_FORMS, "lyapunov")
+    _choice(cost, COSTS, "cost")
+    if isinstance(free_moves, bool) or free_moves not in (0, 1):
+        raise InvalidArgumentError("free_moves", "0 or 1", repr(free_moves))
+    _choice(saturation, SATURATIONS, "saturation")
+    soft_weights = _soft(soft, input_constraint is not None, has_output)
+    dist = _disturbance(disturbance, n_states)
+    if cost == "nominal" and lyapunov != "common":
+        raise InvalidArgumentError(
+            "cost, lyapunov",
+            "cost='nominal' with lyapunov='common' (the nominal model has no Q_j of its own)",
+            f"cost={cost!r}, lyapunov={lyapunov!r}",
+        )
+    if saturation == "auxiliary" and input_constraint != "peak":
+        raise InvalidArgumentError(
+            "saturation, input_constraint",
+            "saturation='auxiliary' with input_constraint='peak' (the saturation is componentwise)",
+            f"input_constraint={input_constraint!r}",
+        )
+    if free_moves == 1 and dist is not None and dist.w_max > 0.0:
+        raise InvalidArgumentError(
+            "free_moves, disturbance",
+            "free_moves=0 with a disturbance (the free move's prediction has no disturbance bound)",
+            f"free_moves=1, w_max={dist.w_max!r}",
+        )
+    return FormOptions(
+        str(lyapunov), str(cost), int(free_moves), saturation, soft_weights, dist,  # type: ignore[arg-type]
+    )

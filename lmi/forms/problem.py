@@ -1,0 +1,451 @@
+"""A robust MPC form built once over a polytope and solved per state, certified like Kothare's.
+
+:class:`FormProblem` takes the options of :mod:`lmi.forms.options`, lays out the variables and
+writes the LMIs of :mod:`lmi.forms.lmis`, and solves them at each state with the toolkit's
+interior-point method (:class:`lmi.BlockLMISolver`, warm-started from the previous solve, only the
+blocks' constants rewritten per state), with Clarabel as fallback; ``backend="clarabel"`` and
+``backend="cvxpy"`` solve the same LMIs with Clarabel's own API or through cvxpy. As in
+:class:`lmi.KothareProblem` the problem is solved at ``x / ||x||`` (every LMI is homogeneous of
+degree two in the state once the bounds are divided by ``||x||``) and in the diagonal state
+coordinates of :func:`lmi.scaling.state_scaling`; the answer is mapped back and certified in the
+original coordinates: every block recomputed in numpy at the returned matrices.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy import sparse
+
+from lmi.certificate import Certificate
+from lmi.data import InputConstraint, KothareData, build_kothare_data
+from lmi.forms.lmis import FormData, declare, objective, write
+from lmi.forms.options import FormOptions, form_options
+from lmi.forms.program import Layout, Program
+from lmi.ipm import BlockLMISolver
+from lmi.kothare import KothareProblem, LMISolution
+from lmi.scaling import state_scaling
+from lmi.status import CLARABEL_STATUS_MAP, CVXPY_STATUS_MAP, INFEASIBLE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
+from lmi.threads import SingleThreadBlas
+from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_matrix, as_vector, check_positive
+
+__all__ = ["LAMBDA_GRID", "FormProblem"]
+
+#: The contraction factors tried first when the disturbance form searches ``lam``; the best is
+#: then refined by :data:`LAMBDA_REFINE` golden-section steps inside its neighbours' interval.
+LAMBDA_GRID: tuple[float, ...] = (0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.85, 0.93, 0.98)
+LAMBDA_REFINE = 8
+
+_BACKENDS = ("ipm", "clarabel", "cvxpy")
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+class _Solved:
+    """One solver's answer in the solver's coordinates (``z``), or none."""
+
+    def __init__(self, status: str, solver_status: str, z: np.ndarray | None, iterations: int | None,
+                 solve_time: float) -> None:
+        self.status, self.solver_status, self.z = status, solver_status, z
+        self.iterations, self.solve_time = iterations, solve_time
+
+
+class FormProblem:
+    """One robust MPC form over a polytope ``Co{[A_j B_j]}``: ``min`` its cost bound at a state.
+
+    Parameters
+    ----------
+    A, B, Q, R, dt, input_constraint, u_max, output_matrix, y_max
+        As for :class:`lmi.KothareProblem` (checked the same way).
+    nominal : (A0, B0), optional
+        The nominal model, needed by ``cost="nominal"``.
+    lyapunov, cost, free_moves, saturation, soft, disturbance
+        The form (:func:`lmi.forms.options.form_options`; the LMIs: the page "The field's robust
+        MPC forms" of the docs).
+    backend : {"ipm", "clarabel", "cvxpy"}
+        The toolkit's interior-point method (default; Clarabel when it fails, option
+        ``fallback``), Clarabel's own API, or cvxpy with Clarabel (the same LMIs, the reference).
+    solver_options : dict, optional
+        For ``"ipm"``: ``fallback`` (bool, default true), ``warm_start`` (bool, default true),
+        ``state_scaling`` (bool, default true) and :class:`lmi.BlockLMISolver`'s settings
+        (``tol_feas``, ``max_iter``, ...). For ``"clarabel"``/``"cvxpy"``: Clarabel's settings.
+    certificate_tol : float
+        A solve is ``"optimal"`` only if every recomputed block's relative margin is ``>= -tol``.
+
+    Examples
+    --------
+    Kothare's example 2 (two masses and a spring whose constant lies in [0.5, 10]) with one
+    Lyapunov matrix per vertex:
+
+    >>> import numpy as np
+    >>> from lmi.forms import FormProblem
+    >>> def plant(k):
+    ...     return [[1, 0, .1, 0], [0, 1, 0, .1], [-.1 * k, .1 * k, 1, 0], [.1 * k, -.1 * k, 0, 1]]
+    >>> prob = FormProblem([plant(0.5), plant(10.0)], [[[0], [0], [.1], [0]]] * 2, Q=np.eye(4),
+    ...                    R=[[1.0]], u_max=1.0, lyapunov="vertex")
+    >>> sol = prob.solve([1.0, 1.0, 0.0, 0.0])
+    >>> sol.status, round(sol.gamma, 2), len(sol.Q_vertices)
+    ('optimal', 200.36, 2)
+    """
+
+    def __init__(
+        self,
+        A: ArrayLike,
+        B: ArrayLike,
+        Q: ArrayLike,
+        R: ArrayLike,
+        *,
+        dt: float = 1.0,
+        input_constraint: InputConstraint = "ellipsoid",
+        u_max: ArrayLike | None = None,
+        output_matrix: ArrayLike | None = None,
+        y_max: ArrayLike | None = None,
+        nominal: tuple[ArrayLike, ArrayLike] | None = None,
+        lyapunov: str = "common",
+        cost: str = "worst_case",
+        free_moves: int = 0,
+        saturation: str | None = None,
+        soft: dict[str, float] | None = None,
+        disturbance: Any = None,
+        backend: str = "ipm",
+        solver_options: dict[str, Any] | None = None,
+        certificate_tol: float = 1e-7,
+    ) -> None:
+        self.data: KothareData = build_kothare_data(
+            A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
+            output_matrix=output_matrix, y_max=y_max, formulation="standard",
+        )
+        data = self.data
+        self.options: FormOptions = form_options(
+            n_states=data.n, input_constraint=data.input_constraint, has_output=data.C_out is not None,
+            lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
+            disturbance=disturbance,
+        )
+        if backend not in _BACKENDS:
+            raise InvalidArgumentError("backend", "'ipm', 'clarabel' or 'cvxpy'", repr(backend))
+        self.backend = backend
+        self.certificate_tol = check_positive(certificate_tol, "certificate_tol")
+        self._nominal = self._check_nominal(nominal)
+        self._settings = self._check_settings(solver_options)
+        dist = self.options.disturbance
+        self._E = None if dist is None else dist.E
+        if self._E is not None and data.C_out is not None:
+            tight = data.y_max - np.linalg.norm(data.C_out @ self._E, axis=1) * dist.w_max
+            if np.any(tight <= 0.0):
+                raise InvalidArgumentError(
+                    "disturbance, y_max",
+                    "output bounds larger than the disturbance's own reach ||c_r E|| w_max",
+                    f"y_max - ||C E|| w_max = {tight.tolist()}",
+                )
+        use_scaling = self._settings.pop("state_scaling", True) if backend == "ipm" else False
+        self._t = state_scaling(data) if use_scaling else np.ones(data.n)
+        template = self._form_data(np.ones(data.n), data.u_max, data.y_max, 0.0, 1.0)
+        self.layout: Layout = declare(self.options, template)
+        self._c = objective(self.options, self.layout)
+        self._solvers: dict[float, Any] = {}
+        self._blas = SingleThreadBlas()
+
+    # -- checks ----------------------------------------------------------------------------
+    def _check_nominal(self, nominal: Any) -> tuple[np.ndarray, np.ndarray] | None:
+        n, m = self.data.n, self.data.m
+        if nominal is None:
+            if self.options.cost == "nominal":
+                expected = "the nominal model (A0, B0) with cost='nominal'"
+                raise InvalidArgumentError("nominal", expected, "None")
+            return None
+        if not isinstance(nominal, tuple | list) or len(nominal) != 2:
+            raise InvalidArgumentError("nominal", "an (A0, B0) pair", type(nominal).__name__)
+        return as_matrix(nominal[0], "nominal A", (n, n)), as_matrix(nominal[1], "nominal B", (n, m))
+
+    def _check_settings(self, options: dict[str, Any] | None) -> dict[str, Any]:
+        if options is not None and not isinstance(options, dict):
+            raise InvalidArgumentError("solver_options", "a dict of solver settings", type(options).__name__)
+        opts = dict(options or {})
+        if self.backend == "ipm":
+            known = {"fallback", "warm_start", "state_scaling", "tol_feas", "tol_gap_abs", "tol_gap_rel",
+                     "max_iter", "warm_max_iter", "warm_gap", "warm_feas", "infeasibility_radius"}
+            unknown = sorted(set(opts) - known)
+            if unknown:
+                raise InvalidArgumentError("solver_options", f"settings among {sorted(known)}",
+                                           f"unknown setting(s) {unknown}")
+            merged: dict[str, Any] = {"fallback": True, "warm_start": True, "state_scaling": True,
+                                      "tol_gap_abs": 1e-12, "max_iter": 100}
+            merged.update(opts)
+            return merged
+        from lmi.backends.clarabel import clarabel_settings
+
+        clarabel_settings(opts)  # unknown names raise here
+        return opts
+
+    # -- the data of one solve ----------------------------------------------------------------
+    def _form_data(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray, w_max: float, lam: float,
+                   t: np.ndarray | None = None) -> FormData:
+        """The LMIs' numbers in the coordinates ``x = T x~`` (``T = diag(t)``)."""
+        data = self.data
+        t = self._t if t is None else t
+        ti = 1.0 / t
+        a = ti[None, :, None] * data.A * t[None, None, :]
+        b = ti[None, :, None] * data.B
+        a0 = b0 = None
+        if self._nominal is not None:
+            a0 = ti[:, None] * self._nominal[0] * t[None, :]
+            b0 = ti[:, None] * self._nominal[1]
+        y_tight = y_max
+        if self._E is not None and data.C_out is not None:
+            y_tight = y_max - np.linalg.norm(data.C_out @ self._E, axis=1) * w_max
+        return FormData(
+            A=a, B=b, A0=a0, B0=b0, Q1h=data.Q1h * t[None, :], Rh=data.Rh,
+            input_constraint=data.input_constraint,
+            C_out=None if data.C_out is None else data.C_out * t[None, :],
+            E=None if self._E is None else ti[:, None] * self._E,
+            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam,
+        )
+
+    # -- solve ---------------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Forget the solvers built so far (their warm starts): the next solve starts afresh."""
+        self._solvers.clear()
+
+    def solve(self, x: ArrayLike, u_max: ArrayLike | None = None) -> LMISolution:
+        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised."""
+        x = as_vector(x, "x", self.data.n)
+        scale = float(np.linalg.norm(x))
+        if scale == 0.0:
+            expected = "a non-zero state (the problem is degenerate at the origin)"
+            raise InvalidArgumentError("x", expected, "x = 0")
+        bound = self.data.u_max if u_max is None else self.input_bound(u_max)
+        xs, us, ys = x / scale, bound / scale, self.data.y_max / scale
+        dist = self.options.disturbance
+        w_max = 0.0 if dist is None else dist.w_max / scale
+        if w_max > 0.0 and dist is not None and dist.lam is None:
+            return self._search_lambda(x, scale, xs, us, ys, w_max)
+        lam = 1.0 if w_max == 0.0 or dist is None or dist.lam is None else dist.lam
+        return self._solve_at(x, scale, xs, us, ys, w_max, lam)
+
+    def input_bound(self, u_max: ArrayLike) -> np.ndarray:
+        """``u_max`` checked as an input bound of this problem's kind (as
+        :meth:`lmi.KothareProblem.input_bound`)."""
+        return KothareProblem.input_bound(self, u_max)  # type: ignore[arg-type]
+
+    def _search_lambda(self, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
+                       w_max: float) -> LMISolution:
+        """The contraction factor with the smallest certified bound: a grid, then golden section."""
+        tried: dict[float, LMISolution] = {}
+        total_time, total_its = 0.0, 0
+
+        def value(lam: float) -> float:
+            nonlocal total_time, total_its
+            sol = self._solve_at(x, scale, xs, us, ys, w_max, lam)
+            tried[lam] = sol
+            total_time += sol.solve_time
+            total_its += sol.iterations or 0
+            return self._objective(sol) if sol.ok else math.inf
+
+        grid = [value(lam) for lam in LAMBDA_GRID]
+        best = int(np.argmin(grid))
+        if np.isfinite(grid[best]):
+            lo = LAMBDA_GRID[best - 1] if best > 0 else 0.5 * LAMBDA_GRID[0]
+            hi = LAMBDA_GRID[best + 1] if best + 1 < len(LAMBDA_GRID) else 0.5 * (1.0 + LAMBDA_GRID[-1])
+            c = hi - _GOLDEN * (hi - lo)
+            d = lo + _GOLDEN * (hi - lo)
+            fc, fd = value(c), value(d)
+            for _ in range(LAMBDA_REFINE - 2):
+                if fc < fd:
+                    hi, d, fd = d, c, fc
+                    c = hi - _GOLDEN * (hi - lo)
+                    fc = value(c)
+                else:
+                    lo, c, fc = c, d, fd
+                    d = lo + _GOLDEN * (hi - lo)
+                    fd = value(d)
+        certified = [s for s in tried.values() if s.ok]
+        pick = min(certified, key=self._objective) if certified else tried[LAMBDA_GRID[best]]
+        import dataclasses
+
+        return dataclasses.replace(pick, solve_time=total_time, iterations=total_its)
+
+    def _objective(self, sol: LMISolution) -> float:
+        """The minimised objective: the cost bound plus the soft constraints' penalties."""
+        slack = sol.slack or {}
+        return sol.gamma + sum(w * slack.get(key, 0.0) for key, w in (self.options.soft or {}).items())
+
+    def _solve_at(self, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
+                  w_max: float, lam: float) -> LMISolution:
+        fd = self._form_data(xs, us, ys, w_max, lam)
+        if self.backend == "ipm":
+            solved = self._solve_ipm(fd)
+            if solved.status != OPTIMAL and self._settings["fallback"]:
+                first = solved
+                solved = self._solve_clarabel(fd)
+                solved.solve_time += first.solve_time
+                solved.solver_status = f"ipm:{first.solver_status}; clarabel:{solved.solver_status}"
+        elif self.backend == "clarabel":
+            solved = self._solve_clarabel(fd)
+        else:
+            solved = self._solve_cvxpy(fd)
+        return self._finish(solved, x, scale, xs, us, ys, w_max, lam)
+
+    def _symbolic(self, fd: FormData) -> Program:
+        return write(Program(self.layout), self.options, fd)
+
+    def _solve_ipm(self, fd: FormData) -> _Solved:
+        settings = {k: v for k, v in self._settings.items() if k not in ("fallback", "warm_start")}
+        key = ("ipm", fd.lam)
+        solver = self._solvers.get(key)
+        start = time.perf_counter()
+        try:
+            if solver is None:
+                prog = self._symbolic(fd)
+                solver = BlockLMISolver(self._c, prog.solver_blocks(), **settings)
+                self._solvers[key] = solver
+                warm = False
+            else:
+                consts = write(Program(self.layout, {}), self.options, fd).constants()
+                for j, const in enumerate(consts):
+                    solver.set_block(j, const)
+                warm = bool(self._settings["warm_start"])
+            res = solver.solve(warm_start=warm)
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
+            return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
+        return _Solved(res.status, res.solver_status or res.status, res.x, res.iterations, res.solve_time)
+
+    def _clarabel_data(self, fd: FormData) -> tuple[np.ndarray, np.ndarray, list[int]]:
+        return self._symbolic(fd).conic_rows()
+
+    def _solve_clarabel(self, fd: FormData) -> _Solved:
+        import clarabel
+
+        from lmi.backends.clarabel import clarabel_settings
+
+        a_rows, b, orders = self._clarabel_data(fd)
+        n = self.layout.size
+        settings = clarabel_settings(self._settings if self.backend != "ipm" else None)
+        start = time.perf_counter()
+        try:
+            with self._blas.limit():
+                solver = clarabel.DefaultSolver(
+                    sparse.csc_matrix((n, n)), self._c, sparse.csc_matrix(a_rows), b,
+                    [clarabel.PSDTriangleConeT(k) for k in orders], settings,
+                )
+                sol = solver.solve()
+        except BaseException as err:  # Clarabel raises its own panics as BaseException
+            if isinstance(err, KeyboardInterrupt):
+                raise
+            return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
+        raw = str(sol.status)
+        status = CLARABEL_STATUS_MAP.get(raw, SOLVER_ERROR)
+        z = None if status == INFEASIBLE else np.asarray(sol.x)
+        return _Solved(status, raw, z, int(sol.iterations), time.perf_counter() - start)
+
+    def _solve_cvxpy(self, fd: FormData) -> _Solved:
+        import cvxpy as cp
+
+        key = ("cvxpy", fd.lam)
+        built = self._solvers.get(key)
+        if built is None:
+            prog = self._symbolic(fd)
+            z = cp.Variable(self.layout.size)
+            params, cons = [], []
+            for block in prog.blocks.values():
+                coef = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+                k = coef.shape[1]
+                const = cp.Parameter((k, k), symmetric=True)
+                lin = coef[1:].reshape(self.layout.size, k * k).T @ z
+                expr = const + cp.reshape(lin, (k, k), order="C")
+                cons.append(0.5 * (expr + expr.T) >> 0)
+                params.append(const)
+            built = (cp.Problem(cp.Minimize(self._c @ z), cons), z, params)
+            self._solvers[key] = built
+        problem, z, params = built
+        consts = write(Program(self.layout, {}), self.options, fd).constants()
+        for param, const in zip(params, consts, strict=True):
+            param.value = const
+        start = time.perf_counter()
+        try:
+            with self._blas.limit():
+                problem.solve(solver="CLARABEL", **self._settings)
+        except Exception as err:  # cvxpy.error.SolverError and the solver's own errors
+            return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
+        elapsed = time.perf_counter() - start
+        status = CVXPY_STATUS_MAP.get(str(problem.status), SOLVER_ERROR)
+        zval = None if z.value is None else np.asarray(z.value, dtype=float)
+        stats = problem.solver_stats
+        its = None if stats is None or stats.num_iters is None else int(stats.num_iters)
+        return _Solved(status, str(problem.status), zval, its, elapsed)
+
+    # -- the answer ------------------------------------------------------------------------------
+    def _finish(self, solved: _Solved, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray,
+                ys: np.ndarray, w_max: float, lam: float) -> LMISolution:
+        backend = self.backend if self.backend != "cvxpy" else "cvxpy:CLARABEL"
+        if solved.z is None or not np.all(np.isfinite(solved.z)):
+            return LMISolution(solved.status, np.nan, None, None, None, solved.solve_time, solved.iterations,
+                               solved.solver_status, None, backend, x)
+        values = self._original(self.layout.values(solved.z))
+        # the certificate: every block recomputed at the answer, original coordinates, x / ||x||
+        check = write(Program(self.layout, values), self.options,
+                      self._form_data(xs, us, ys, w_max, lam, t=np.ones(self.data.n)))
+        margins = check.margins()
+        opts = self.options
+        g_mat = values["G"] if opts.vertex_lyapunov else values["Q"]
+        try:
+            g_inv = np.linalg.inv(g_mat)
+        except np.linalg.LinAlgError:
+            g_inv = None
+            margins["G_invertible"] = -np.inf
+        cert = Certificate(margins, self.certificate_tol)
+        s2 = scale**2
+        f_mat = None if g_inv is None else values["Y"] @ g_inv
+        h_mat = None if g_inv is None or "Z" not in values else values["Z"] @ g_inv
+        q_vertices = None
+        if opts.vertex_lyapunov:
+            q_vertices = tuple(s2 * values[f"Q{j}"] for j in range(self.data.n_vertices))
+            q_mat = _inner_ellipsoid(q_vertices)
+        else:
+            q_mat = s2 * values["Q"]
+        gamma = float(values["gamma"][0, 0]) + (float(values["s0"][0, 0]) if "s0" in values else 0.0)
+        slack = None
+        if opts.soft is not None:
+            slack = {key: s2 * float(values[f"s_{key}"][0, 0]) for key in opts.soft}
+        status = solved.status
+        finite = f_mat is not None and np.all(np.isfinite(f_mat)) and q_mat is not None
+        if status == OPTIMAL and not (cert.ok and finite):
+            status = UNCERTIFIED
+        dist = opts.disturbance
+        return LMISolution(
+            status, s2 * gamma, q_mat, s2 * values["Y"], f_mat, solved.solve_time, solved.iterations,
+            solved.solver_status, cert, backend, x,
+            G=s2 * g_mat if opts.vertex_lyapunov else None, Q_vertices=q_vertices,
+            u0=scale * values["u0"][:, 0] if "u0" in values else None,
+            H=h_mat, slack=slack, lam=lam if dist is not None and w_max > 0.0 else None,
+        )
+
+    def _original(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Variables of the scaled coordinates ``x = T x~`` mapped back (``Q = T Q~ T``, ...)."""
+        t = self._t
+        out = {}
+        for name, val in values.items():
+            if name == "G" or name.startswith("Q"):
+                out[name] = t[:, None] * val * t[None, :]
+            elif name in ("Y", "Z"):
+                out[name] = val * t[None, :]
+            else:
+                out[name] = val
+        return out
+
+
+def _inner_ellipsoid(q_vertices: tuple[np.ndarray, ...]) -> np.ndarray | None:
+    """``c Q_1`` with the largest ``c`` such that ``c Q_1 <= Q_j`` for every ``j``: an ellipsoid
+    inside every ``{x' Q_j^-1 x <= 1}``."""
+    try:
+        chol = np.linalg.cholesky(q_vertices[0])
+    except np.linalg.LinAlgError:
+        return None
+    c_inv = np.linalg.inv(chol)
+    c = min(float(np.linalg.eigvalsh(c_inv @ q @ c_inv.T)[0]) for q in q_vertices)
+    return c * q_vertices[0] if c > 0.0 else None
+
+

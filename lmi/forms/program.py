@@ -1,0 +1,189 @@
+"""A small LMI program: named variables, named blocks ``M(z) >= 0``, a linear objective.
+
+The forms of :mod:`lmi.forms.lmis` are written once against a :class:`Program` and evaluated in
+two ways: symbolically (each variable an :class:`~lmi.affine.AffineMatrix` in the decision vector
+``z``: the data handed to :class:`lmi.BlockLMISolver`, Clarabel or cvxpy) or numerically (each
+variable a given matrix, with no decision vector: the blocks' constants for a new state, or the
+LMIs recomputed at a solver's answer for the certificate).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from lmi.affine import AffineMatrix, svec_matrix
+
+__all__ = ["Layout", "Program", "relative_margin"]
+
+
+@dataclass(frozen=True)
+class _Var:
+    offset: int
+    shape: tuple[int, int]
+    symmetric: bool
+
+    @property
+    def size(self) -> int:
+        r = self.shape[0]
+        return r * (r + 1) // 2 if self.symmetric else self.shape[0] * self.shape[1]
+
+
+class Layout:
+    """The decision vector's variables, in the order they are declared."""
+
+    def __init__(self) -> None:
+        self._vars: dict[str, _Var] = {}
+        self.size = 0
+
+    def symmetric(self, name: str, size: int) -> None:
+        """Declare a symmetric ``size x size`` variable."""
+        self._add(name, _Var(self.size, (size, size), True))
+
+    def full(self, name: str, rows: int, cols: int) -> None:
+        """Declare a ``rows x cols`` variable (a scalar is ``1 x 1``)."""
+        self._add(name, _Var(self.size, (rows, cols), False))
+
+    def _add(self, name: str, var: _Var) -> None:
+        if name in self._vars:
+            raise ValueError(f"variable {name!r} declared twice")
+        self._vars[name] = var
+        self.size += var.size
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._vars
+
+    @property
+    def names(self) -> list[str]:
+        return list(self._vars)
+
+    def shape(self, name: str) -> tuple[int, int]:
+        return self._vars[name].shape
+
+    def index(self, name: str) -> int:
+        """The position of a scalar variable in ``z``."""
+        var = self._vars[name]
+        if var.shape != (1, 1):
+            raise ValueError(f"{name!r} is not a scalar")
+        return var.offset
+
+    def affine(self, name: str) -> AffineMatrix:
+        """The variable as an affine matrix of ``z``."""
+        var = self._vars[name]
+        if var.symmetric:
+            return AffineMatrix.symmetric_variable(var.shape[0], var.offset, self.size)
+        return AffineMatrix.full_variable(*var.shape, var.offset, self.size)
+
+    def values(self, z: np.ndarray) -> dict[str, np.ndarray]:
+        """Every variable's value at ``z``."""
+        return {name: self.affine(name).value(z) for name in self._vars}
+
+    def vector(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The ``z`` holding the given values (missing variables are zero)."""
+        z = np.zeros(self.size)
+        for name, var in self._vars.items():
+            if name not in values:
+                continue
+            val = np.asarray(values[name], dtype=float).reshape(var.shape)
+            if var.symmetric:
+                iu = np.triu_indices(var.shape[0])
+                # the upper triangle column by column, as lmi.affine.svec_indices orders it
+                order = np.lexsort((iu[0], iu[1]))
+                z[var.offset : var.offset + var.size] = val[iu[0][order], iu[1][order]]
+            else:
+                z[var.offset : var.offset + var.size] = val.ravel()
+        return z
+
+
+class Program:
+    """Blocks ``M_k >= 0`` written with the variables of a :class:`Layout`.
+
+    Parameters
+    ----------
+    layout : Layout
+    values : mapping of str to ndarray, optional
+        ``None``: symbolic (every variable affine in ``z``). Otherwise numeric: each variable is
+        the given matrix (a missing one is zero), and the blocks are constant matrices.
+    """
+
+    def __init__(self, layout: Layout, values: Mapping[str, np.ndarray] | None = None) -> None:
+        self.layout = layout
+        self.numeric = values is not None
+        self._values = dict(values or {})
+        self.n_vars = 0 if self.numeric else layout.size
+        self.blocks: dict[str, AffineMatrix] = {}
+        self._floors: dict[str, float] = {}
+
+    def var(self, name: str) -> AffineMatrix:
+        if not self.numeric:
+            return self.layout.affine(name)
+        value = self._values.get(name)
+        if value is None:
+            return AffineMatrix.zeros(*self.layout.shape(name), 0)
+        return AffineMatrix.constant(np.asarray(value, dtype=float).reshape(self.layout.shape(name)), 0)
+
+    def const(self, value: np.ndarray | float) -> AffineMatrix:
+        return AffineMatrix.constant(np.atleast_2d(np.asarray(value, dtype=float)), self.n_vars)
+
+    def eye(self, size: int, scale: float = 1.0) -> AffineMatrix:
+        return self.const(scale * np.eye(size))
+
+    def bmat(self, rows: list[list[AffineMatrix | None]]) -> AffineMatrix:
+        return AffineMatrix.bmat(rows, self.n_vars)
+
+    def add(self, name: str, block: AffineMatrix, floor: float = 0.0) -> None:
+        """Require ``block >= 0`` (its symmetric part).
+
+        ``floor``: the certificate divides the block's smallest eigenvalue by its largest absolute
+        eigenvalue or by ``floor``, whichever is larger (a scalar block ``s >= 0`` needs a scale
+        of its own: relative to itself its margin is only ever ``+1`` or ``-1``).
+        """
+        if name in self.blocks:
+            raise ValueError(f"block {name!r} added twice")
+        self.blocks[name] = block
+        if floor > 0.0:
+            self._floors[name] = floor
+
+    # -- what the solvers read -----------------------------------------------------------
+    def solver_blocks(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """``(C_j, A_j)`` with ``M_j(z) = C_j - sum_i z_i A_ij`` (:class:`lmi.BlockLMISolver`)."""
+        out = []
+        for block in self.blocks.values():
+            coef = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+            out.append((coef[0], -coef[1:]))
+        return out
+
+    def constants(self) -> list[np.ndarray]:
+        """The symmetric constant part of each block (a numeric program: the blocks' values)."""
+        return [0.5 * (b.coef[0] + b.coef[0].T) for b in self.blocks.values()]
+
+    def conic_rows(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
+        """``(A, b, orders)`` with ``svec(M_j(z)) = b_j - A_j z`` stacked over the blocks
+        (Clarabel's ``PSDTriangleConeT`` convention)."""
+        a_rows, b_rows, orders = [], [], []
+        for block in self.blocks.values():
+            sym = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+            sv = svec_matrix(sym)
+            a_rows.append(-sv[1:].T)
+            b_rows.append(sv[0])
+            orders.append(block.shape[0])
+        return np.vstack(a_rows), np.concatenate(b_rows), orders
+
+    def margins(self) -> dict[str, float]:
+        """Of a numeric program: each block's smallest eigenvalue relative to its largest."""
+        return {
+            name: relative_margin(b.coef[0], self._floors.get(name, 0.0)) for name, b in self.blocks.items()
+        }
+
+
+def relative_margin(mat: np.ndarray, floor: float = 0.0) -> float:
+    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue (or
+    by ``floor`` if that is larger)."""
+    sym = 0.5 * (mat + mat.T)
+    if not np.all(np.isfinite(sym)):
+        return -np.inf
+    lam = np.linalg.eigvalsh(sym)
+    scale = max(float(np.max(np.abs(lam))), floor, np.finfo(float).tiny)
+    return float(lam[0] / scale)
