@@ -89,8 +89,9 @@ def plot_summary(records: Sequence[Mapping[str, Any]], path: Path) -> Path | Non
     ):
         shown = np.log2(data)
         lim = max(1.0, float(np.nanmax(np.abs(shown)))) if np.isfinite(shown).any() else 1.0
-        im = ax.imshow(shown, cmap="coolwarm_r" if ax is axes[0] else "coolwarm", vmin=-lim, vmax=lim,
-                       aspect="auto")
+        im = ax.imshow(
+            shown, cmap="coolwarm_r" if ax is axes[0] else "coolwarm", vmin=-lim, vmax=lim, aspect="auto"
+        )
         ax.set_xticks(range(len(methods)), methods, rotation=20, fontsize=8)
         ax.set_yticks(range(len(problems)), problems, fontsize=8)
         for i in range(len(problems)):

@@ -83,6 +83,10 @@ class MethodsSettings:
         How many closed-loop states are also solved by cvxpy + Clarabel.
     slow_solve_s : float
         A method whose solve at ``x0`` takes longer skips the region and the closed loop (recorded).
+    region_budget_s, loop_budget_s, cvxpy_budget_s : float
+        Wall-time budgets of the region, the two closed loops together and the cvxpy solves: a
+        phase that runs past its budget stops, and the record says where (``notes``; a region or a
+        cost that is not complete is ``None``).
     seed : int
         Seed of the random directions and the switching sequence.
     """
@@ -94,12 +98,26 @@ class MethodsSettings:
     steps_factor: float = 1.0
     cvxpy_states: int = 3
     slow_solve_s: float = 20.0
+    region_budget_s: float = 240.0
+    loop_budget_s: float = 240.0
+    cvxpy_budget_s: float = 60.0
     seed: int = 0
 
     @classmethod
     def short(cls) -> MethodsSettings:
         """The settings of ``--short``: a smoke run that checks the set-up."""
-        return cls(directions_2d=8, directions=2, rel_tol=0.1, steps_factor=0.25, cvxpy_states=1, slow_solve_s=5.0)
+        return cls(
+            directions_2d=6,
+            directions=2,
+            rel_tol=0.1,
+            t_max=64.0,
+            steps_factor=0.25,
+            cvxpy_states=1,
+            slow_solve_s=5.0,
+            region_budget_s=15.0,
+            loop_budget_s=15.0,
+            cvxpy_budget_s=10.0,
+        )
 
     def as_dict(self) -> dict[str, Any]:
         """The settings as a plain dict (stored with every record)."""
@@ -169,26 +187,40 @@ def _directions(problem: MethodsProblem, settings: MethodsSettings) -> np.ndarra
     return size * v * scale
 
 
-def _feasible(ctrl: Any, x: np.ndarray, counts: dict[str, int]) -> bool:
+class _OverBudget(Exception):
+    """A phase of a case ran past its time budget."""
+
+
+def _feasible(ctrl: Any, x: np.ndarray, counts: dict[str, int], deadline: float, last: list[str]) -> bool:
+    if time.perf_counter() > deadline:
+        raise _OverBudget
     sol = ctrl.solve(x)
     counts[sol.status] = counts.get(sol.status, 0) + 1
+    if sol.status != "optimal":
+        last[0] = sol.status
     return sol.status == "optimal"
 
 
-def region_along(ctrl: Any, d: np.ndarray, settings: MethodsSettings, counts: dict[str, int]) -> float:
-    """The largest multiple ``t`` (to ``rel_tol``) with ``t d`` certified feasible; 0 if none in range.
+def region_along(
+    ctrl: Any, d: np.ndarray, settings: MethodsSettings, counts: dict[str, int], deadline: float = np.inf
+) -> tuple[float, str]:
+    """The largest multiple ``t`` (to ``rel_tol``) with ``t d`` certified feasible, and what stopped it.
 
     Feasibility is star-shaped (the LMIs at ``t x`` with ``t < 1`` are met by the same variables),
-    so bracketing by doubling or halving from ``t = 1`` and bisecting finds the boundary.
+    so bracketing by doubling or halving from ``t = 1`` and bisecting finds the boundary. The
+    second value is the status of the last solve that failed above ``t`` (``"infeasible"``, a
+    solver failure word) or ``"cap"`` when ``t`` reached ``t_max``. Raises ``_OverBudget`` past
+    ``deadline`` (a ``time.perf_counter`` value).
     """
+    last = ["cap"]
     lo, hi = 0.0, 1.0
-    if _feasible(ctrl, d, counts):
+    if _feasible(ctrl, d, counts, deadline, last):
         lo = 1.0
         while True:
             hi = 2.0 * lo
             if hi > settings.t_max:
-                return settings.t_max
-            if not _feasible(ctrl, hi * d, counts):
+                return settings.t_max, "cap"
+            if not _feasible(ctrl, hi * d, counts, deadline, last):
                 break
             lo = hi
     else:
@@ -196,23 +228,30 @@ def region_along(ctrl: Any, d: np.ndarray, settings: MethodsSettings, counts: di
         while True:
             t /= 2.0
             if t < 1.0 / settings.t_max:
-                return 0.0
-            if _feasible(ctrl, t * d, counts):
+                return 0.0, last[0]
+            if _feasible(ctrl, t * d, counts, deadline, last):
                 lo, hi = t, 2.0 * t
                 break
     while hi - lo > settings.rel_tol * lo:
         mid = 0.5 * (lo + hi)
-        if _feasible(ctrl, mid * d, counts):
+        if _feasible(ctrl, mid * d, counts, deadline, last):
             lo = mid
         else:
             hi = mid
-    return lo
+    return lo, last[0]
 
 
 def _closed_loop(
-    ctrl: Any, problem: MethodsProblem, steps: int, plants: Sequence[tuple[np.ndarray, np.ndarray]]
+    ctrl: Any,
+    problem: MethodsProblem,
+    steps: int,
+    plants: Sequence[tuple[np.ndarray, np.ndarray]],
+    deadline: float = np.inf,
 ) -> dict[str, Any]:
-    """Run ``ctrl.step`` on ``plants[k]`` for ``steps`` samples; cost, step times, statuses, states."""
+    """Run ``ctrl.step`` on ``plants[k]`` for ``steps`` samples; cost, step times, statuses, states.
+
+    Past ``deadline`` the run stops: ``done`` < ``steps`` and the cost covers the steps run.
+    """
     ctrl.reset()
     x = problem.x0.copy()
     cost = 0.0
@@ -220,7 +259,11 @@ def _closed_loop(
     counts: dict[str, int] = {}
     states = [x.copy()]
     max_u = 0.0
+    done = 0
     for k in range(steps):
+        if time.perf_counter() > deadline:
+            break
+        done = k + 1
         start = time.perf_counter()
         u = np.asarray(ctrl.step(x), dtype=float)
         elapsed = time.perf_counter() - start
@@ -245,6 +288,7 @@ def _closed_loop(
         "states": np.array(states),
         "max_abs_u": max_u,
         "final_norm": float(np.linalg.norm(states[-1])),
+        "done": done,
     }
 
 
@@ -253,7 +297,7 @@ def _percentile(values: Sequence[float], q: float) -> float | None:
 
 
 def _cvxpy_times(
-    problem: MethodsProblem, options: dict[str, Any], states: Sequence[np.ndarray]
+    problem: MethodsProblem, options: dict[str, Any], states: Sequence[np.ndarray], deadline: float = np.inf
 ) -> dict[str, Any]:
     """cvxpy + Clarabel on ``states`` next to the ipm on the same states (wall time of ``solve``)."""
     out: dict[str, Any] = {"cvxpy_statuses": {}, "cvxpy_gamma": None, "cvxpy_error": None}
@@ -265,6 +309,8 @@ def _cvxpy_times(
     ipm = _controller(problem, options)
     cv_times, ipm_times = [], []
     for i, x in enumerate(states):
+        if i and time.perf_counter() > deadline:
+            break
         start = time.perf_counter()
         sol = ref.solve(x)
         cv_times.append(time.perf_counter() - start)
@@ -277,15 +323,17 @@ def _cvxpy_times(
         ipm_times.append(time.perf_counter() - start)
     out["cvxpy_time_p50"] = _percentile(cv_times, 50)
     out["ipm_time_same_states_p50"] = _percentile(ipm_times, 50)
-    out["cvxpy_states"] = len(states)
+    out["cvxpy_states"] = len(cv_times)
     return out
 
 
 def _switching(problem: MethodsProblem, steps: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
     rng = np.random.default_rng(seed)
     idx = rng.integers(0, problem.plant.n_vertices, size=steps)
-    return [problem.plant.vertex(int(j)) if hasattr(problem.plant, "vertex") else problem.plant.vertices[j]
-            for j in idx]
+    return [
+        problem.plant.vertex(int(j)) if hasattr(problem.plant, "vertex") else problem.plant.vertices[j]
+        for j in idx
+    ]
 
 
 def _base_record(problem: MethodsProblem, method: str, settings: MethodsSettings) -> dict[str, Any]:
@@ -367,23 +415,34 @@ def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) ->
     # the region
     dirs = _directions(problem, settings)
     region_counts: dict[str, int] = {}
-    ts = [region_along(ctrl, d, settings, region_counts) for d in dirs]
-    rec["region"] = {
-        "t": ts,
-        "geo_mean_t": float(np.exp(np.mean(np.log(np.maximum(ts, 1.0 / settings.t_max))))),
-        "min_t": float(min(ts)),
-        "t_x0": float(ts[0]) if problem.n_states > 2 else None,
-        "capped": bool(max(ts) >= settings.t_max),
-        "directions": len(ts),
-        "status_counts": region_counts,
-    }
-    extra["region_points"] = (np.array(ts)[:, None] * dirs).tolist()
+    deadline = time.perf_counter() + settings.region_budget_s
+    ts, limits = [], []
+    try:
+        for d in dirs:
+            t, why = region_along(ctrl, d, settings, region_counts, deadline)
+            ts.append(t)
+            limits.append(why)
+    except _OverBudget:
+        rec["notes"].append(
+            f"region: {len(ts)} of {len(dirs)} directions within its {settings.region_budget_s:g} s budget"
+        )
+        rec["region_partial"] = {"t": ts, "limits": limits, "status_counts": region_counts}
+        ts = []
+    if ts:
+        _region(rec, ts, limits, region_counts, problem, settings)
+        extra["region_points"] = (np.array(ts)[:, None] * dirs).tolist()
     # the closed loop: fixed plant, then switching vertices
-    steps = max(2, int(round(problem.steps * settings.steps_factor)))
-    fixed = _closed_loop(ctrl, problem, steps, [problem.true_plant] * steps)
-    switching = _closed_loop(ctrl, problem, steps, _switching(problem, steps, settings.seed))
-    rec["closed_loop_cost"] = fixed["cost"]
-    rec["closed_loop_cost_switching"] = switching["cost"]
+    steps = max(2, round(problem.steps * settings.steps_factor))
+    deadline = time.perf_counter() + settings.loop_budget_s
+    fixed = _closed_loop(ctrl, problem, steps, [problem.true_plant] * steps, deadline)
+    switching = _closed_loop(ctrl, problem, steps, _switching(problem, steps, settings.seed), deadline)
+    for name, run in (("closed_loop_cost", fixed), ("closed_loop_cost_switching", switching)):
+        if run["done"] == steps:
+            rec[name] = run["cost"]
+        else:
+            rec["notes"].append(
+                f"{name}: stopped after {run['done']} of {steps} steps ({settings.loop_budget_s:g} s budget)"
+            )
     rec["closed_loop_steps"] = steps
     rec["closed_loop_max_abs_u"] = fixed["max_abs_u"]
     rec["closed_loop_final_norm"] = fixed["final_norm"]
@@ -399,12 +458,36 @@ def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) ->
     extra["trajectory"] = fixed["states"].tolist()
     # cvxpy + Clarabel on the first states of the closed loop
     cv_states = list(fixed["states"][: max(1, settings.cvxpy_states)])
-    cv = _cvxpy_times(problem, options, cv_states)
+    cv = _cvxpy_times(problem, options, cv_states, time.perf_counter() + settings.cvxpy_budget_s)
     rec.update(cv)
     if rec["cvxpy_time_p50"] and rec.get("ipm_time_same_states_p50"):
         rec["cvxpy_ratio"] = rec["cvxpy_time_p50"] / rec["ipm_time_same_states_p50"]
     rec["case_time_s"] = time.perf_counter() - start_case
     return rec, extra
+
+
+def _region(
+    rec: dict[str, Any],
+    ts: list[float],
+    limits: list[str],
+    counts: dict[str, int],
+    problem: MethodsProblem,
+    settings: MethodsSettings,
+) -> None:
+    ended: dict[str, int] = {}
+    for why in limits:
+        ended[why] = ended.get(why, 0) + 1
+    rec["region"] = {
+        "t": ts,
+        "limits": limits,
+        "ended_by": ended,
+        "geo_mean_t": float(np.exp(np.mean(np.log(np.maximum(ts, 1.0 / settings.t_max))))),
+        "min_t": float(min(ts)),
+        "t_x0": float(ts[0]) if problem.n_states > 2 else None,
+        "capped": bool(max(ts) >= settings.t_max),
+        "directions": len(ts),
+        "status_counts": counts,
+    }
 
 
 # -- running, storing, resuming ----------------------------------------------------------------
@@ -504,7 +587,9 @@ def run_methods(
                         built[p] = build_problem(p)
                     rec, extra = evaluate(built[p], m, settings)
                 except Exception as err:  # a failing case is data, not a crash of the suite
-                    failures.append({"experiment": p, "key": f"{p}__{m}", "error": f"{type(err).__name__}: {err}"})
+                    failures.append(
+                        {"experiment": p, "key": f"{p}__{m}", "error": f"{type(err).__name__}: {err}"}
+                    )
                     bar.advance(f"{p}/{m}", ok=False)
                     continue
                 _store_case(path, settings, rec, extra)
@@ -566,6 +651,9 @@ def table_row(rec: dict[str, Any], base: dict[str, Any] | None) -> dict[str, str
         "iter": _fmt(rec.get("iterations"), "d") if rec.get("iterations") is not None else "-",
         "region min / geo-mean t": reach,
         "region vs kothare": _fmt(ratio, ".3f"),
+        "region ended by": "-"
+        if region is None
+        else ", ".join(f"{k} {v}" for k, v in sorted(region.get("ended_by", {}).items())),
         "cost (nominal plant)": _fmt(rec.get("closed_loop_cost")),
         "cost (switching)": _fmt(rec.get("closed_loop_cost_switching")),
         "solve p50 / p95 (ms)": f"{_ms(rec.get('solve_time_p50'))} / {_ms(rec.get('solve_time_p95'))}",
@@ -591,19 +679,27 @@ def least_conservative(records: list[dict[str, Any]]) -> list[str]:
         parts = []
         gam = _best(
             [r for r in recs if r["method"] in GAMMA_COMPARABLE and r["status"] == "optimal"],
-            lambda r: r.get("gamma"), largest=False,
+            lambda r: r.get("gamma"),
+            largest=False,
         )
         if gam is not None:
-            ref = f" (kothare {base['gamma']:.4g}, {base['status']})" if base and base.get("gamma") is not None else ""
+            ref = (
+                f" (kothare {base['gamma']:.4g}, {base['status']})"
+                if base and base.get("gamma") is not None
+                else ""
+            )
             parts.append(f"smallest worst-case gamma: {gam['method']} {gam['gamma']:.4g}{ref}")
-        reg = _best(recs, lambda r: region_ratio(r, base), largest=True)
+        reg = _best(recs, lambda r, b=base: region_ratio(r, b), largest=True)
         if reg is not None:
-            parts.append(f"largest region: {reg['method']} ({region_ratio(reg, base):.3f} x kothare's, geometric mean)")
+            parts.append(
+                f"largest region: {reg['method']} ({region_ratio(reg, base):.3f} x kothare's, geometric mean)"
+            )
         cost = _best(recs, lambda r: r.get("closed_loop_cost"), largest=False)
         if cost is not None:
             ref = (
                 f" (kothare {base['closed_loop_cost']:.4g})"
-                if base and base.get("closed_loop_cost") is not None else ""
+                if base and base.get("closed_loop_cost") is not None
+                else ""
             )
             parts.append(f"lowest closed-loop cost: {cost['method']} {cost['closed_loop_cost']:.4g}{ref}")
         if parts:
@@ -652,13 +748,19 @@ def write_methods_report(
         "# Benchmark suite `methods`: the robust MPC forms head to head",
         "",
         *run_lines(info, scale),
-        f"{resumed} cases were taken from an earlier run of the same command (`cases/`)." if resumed else "",
+        *(
+            [f"{resumed} cases were taken from an earlier run of the same command (`cases/`)."]
+            if resumed
+            else []
+        ),
         "",
         "Per problem and method: the status and `gamma` of the solve at the start state `x0`; the "
         "feasible region as the largest certified multiple `t` of fixed directions (scaled to the "
         "size of `x0`, so `t = 1` reaches as far as `x0`; smallest and geometric mean over the "
         f"directions, `>=` where a direction reached the cap {settings.t_max:g}) and its ratio to "
-        "Kothare's direction by direction; the closed-loop cost `sum x'Q x + u'R u` on the nominal "
+        "Kothare's direction by direction, and what ended each direction (`infeasible`: the solver's "
+        "certificate; a solver failure word: the form gave up there; `cap`); the closed-loop cost "
+        "`sum x'Q x + u'R u` on the nominal "
         "plant and on a seeded switching sequence of vertices; the wall time of the closed-loop steps "
         "that solved (p50 / p95, certification included) and of cvxpy + Clarabel on the same LMIs "
         f"at the first {settings.cvxpy_states} closed-loop states (ratio to the toolkit's ipm on "
@@ -682,18 +784,29 @@ def write_methods_report(
         ]
         prows = [table_row(r, _kothare(records, p)) for r in recs]
         lines += [to_markdown(list(prows[0]), [list(row.values()) for row in prows]), ""]
-        notes = [
-            f"- {r['method']}: {r['skip_reason']}" for r in recs if r.get("skip_reason")
-        ] + [f"- {r['method']}: {n}" for r in recs for n in r.get("notes", [])]
+        notes = [f"- {r['method']}: {r['skip_reason']}" for r in recs if r.get("skip_reason")] + [
+            f"- {r['method']}: {n}" for r in recs for n in r.get("notes", [])
+        ]
         lines += notes + ([""] if notes else [])
         if p in figures:
             lines += [f"![{p}]({figures[p].relative_to(out).as_posix()})", ""]
     if summary is not None:
-        lines += ["## Regions and costs against Kothare's", "", f"![summary]({summary.relative_to(out).as_posix()})", ""]
+        lines += [
+            "## Regions and costs against Kothare's",
+            "",
+            f"![summary]({summary.relative_to(out).as_posix()})",
+            "",
+        ]
     lines += failed_cases(outcome.failures)
     rows_s = [(k, v, why) for k, v, why in SUITE_CHOICES]
-    rows_s.append(("region", f"{settings.directions_2d} angles (2 states) / {settings.directions} directions, "
-                   f"bisection to {settings.rel_tol:g} relative", "suite settings"))
+    rows_s.append(
+        (
+            "region",
+            f"{settings.directions_2d} angles (2 states) / {settings.directions} directions, "
+            f"bisection to {settings.rel_tol:g} relative",
+            "suite settings",
+        )
+    )
     rows_s.append(("seed", str(settings.seed), "directions and switching sequence"))
     lines += settings_section(
         "The problems' data and the suite's own choices (`benchmarks/suites/methods_problems.py`).",

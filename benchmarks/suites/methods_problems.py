@@ -113,7 +113,12 @@ def _kothare_ex2() -> MethodsProblem:
 
     def a_of(k: float) -> np.ndarray:
         return np.array(
-            [[1.0, 0.0, 0.1, 0.0], [0.0, 1.0, 0.0, 0.1], [-0.1 * k, 0.1 * k, 1.0, 0.0], [0.1 * k, -0.1 * k, 0.0, 1.0]]
+            [
+                [1.0, 0.0, 0.1, 0.0],
+                [0.0, 1.0, 0.0, 0.1],
+                [-0.1 * k, 0.1 * k, 1.0, 0.0],
+                [0.1 * k, -0.1 * k, 0.0, 1.0],
+            ]
         )
 
     b = np.array([[0.0], [0.0], [0.1], [0.0]])
@@ -121,7 +126,10 @@ def _kothare_ex2() -> MethodsProblem:
     return MethodsProblem(
         name="kothare_ex2",
         title="Kothare's example 2: two masses and a spring, k in [0.5, 10]",
-        source="Kothare, Balakrishnan & Morari, Automatica 32(10), 1996, example 2 (as MUP's benchmark writes it)",
+        source=(
+            "Kothare, Balakrishnan & Morari, Automatica 32(10), 1996, example 2 "
+            "(as MUP's benchmark writes it)"
+        ),
         plant=plant,
         Q=np.eye(4),
         R=np.eye(1),
@@ -181,7 +189,7 @@ def _paper_p(mode: str) -> MethodsProblem:
         input_constraint=str(s["input_constraint"]),
         x0=np.asarray(x0, dtype=float),
         true_plant=plant.nominal,
-        steps=300,
+        steps=150,
         region_scale=np.array([1.0, 1.0, 1.0, 0.1, 0.1, 0.1]),
     )
 
@@ -229,7 +237,7 @@ def _flexible() -> MethodsProblem:
     return MethodsProblem(
         name=f"flexible_{plant.n_vertices}v",
         title=f"The flexible satellite, {n} states, 'groups' polytope ({plant.n_vertices} vertices)",
-        source="Di Gennaro's 4 modes; polytope, weights, period and the small slew of benchmarks/families/flexible",
+        source="Di Gennaro's 4 modes; the polytope, weights, period and small slew of the flexible family",
         plant=plant,
         Q=Q,
         R=R,
