@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -312,7 +313,9 @@ def _cvxpy_times(
         if i and time.perf_counter() > deadline:
             break
         start = time.perf_counter()
-        sol = ref.solve(x)
+        with warnings.catch_warnings():  # cvxpy's "may be inaccurate": the status says it
+            warnings.simplefilter("ignore", UserWarning)
+            sol = ref.solve(x)
         cv_times.append(time.perf_counter() - start)
         out["cvxpy_statuses"][sol.status] = out["cvxpy_statuses"].get(sol.status, 0) + 1
         if i == 0:
