@@ -156,8 +156,11 @@ def test_the_ranking_is_read_from_the_records():
         rec("vertex", 8.0, [2.0, 4.0], 6.0),
         rec("nominal", 1.0, [1.0, 1.0], 4.0),
         rec("vertex_pairs", 7.0, [1.0, 2.0], 5.5, "inaccurate"),
+        rec("soft", 10.0, [64.0, 64.0], 5.0),  # relaxes the bounds: not in the region ranking
+        rec("free_move", 9.0, [2.0, 4.0], 6.0),
     ]
     (line,) = least_conservative(records)
     assert "smallest worst-case gamma: vertex 8" in line  # nominal bounds another cost, pairs not optimal
-    assert "largest region: vertex (2.000 x" in line
+    assert "largest region (hard bounds): vertex (2.000 x kothare's, geometric mean) (tied" in line
+    assert "(tied within 0.1%: free_move)" in line
     assert "lowest closed-loop cost: nominal 4" in line

@@ -61,6 +61,9 @@ SOFT_WEIGHT: float = 1e3
 #: soft form adds the slack price): the ones ranked by gamma.
 GAMMA_COMPARABLE: tuple[str, ...] = ("kothare", "vertex", "vertex_pairs", "free_move", "auxiliary_saturation")
 
+#: Relative difference below which two methods tie in the report's ranking.
+TIE_TOLERANCE: float = 0.001
+
 #: Version of the record layout; a stored case of another version is run again.
 RECORD_VERSION = 1
 
@@ -673,6 +676,17 @@ def _best(recs: list[dict[str, Any]], key: Any, largest: bool) -> dict[str, Any]
     return (max if largest else min)(cands, key=key)
 
 
+def _ties(recs: list[dict[str, Any]], key: Any, best: dict[str, Any], rel: float = TIE_TOLERANCE) -> str:
+    """`` (tied: a, b)`` for the other methods within ``rel`` of the best value, else ``""``."""
+    v = key(best)
+    tied = [
+        r["method"]
+        for r in recs
+        if r is not best and key(r) is not None and abs(key(r) - v) <= rel * max(abs(v), 1e-300)
+    ]
+    return f" (tied within {rel:.1%}: {', '.join(tied)})" if tied else ""
+
+
 def least_conservative(records: list[dict[str, Any]]) -> list[str]:
     """Per problem: the smallest worst-case gamma, the largest region and the lowest closed-loop cost."""
     lines = []
@@ -691,11 +705,22 @@ def least_conservative(records: list[dict[str, Any]]) -> list[str]:
                 if base and base.get("gamma") is not None
                 else ""
             )
-            parts.append(f"smallest worst-case gamma: {gam['method']} {gam['gamma']:.4g}{ref}")
-        reg = _best(recs, lambda r, b=base: region_ratio(r, b), largest=True)
+            ranked = [r for r in recs if r["method"] in GAMMA_COMPARABLE and r["status"] == "optimal"]
+            parts.append(
+                f"smallest worst-case gamma: {gam['method']} {gam['gamma']:.4g}{ref}"
+                + _ties(ranked, lambda r: r.get("gamma"), gam)
+            )
+        hard = [r for r in recs if r["method"] != "soft"]  # soft bounds enlarge the region by relaxing them
+
+        def ratio(r: dict[str, Any], b: dict[str, Any] | None = base) -> float | None:
+            return region_ratio(r, b)
+
+        reg = _best(hard, ratio, largest=True)
         if reg is not None:
             parts.append(
-                f"largest region: {reg['method']} ({region_ratio(reg, base):.3f} x kothare's, geometric mean)"
+                f"largest region (hard bounds): {reg['method']} ({ratio(reg):.3f} x kothare's, "
+                "geometric mean)"
+                + _ties(hard, ratio, reg)
             )
         cost = _best(recs, lambda r: r.get("closed_loop_cost"), largest=False)
         if cost is not None:
@@ -704,7 +729,10 @@ def least_conservative(records: list[dict[str, Any]]) -> list[str]:
                 if base and base.get("closed_loop_cost") is not None
                 else ""
             )
-            parts.append(f"lowest closed-loop cost: {cost['method']} {cost['closed_loop_cost']:.4g}{ref}")
+            parts.append(
+                f"lowest closed-loop cost: {cost['method']} {cost['closed_loop_cost']:.4g}{ref}"
+                + _ties(recs, lambda r: r.get("closed_loop_cost"), cost)
+            )
         if parts:
             lines.append(f"- **{p}**: " + "; ".join(parts) + ".")
     return lines
