@@ -10,6 +10,7 @@ variables of a form, :func:`write` adds its blocks. The same code gives the solv
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +19,7 @@ from lmi.affine import AffineMatrix
 from lmi.forms.options import FormOptions
 from lmi.forms.program import Layout, Program
 
-__all__ = ["FormData", "declare", "objective", "pairs", "write"]
+__all__ = ["FormData", "declare", "delta_congruence", "objective", "pairs", "write"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,7 @@ class FormData:
     y_max: np.ndarray
     w_max: float
     lam: float
+    dt: float = 1.0
 
     @property
     def n(self) -> int:
@@ -84,6 +86,9 @@ def declare(opts: FormOptions, fd: FormData) -> Layout:
     lay.full("Y", m, n)
     if opts.saturation == "auxiliary":
         lay.full("Z", m, n)
+    if shares_cost(opts, fd.n_vertices):
+        for k in range(len(_signs(opts, m))):
+            lay.symmetric(f"W{k}", n)
     if opts.free_moves:
         lay.full("u0", m, 1)
         lay.full("s0", 1, 1)
@@ -93,6 +98,15 @@ def declare(opts: FormOptions, fd: FormData) -> Layout:
     if "y" in soft:
         lay.full("s_y", 1, 1)
     return lay
+
+
+def shares_cost(opts: FormOptions, n_vertices: int) -> bool:
+    """Whether the cost LMIs share their ``Q1``/``R`` part through a variable ``W`` (more than one
+    cost LMI per input sign): ``[[dt W, G' Q1h', Y_s' Rh'], [Q1h G, gamma I, 0], [Rh Y_s, 0, gamma
+    I]] >= 0`` once, and ``[[T_i - dt W, M'], [M, Q_j]] >= 0`` per pair: by a Schur complement the
+    same set of ``(G, Q_j, Y, gamma)`` (the best ``W`` is ``(G' Q1 G + Y_s' R Y_s) / (dt gamma)``),
+    with each pair's block of order ``2n`` instead of ``2n + p + m`` (as Kothare's "delta_shared")."""
+    return opts.cost == "worst_case" and len(pairs(opts, n_vertices)) > 1
 
 
 def objective(opts: FormOptions, lay: Layout) -> np.ndarray:
@@ -142,10 +156,10 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
     def cost_block(a: np.ndarray, b: np.ndarray, t: AffineMatrix, qn: AffineMatrix,
                    ys: AffineMatrix) -> AffineMatrix:
         mid = g_var.lmul(a) + ys.lmul(b)
-        u_eye = AffineMatrix(np.kron(gamma.coef, np.eye(m)))
+        u_eye = prog.times(gamma, np.eye(m))
         if p == 0:  # Q1 = 0: no state cost rows
             return prog.bmat([[t, mid.T, ys.T.rmul(rh.T)], [mid, qn, None], [ys.lmul(rh), None, u_eye]])
-        g_eye = AffineMatrix(np.kron(gamma.coef, np.eye(p)))
+        g_eye = prog.times(gamma, np.eye(p))
         return prog.bmat([
             [t, mid.T, g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)],
             [mid, qn, None, None],
@@ -166,32 +180,91 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
             [mid, we, qn],
         ])
 
+    n = fd.n
+
+    def delta(extra: int, rest_scale: float) -> np.ndarray:
+        """``L`` of the delta congruence (see :func:`delta_congruence`)."""
+        return delta_congruence(n, extra, fd.dt, rest_scale)
+
+    cost_delta = delta(p + m, math.sqrt(fd.dt))
     vertex_pairs = pairs(opts, nv)
     disturbed = fd.E is not None and fd.w_max > 0.0
+    shared = shares_cost(opts, nv)
+    root = math.sqrt(fd.dt)
     for k, sign in enumerate(signs):
         tag = "" if sign is None else f"_s{k}"
         ys = y_sign(sign)
-        if opts.cost == "worst_case":
+        if shared:
+            w_dt = prog.var(f"W{k}") * fd.dt
+            cost_rows = [g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)] if p else [ys.T.rmul(rh.T)]
+            gam_blocks = ([prog.times(gamma, np.eye(p))] if p else []) + [prog.times(gamma, np.eye(m))]
+            size = len(cost_rows)
+            rows: list[list[AffineMatrix | None]] = [[w_dt, *cost_rows]]
+            for r, (row, gam_eye) in enumerate(zip(cost_rows, gam_blocks, strict=True)):
+                rows.append([row.T] + [gam_eye if c == r else None for c in range(size)])
+            extra = (p if p else 0) + m
+            scale = np.diag(np.concatenate([np.full(n, 1.0 / root), np.full(extra, root)]))
+            prog.add(f"cost_shared{tag}", prog.bmat(rows), congruence=scale)
             for i, j in vertex_pairs:
-                prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys))
+                mid = g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])
+                block = prog.bmat([[top(i) - w_dt, mid.T], [mid, q_next(j)]])
+                prog.add(f"cost_{i}_{j}{tag}", block, congruence=delta(0, 1.0))
+        elif opts.cost == "worst_case":
+            for i, j in vertex_pairs:
+                prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys),
+                         congruence=cost_delta)
         else:
             assert fd.A0 is not None and fd.B0 is not None
-            prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys))
+            prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys),
+                     congruence=cost_delta)
         if disturbed or opts.cost == "nominal":
             for i, j in vertex_pairs:
                 block = invariance_block(fd.A[i], fd.B[i], top(i), q_next(j), ys)
-                prog.add(f"invariance_{i}_{j}{tag}", block)
+                prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)
     _bound_blocks(prog, opts, fd, top, y_sign, signs, lyap)
-    _slack_signs(prog, fd)
     return prog
 
 
-def _slack_signs(prog: Program, fd: FormData) -> None:
-    """``s >= 0``, certified relative to the squared bound the slack enlarges."""
-    for name, bounds in (("s_u", fd.u_max), ("s_y", fd.y_max)):
-        if name in prog.layout:
-            prog.add(f"{name}_nonnegative", prog.var(name), floor=float(np.max(bounds)) ** 2)
+def delta_congruence(n: int, extra: int, dt: float, rest_scale: float) -> np.ndarray:
+    """``L`` with ``L [r1; r2; r3] = [(r1 - r2) / sqrt(dt); r2; rest_scale r3]`` (block rows of
+    sizes ``n``, ``n``, ``extra``).
+
+    On a cost or invariance block ``[[T_i, M'], [M, Q_j], ...]`` with ``M = A_i G + B_i Y`` and
+    ``A_i = I + O(dt)`` it gives the top-left block ``(T_i - M - M' + Q_j) / dt``, which for
+    ``T_i = G + G' - Q_i`` is ``(Q_j - Q_i) / dt - (H_i + H_i')`` with ``H_i = ((A_i - I) G + B_i
+    Y) / dt``: the differences of order ``dt`` that the printed block holds between entries of
+    order one become entries of order one (Kothare's "delta" form; with ``rest_scale =
+    sqrt(dt)`` the cost rows' ``gamma I`` become ``dt gamma I``). A congruence: the same LMI.
+    """
+    size = 2 * n + extra
+    lmat = np.zeros((size, size))
+    root = math.sqrt(dt)
+    lmat[:n, :n] = np.eye(n) / root
+    lmat[:n, n : 2 * n] = -np.eye(n) / root
+    lmat[n : 2 * n, n : 2 * n] = np.eye(n)
+    lmat[2 * n :, 2 * n :] = rest_scale * np.eye(extra)
+    return lmat
+
+
+def _with_slacks(prog: Program, block: AffineMatrix) -> AffineMatrix:
+    """``block`` with the soft constraints' slacks ``s_u, s_y >= 0`` appended on its diagonal.
+
+    A slack is zero at the optimum wherever the hard bound holds; on a ``1 x 1`` block of its
+    own, the solver's block-wise residual test (relative to the block's size, then about zero)
+    could never pass, so the slacks share the state block, whose size is one.
+    """
+    slacks = [prog.var(name) for name in ("s_u", "s_y") if name in prog.layout]
+    if not slacks:
+        return block
+    rows: list[list[AffineMatrix | None]] = [[block] + [None] * len(slacks)]
+    for k, slack in enumerate(slacks):
+        rows.append([None] * (k + 1) + [slack] + [None] * (len(slacks) - k - 1))
+    rows[0][1] = prog.zeros(block.shape[0], 1)
+    for k in range(1, len(slacks)):
+        rows[k][0] = prog.zeros(1, block.shape[1])
+    rows[-1][0] = prog.zeros(1, block.shape[1])
+    return prog.bmat(rows)
 
 
 def _soft_square(prog: Program, bound: float, name: str) -> AffineMatrix:
@@ -206,7 +279,8 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
     if not opts.free_moves:
         xc = prog.const(fd.x[:, None])
         for j, q in enumerate(lyap):
-            prog.add(f"state_{j}", prog.bmat([[one, xc.T], [xc, q]]))
+            block = prog.bmat([[one, xc.T], [xc, q]])
+            prog.add(f"state_{j}", _with_slacks(prog, block) if j == 0 else block)
         return
     u0 = prog.var("u0")
     # every vertex's prediction x(k+1) = A_i x + B_i u0 inside the ellipsoid of Q_j
@@ -221,7 +295,8 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
         prog.add(f"prediction_{tag}", prog.bmat([[one, pred.T], [pred, q]]))
     stage = float(fd.x @ fd.Q1h.T @ fd.Q1h @ fd.x)
     s0 = prog.var("s0") - prog.const(stage)
-    prog.add("stage_cost", prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]]))
+    stage_block = prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]])
+    prog.add("stage_cost", _with_slacks(prog, stage_block))
 
 
 def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, signs,
@@ -233,11 +308,11 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
         t = top(j)
         if kind == "ellipsoid":
             square = _soft_square(prog, float(fd.u_max[0]), "s_u")
-            prog.add(f"input_{j}", prog.bmat([[AffineMatrix(np.kron(square.coef, np.eye(m))), bounded],
+            prog.add(f"input_{j}", prog.bmat([[prog.times(square, np.eye(m)), bounded],
                                                [bounded.T, t]]))
         elif kind == "peak":
             for ell in range(m):
-                row = AffineMatrix(bounded.coef[:, ell : ell + 1, :])
+                row = bounded.lmul(np.eye(m)[ell : ell + 1])
                 square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
                 prog.add(f"input_{ell}_{j}", prog.bmat([[square, row], [row.T, t]]))
     if opts.free_moves and kind is not None:
@@ -247,7 +322,7 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
             prog.add("input_u0", prog.bmat([[square, u0.T], [u0, prog.eye(m)]]))
         else:
             for ell in range(m):
-                comp = AffineMatrix(u0.coef[:, ell : ell + 1, :])
+                comp = u0.lmul(np.eye(m)[ell : ell + 1])
                 square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
                 prog.add(f"input_u0_{ell}", prog.bmat([[square, comp], [comp, prog.const(1.0)]]))
     if fd.C_out is None:

@@ -13,6 +13,7 @@ original coordinates: every block recomputed in numpy at the returned matrices.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -21,15 +22,25 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import sparse
 
+from lmi.affine import svec_matrix
 from lmi.certificate import Certificate
 from lmi.data import InputConstraint, KothareData, build_kothare_data
 from lmi.forms.lmis import FormData, declare, objective, write
 from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
+from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
 from lmi.kothare import KothareProblem, LMISolution
 from lmi.scaling import state_scaling
-from lmi.status import CLARABEL_STATUS_MAP, CVXPY_STATUS_MAP, INFEASIBLE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
+from lmi.status import (
+    CLARABEL_STATUS_MAP,
+    CVXPY_STATUS_MAP,
+    INFEASIBLE,
+    NUMERICAL_ERROR,
+    OPTIMAL,
+    SOLVER_ERROR,
+    UNCERTIFIED,
+)
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_positive
@@ -49,9 +60,10 @@ class _Solved:
     """One solver's answer in the solver's coordinates (``z``), or none."""
 
     def __init__(self, status: str, solver_status: str, z: np.ndarray | None, iterations: int | None,
-                 solve_time: float) -> None:
+                 solve_time: float, infeasibility: InfeasibilityCertificate | None = None) -> None:
         self.status, self.solver_status, self.z = status, solver_status, z
         self.iterations, self.solve_time = iterations, solve_time
+        self.infeasibility = infeasibility
 
 
 class FormProblem:
@@ -202,7 +214,7 @@ class FormProblem:
             input_constraint=data.input_constraint,
             C_out=None if data.C_out is None else data.C_out * t[None, :],
             E=None if self._E is None else ti[:, None] * self._E,
-            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam,
+            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam, dt=data.dt,
         )
 
     # -- solve ---------------------------------------------------------------------------------
@@ -263,10 +275,13 @@ class FormProblem:
                     d = lo + _GOLDEN * (hi - lo)
                     fd = value(d)
         certified = [s for s in tried.values() if s.ok]
-        pick = min(certified, key=self._objective) if certified else tried[LAMBDA_GRID[best]]
-        import dataclasses
-
-        return dataclasses.replace(pick, solve_time=total_time, iterations=total_its)
+        if certified:
+            pick = min(certified, key=self._objective)
+            return dataclasses.replace(pick, solve_time=total_time, iterations=total_its)
+        pick = tried[LAMBDA_GRID[best]]
+        word = f"{pick.solver_status} (no certified answer at any of the {len(tried)} lam tried)"
+        return dataclasses.replace(pick, solve_time=total_time, iterations=total_its, solver_status=word,
+                                   lam=LAMBDA_GRID[best])
 
     def _objective(self, sol: LMISolution) -> float:
         """The minimised objective: the cost bound plus the soft constraints' penalties."""
@@ -278,7 +293,8 @@ class FormProblem:
         fd = self._form_data(xs, us, ys, w_max, lam)
         if self.backend == "ipm":
             solved = self._solve_ipm(fd)
-            if solved.status != OPTIMAL and self._settings["fallback"]:
+            proved = solved.infeasibility is not None and solved.infeasibility.ok
+            if solved.status != OPTIMAL and not proved and self._settings["fallback"]:
                 first = solved
                 solved = self._solve_clarabel(fd)
                 solved.solve_time += first.solve_time
@@ -311,6 +327,14 @@ class FormProblem:
             res = solver.solve(warm_start=warm)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
+        if res.status == INFEASIBLE:
+            # the run's Farkas ray, checked on the conic data of the problem as solved
+            a_rows, b, orders = self._symbolic(fd).conic_rows()
+            y = np.concatenate([svec_matrix(z_block) for z_block in res.Z])
+            proof = check_farkas(a_rows, b, [("psd", k) for k in orders], y)
+            status = INFEASIBLE if proof.ok else NUMERICAL_ERROR
+            word = res.solver_status or res.status
+            return _Solved(status, word, None, res.iterations, res.solve_time, proof)
         return _Solved(res.status, res.solver_status or res.status, res.x, res.iterations, res.solve_time)
 
     def _clarabel_data(self, fd: FormData) -> tuple[np.ndarray, np.ndarray, list[int]]:
@@ -350,8 +374,8 @@ class FormProblem:
             prog = self._symbolic(fd)
             z = cp.Variable(self.layout.size)
             params, cons = [], []
-            for block in prog.blocks.values():
-                coef = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+            for name in prog.blocks:
+                coef = prog.solver_coef(name)  # the data the other back-ends get
                 k = coef.shape[1]
                 const = cp.Parameter((k, k), symmetric=True)
                 lin = coef[1:].reshape(self.layout.size, k * k).T @ z
@@ -383,7 +407,8 @@ class FormProblem:
         backend = self.backend if self.backend != "cvxpy" else "cvxpy:CLARABEL"
         if solved.z is None or not np.all(np.isfinite(solved.z)):
             return LMISolution(solved.status, np.nan, None, None, None, solved.solve_time, solved.iterations,
-                               solved.solver_status, None, backend, x)
+                               solved.solver_status, None, backend, x,
+                               solved.infeasibility if solved.status == INFEASIBLE else None)
         values = self._original(self.layout.values(solved.z))
         # the certificate: every block recomputed at the answer, original coordinates, x / ||x||
         check = write(Program(self.layout, values), self.options,
@@ -428,7 +453,7 @@ class FormProblem:
         t = self._t
         out = {}
         for name, val in values.items():
-            if name == "G" or name.startswith("Q"):
+            if name == "G" or name[0] in "QW":  # G, Q, Q_j and the shared W
                 out[name] = t[:, None] * val * t[None, :]
             elif name in ("Y", "Z"):
                 out[name] = val * t[None, :]

@@ -114,7 +114,7 @@ class Program:
         self._values = dict(values or {})
         self.n_vars = 0 if self.numeric else layout.size
         self.blocks: dict[str, AffineMatrix] = {}
-        self._floors: dict[str, float] = {}
+        self._congruences: dict[str, np.ndarray] = {}
 
     def var(self, name: str) -> AffineMatrix:
         if not self.numeric:
@@ -130,42 +130,56 @@ class Program:
     def eye(self, size: int, scale: float = 1.0) -> AffineMatrix:
         return self.const(scale * np.eye(size))
 
+    def zeros(self, rows: int, cols: int) -> AffineMatrix:
+        return AffineMatrix.zeros(rows, cols, self.n_vars)
+
+    def times(self, scalar: AffineMatrix, matrix: np.ndarray) -> AffineMatrix:
+        """A ``1 x 1`` expression times a constant matrix."""
+        return AffineMatrix(np.kron(scalar.coef, np.atleast_2d(matrix)))
+
     def bmat(self, rows: list[list[AffineMatrix | None]]) -> AffineMatrix:
         return AffineMatrix.bmat(rows, self.n_vars)
 
-    def add(self, name: str, block: AffineMatrix, floor: float = 0.0) -> None:
+    def add(self, name: str, block: AffineMatrix, congruence: np.ndarray | None = None) -> None:
         """Require ``block >= 0`` (its symmetric part).
 
-        ``floor``: the certificate divides the block's smallest eigenvalue by its largest absolute
-        eigenvalue or by ``floor``, whichever is larger (a scalar block ``s >= 0`` needs a scale
-        of its own: relative to itself its margin is only ever ``+1`` or ``-1``).
+        ``congruence``: an invertible ``L``; the solvers get ``L M L'`` (the same LMI, better
+        conditioned), and the certificate checks both ``M`` and ``L M L'`` (``name + "_delta"``).
         """
         if name in self.blocks:
             raise ValueError(f"block {name!r} added twice")
         self.blocks[name] = block
-        if floor > 0.0:
-            self._floors[name] = floor
+        if congruence is not None:
+            self._congruences[name] = congruence
+
+    def solver_coef(self, name: str) -> np.ndarray:
+        """Block ``name``'s symmetric coefficients ``(n_vars + 1, k, k)`` as the solvers get them."""
+        coef = self.blocks[name].coef
+        lmat = self._congruences.get(name)
+        if lmat is not None:
+            coef = np.matmul(np.matmul(lmat, coef), lmat.T)
+        return 0.5 * (coef + np.swapaxes(coef, 1, 2))
 
     # -- what the solvers read -----------------------------------------------------------
     def solver_blocks(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """``(C_j, A_j)`` with ``M_j(z) = C_j - sum_i z_i A_ij`` (:class:`lmi.BlockLMISolver`)."""
         out = []
-        for block in self.blocks.values():
-            coef = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
+        for name in self.blocks:
+            coef = self.solver_coef(name)
             out.append((coef[0], -coef[1:]))
         return out
 
     def constants(self) -> list[np.ndarray]:
-        """The symmetric constant part of each block (a numeric program: the blocks' values)."""
-        return [0.5 * (b.coef[0] + b.coef[0].T) for b in self.blocks.values()]
+        """The constant part of each block as the solvers get it (a numeric program: the blocks'
+        values)."""
+        return [self.solver_coef(name)[0] for name in self.blocks]
 
     def conic_rows(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
         """``(A, b, orders)`` with ``svec(M_j(z)) = b_j - A_j z`` stacked over the blocks
         (Clarabel's ``PSDTriangleConeT`` convention)."""
         a_rows, b_rows, orders = [], [], []
-        for block in self.blocks.values():
-            sym = 0.5 * (block.coef + np.swapaxes(block.coef, 1, 2))
-            sv = svec_matrix(sym)
+        for name, block in self.blocks.items():
+            sv = svec_matrix(self.solver_coef(name))
             a_rows.append(-sv[1:].T)
             b_rows.append(sv[0])
             orders.append(block.shape[0])
@@ -173,17 +187,19 @@ class Program:
 
     def margins(self) -> dict[str, float]:
         """Of a numeric program: each block's smallest eigenvalue relative to its largest."""
-        return {
-            name: relative_margin(b.coef[0], self._floors.get(name, 0.0)) for name, b in self.blocks.items()
-        }
+        out = {}
+        for name, block in self.blocks.items():
+            out[name] = relative_margin(block.coef[0])
+            if name in self._congruences:
+                out[name + "_delta"] = relative_margin(self.solver_coef(name)[0])
+        return out
 
 
-def relative_margin(mat: np.ndarray, floor: float = 0.0) -> float:
-    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue (or
-    by ``floor`` if that is larger)."""
+def relative_margin(mat: np.ndarray) -> float:
+    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue."""
     sym = 0.5 * (mat + mat.T)
     if not np.all(np.isfinite(sym)):
         return -np.inf
     lam = np.linalg.eigvalsh(sym)
-    scale = max(float(np.max(np.abs(lam))), floor, np.finfo(float).tiny)
+    scale = max(float(np.max(np.abs(lam))), np.finfo(float).tiny)
     return float(lam[0] / scale)

@@ -1,0 +1,440 @@
+"""An independent cvxpy construction of the robust MPC forms (a test helper, not production code).
+
+Written from the statements of the papers and the LMIs of ``docs/rmpc_forms.rst``, with cvxpy
+variables built directly from the raw vertex matrices (nothing from :mod:`lmi` or :mod:`rmpc`):
+
+- Kothare, Balakrishnan & Morari, "Robust constrained model predictive control using linear
+  matrix inequalities", Automatica 32(10), 1996 (``lyapunov="common"``).
+- Cuzzola, Geromel & Morari, "An improved approach for constrained robust model predictive
+  control", Automatica 38(7), 2002, and Mao, "Robust stabilization of uncertain time-varying
+  discrete systems and comments on 'an improved approach for constrained robust model predictive
+  control'", Automatica 39(6), 2003 (``"vertex"``, ``"vertex_pairs"``: one ``Q_j`` per vertex and
+  a slack ``G``, the Lyapunov matrix ``Q_j^-1`` and ``F = Y G^-1``).
+- Wan & Kothare, "Efficient robust constrained model predictive control with a time varying
+  terminal constraint set", Systems & Control Letters 48, 2003 (``cost="nominal"``).
+- Cao & Lin, "Min-max MPC algorithm for LPV systems subject to input saturation", IEE
+  Proceedings - Control Theory and Applications 152(3), 2005 (``saturation="auxiliary"``).
+- Oravec & Bakošová's soft-constrained robust MPC, 2016 (``soft``).
+
+:func:`reference_gamma` returns the status, the bound and the variables, together with every LMI
+evaluated at the returned point (``variables["lmis"]``) and the smallest eigenvalue of each,
+relative to its norm (``variables["residual"]``, the worst over all LMIs): a test trusts the
+reference's gamma only where that residual says Clarabel's answer satisfies its own LMIs.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any
+
+import cvxpy as cp
+import numpy as np
+import scipy.optimize
+
+
+def _psd_sqrt(M: np.ndarray) -> np.ndarray:
+    w, V = np.linalg.eigh((M + M.T) / 2)
+    return (V * np.sqrt(np.clip(w, 0.0, None))) @ V.T
+
+
+def _symmetrised(M: Any) -> np.ndarray:
+    M = np.asarray(M, float)
+    return (M + M.T) / 2
+
+
+def _r(expr: Any, shape: tuple[int, int]) -> Any:
+    return cp.reshape(expr, shape, order="C")
+
+
+def _sym(M: Any) -> Any:
+    """Symmetric part of a block expression that is symmetric by construction (for cvxpy)."""
+    return (M + M.T) / 2
+
+
+def relative_min_eig(M: np.ndarray) -> float:
+    """Smallest eigenvalue of the symmetric part of ``M`` over ``max(1, ||M||_2)``."""
+    S = (M + M.T) / 2
+    return float(np.linalg.eigvalsh(S)[0] / max(1.0, np.linalg.norm(S, 2)))
+
+
+def reference_gamma(
+    A_list: list[np.ndarray],
+    B_list: list[np.ndarray],
+    Q1: np.ndarray,
+    R: np.ndarray,
+    x: np.ndarray,
+    *,
+    u_max: float | np.ndarray,
+    input_constraint: str = "peak",
+    lyapunov: str = "common",
+    cost: str = "worst_case",
+    nominal: tuple[np.ndarray, np.ndarray] | None = None,
+    free_moves: int = 0,
+    saturation: str | None = None,
+    soft: dict[str, float] | None = None,
+    disturbance: tuple | None = None,
+    output_matrix: np.ndarray | None = None,
+    y_max: float | np.ndarray | None = None,
+    solver: str = "CLARABEL",
+    solver_options: dict[str, Any] | None = None,
+    level: float | None = None,
+    at: dict[str, Any] | None = None,
+) -> tuple[str, float, dict[str, Any]]:
+    """Solve one robust MPC form in cvxpy from raw matrices.
+
+    Parameters
+    ----------
+    A_list, B_list : list of ndarray
+        The vertices ``(A_i, B_i)``.
+    Q1, R : ndarray
+        State and input weights.
+    x : ndarray
+        The measured state.
+    u_max : float or ndarray
+        Input bound (per input for ``"peak"``).
+    input_constraint : {"peak", "ellipsoid"}
+    lyapunov : {"common", "vertex", "vertex_pairs"}
+    cost : {"worst_case", "nominal"}
+    nominal : (A0, B0), optional
+        The nominal model (needed with ``cost="nominal"``).
+    free_moves : {0, 1}
+    saturation : {None, "auxiliary"}
+    soft : dict, optional
+        ``{"u": w_u, "y": w_y}`` (either key may be absent).
+    disturbance : tuple, optional
+        ``(E, w_max)`` or ``(E, w_max, lam)``; without ``lam`` the contraction factor is searched
+        (bounded scalar minimisation of gamma over ``(0, 1)``).
+    output_matrix, y_max : ndarray, optional
+        Output bound ``|c_r x(k+1)| <= y_max,r``.
+    solver : str
+        A cvxpy solver name.
+    solver_options : dict, optional
+        Passed to ``problem.solve``.
+    level : float, optional
+        Instead of minimising the objective, keep it ``<= level`` and maximise the smallest
+        eigenvalue ``margin`` of every LMI (used by :func:`reference_upper`).
+    at : dict, optional
+        Do not solve: evaluate every LMI at these values (``gamma`` (the whole bound), ``Y``,
+        ``Q`` or ``G`` and ``Q_vertices``, ``Z``, ``u0``, ``slack``) and return status
+        ``"evaluated"`` with ``lmis``, ``residual`` and ``abs_min_eig``.
+
+    Returns
+    -------
+    status : str
+        cvxpy's status.
+    gamma : float
+        The bound on the cost (``s0 + gamma`` with a free move), ``nan`` when not solved.
+    variables : dict
+        ``F``, ``Y``, ``G``, ``Q`` (list of ``Q_j``), ``Z``, ``H``, ``u0``, ``slack``, ``lam``,
+        ``objective``, ``lmis`` (each LMI at the solution), ``residual`` (the worst relative
+        smallest eigenvalue over them), ``abs_min_eig`` (the worst absolute one) and ``margin``
+        (with ``level``).
+    """
+    if disturbance is not None and len(disturbance) == 2 and float(disturbance[1]) > 0.0 and at is None:
+        E, w_max = disturbance
+
+        def at(lam: float) -> tuple[str, float, dict[str, Any]]:
+            return reference_gamma(
+                A_list, B_list, Q1, R, x, u_max=u_max, input_constraint=input_constraint,
+                lyapunov=lyapunov, cost=cost, nominal=nominal, free_moves=free_moves,
+                saturation=saturation, soft=soft, disturbance=(E, w_max, lam),
+                output_matrix=output_matrix, y_max=y_max, solver=solver, solver_options=solver_options,
+            )
+
+        def objective(lam: float) -> float:
+            status, _, var = at(lam)
+            return var["objective"] if status == "optimal" else 1e12
+
+        # a coarse grid first (gamma(lam) is not known to be unimodal), then a local refinement
+        grid = np.linspace(0.02, 0.98, 25)
+        values = [objective(lam) for lam in grid]
+        k = int(np.argmin(values))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+        res = scipy.optimize.minimize_scalar(objective, bounds=(lo, hi), method="bounded",
+                                             options={"xatol": 1e-5})
+        best = float(res.x) if res.fun <= values[k] else float(grid[k])
+        return at(best)
+
+    A_list = [np.atleast_2d(np.asarray(a, float)) for a in A_list]
+    B_list = [np.asarray(b, float).reshape(A_list[0].shape[0], -1) for b in B_list]
+    n, m = B_list[0].shape
+    N = len(A_list)
+    x = np.asarray(x, float).reshape(n)
+    Q1h = _psd_sqrt(np.atleast_2d(np.asarray(Q1, float)))
+    Rh = _psd_sqrt(np.atleast_2d(np.asarray(R, float)))
+    umax = np.broadcast_to(np.asarray(u_max, float), (m,)).copy()
+    soft = dict(soft or {})
+
+    gamma = cp.Variable(name="gamma")
+    Y = cp.Variable((m, n), name="Y")
+    if lyapunov == "common":
+        Qc = cp.Variable((n, n), symmetric=True, name="Q")
+        G = Qc
+        Qs = [Qc]
+        T = [Qc] * N
+        pairs = [(i, 0) for i in range(N)]
+    else:
+        G = cp.Variable((n, n), name="G")
+        Qs = [cp.Variable((n, n), symmetric=True, name=f"Q{j}") for j in range(N)]
+        T = [G + G.T - Qj for Qj in Qs]
+        if lyapunov == "vertex":
+            pairs = [(i, i) for i in range(N)]
+        elif lyapunov == "vertex_pairs":
+            pairs = [(i, j) for i in range(N) for j in range(N)]
+        else:
+            raise ValueError(lyapunov)
+
+    Z = None
+    if saturation == "auxiliary":
+        Z = cp.Variable((m, n), name="Z")
+        Ys = []
+        for bits in itertools.product((0.0, 1.0), repeat=m):
+            D = np.diag(bits)
+            Ys.append(D @ Y + (np.eye(m) - D) @ Z)
+    elif saturation is None:
+        Ys = [Y]
+    else:
+        raise ValueError(saturation)
+
+    s_u = cp.Variable(nonneg=True, name="s_u") if "u" in soft else None
+    s_y = cp.Variable(nonneg=True, name="s_y") if "y" in soft else None
+
+    lmis: list[Any] = []
+
+    def cost_lmi(A: np.ndarray, B: np.ndarray, Ti: Any, Qj: Any, Yk: Any) -> Any:
+        AGBY = A @ G + B @ Yk
+        return cp.bmat([
+            [Ti, AGBY.T, G.T @ Q1h, Yk.T @ Rh],
+            [AGBY, Qj, np.zeros((n, n)), np.zeros((n, m))],
+            [Q1h @ G, np.zeros((n, n)), gamma * np.eye(n), np.zeros((n, m))],
+            [Rh @ Yk, np.zeros((m, n)), np.zeros((m, n)), gamma * np.eye(m)],
+        ])
+
+    if cost == "worst_case":
+        for i, j in pairs:
+            for Yk in Ys:
+                lmis.append(cost_lmi(A_list[i], B_list[i], T[i], Qs[j], Yk))
+    elif cost == "nominal":
+        if lyapunov != "common" or nominal is None:
+            raise ValueError("nominal cost needs the common form and a nominal model")
+        A0, B0 = (np.asarray(nominal[0], float), np.asarray(nominal[1], float).reshape(n, m))
+        for Yk in Ys:
+            lmis.append(cost_lmi(A0, B0, T[0], Qs[0], Yk))
+            for i in range(N):
+                AQBY = A_list[i] @ G + B_list[i] @ Yk
+                lmis.append(cp.bmat([[Qs[0], AQBY.T], [AQBY, Qs[0]]]))
+    else:
+        raise ValueError(cost)
+
+    objective = gamma
+    u0 = None
+    if free_moves == 0:
+        for Qj in Qs:
+            lmis.append(cp.bmat([[np.ones((1, 1)), x[None, :]], [x[:, None], Qj]]))
+    elif free_moves == 1:
+        u0 = cp.Variable(m, name="u0")
+        s0 = cp.Variable(name="s0")
+        lmis.append(cp.bmat([
+            [_r(s0 - float(x @ Q1 @ x), (1, 1)), _r(Rh @ u0, (1, m))],
+            [_r(Rh @ u0, (m, 1)), np.eye(m)],
+        ]))
+        objective = objective + s0
+        for i, j in pairs:
+            xp = _r(A_list[i] @ x + B_list[i] @ u0, (n, 1))
+            lmis.append(cp.bmat([[np.ones((1, 1)), xp.T], [xp, Qs[j]]]))
+        # the bound on u0
+        if input_constraint == "ellipsoid":
+            top = float(umax[0] ** 2) + (s_u if s_u is not None else 0.0)
+            lmis.append(cp.bmat([[_r(top, (1, 1)), _r(u0, (1, m))],
+                                 [_r(u0, (m, 1)), np.eye(m)]]))
+        else:
+            for k in range(m):
+                top = float(umax[k] ** 2) + (s_u if s_u is not None else 0.0)
+                lmis.append(cp.bmat([[_r(top, (1, 1)), _r(u0[k], (1, 1))],
+                                     [_r(u0[k], (1, 1)), np.ones((1, 1))]]))
+    else:
+        raise ValueError(free_moves)
+
+    # the bounds on the feedback law's input (Z with saturation), for every Lyapunov matrix
+    Yb = Z if Z is not None else Y
+    for Tj in T[: len(Qs)]:
+        if input_constraint == "ellipsoid":
+            top = float(umax[0] ** 2) * np.eye(m) + (s_u * np.eye(m) if s_u is not None else 0.0)
+            lmis.append(cp.bmat([[top, Yb], [Yb.T, Tj]]))
+        elif input_constraint == "peak":
+            for k in range(m):
+                top = float(umax[k] ** 2) + (s_u if s_u is not None else 0.0)
+                yl = _r(Yb[k, :], (1, n))
+                lmis.append(cp.bmat([[_r(top, (1, 1)), yl], [yl.T, Tj]]))
+        else:
+            raise ValueError(input_constraint)
+
+    E = w_max = lam = None
+    if disturbance is not None:
+        E = np.asarray(disturbance[0], float).reshape(n, -1)
+        w_max = float(disturbance[1])
+        lam = float(disturbance[2]) if len(disturbance) > 2 else 1.0
+        if at is not None and at.get("lam") is not None:
+            lam = float(at["lam"])
+
+    if output_matrix is not None:
+        C = np.atleast_2d(np.asarray(output_matrix, float))
+        p = C.shape[0]
+        ymax = np.broadcast_to(np.asarray(y_max, float), (p,)).copy()
+        if E is not None and w_max:
+            ymax = ymax - np.linalg.norm(C @ E, axis=1) * w_max
+        for r in range(p):
+            top = float(ymax[r] ** 2) + (s_y if s_y is not None else 0.0)
+            for i in range(N):
+                for Yk in Ys:
+                    row = _r(C[r] @ (A_list[i] @ G + B_list[i] @ Yk), (1, n))
+                    lmis.append(cp.bmat([[_r(top, (1, 1)), row], [row.T, T[i]]]))
+                if free_moves == 1:
+                    yp = _r(C[r] @ (A_list[i] @ x + B_list[i] @ u0), (1, 1))
+                    lmis.append(cp.bmat([[_r(top, (1, 1)), yp], [yp, np.ones((1, 1))]]))
+
+    if E is not None and w_max > 0.0:
+        q = E.shape[1]
+        inv_pairs = pairs if cost == "worst_case" else [(i, 0) for i in range(N)]
+        for i, j in inv_pairs:
+            for Yk in Ys:
+                AGBY = A_list[i] @ G + B_list[i] @ Yk
+                lmis.append(cp.bmat([
+                    [lam * T[i], np.zeros((n, q)), AGBY.T],
+                    [np.zeros((q, n)), (1.0 - lam) * np.eye(q), w_max * E.T],
+                    [AGBY, w_max * E, Qs[j]],
+                ]))
+
+    if s_u is not None:
+        objective = objective + float(soft["u"]) * s_u
+    if s_y is not None:
+        objective = objective + float(soft["y"]) * s_y
+
+    if at is not None:
+        # evaluate every LMI at given values (a numpy check of another solver's answer)
+        gamma.value = float(at["gamma"])
+        Y.value = np.asarray(at["Y"], float).reshape(m, n)
+        if lyapunov == "common":
+            Qs[0].value = _symmetrised(at["Q"])
+        else:
+            G.value = np.asarray(at["G"], float)
+            for Qj, val in zip(Qs, at["Q_vertices"], strict=True):
+                Qj.value = _symmetrised(val)
+        if Z is not None:
+            Z.value = np.asarray(at["Z"], float).reshape(m, n)
+        if u0 is not None:
+            u0.value = np.asarray(at["u0"], float).reshape(m)
+            s0.value = float(x @ Q1 @ x + u0.value @ R @ u0.value)
+            gamma.value = float(at["gamma"]) - float(s0.value)
+        for key, var in (("u", s_u), ("y", s_y)):
+            if var is not None:
+                var.value = max(0.0, float(at["slack"][key]))
+        values = [np.asarray(M.value) for M in lmis]
+        return "evaluated", float(at["gamma"]), {
+            "lmis": values, "residual": min(relative_min_eig(M) for M in values),
+            "abs_min_eig": min(float(np.linalg.eigvalsh((M + M.T) / 2)[0]) for M in values),
+        }
+
+    margin = None
+    if level is None:
+        problem = cp.Problem(cp.Minimize(objective), [_sym(M) >> 0 for M in lmis])
+    else:
+        margin = cp.Variable(name="margin")
+        problem = cp.Problem(
+            cp.Maximize(margin),
+            [_sym(M) - margin * np.eye(M.shape[0]) >> 0 for M in lmis] + [objective <= level, margin <= 1.0],
+        )
+    try:
+        problem.solve(solver=solver, **(solver_options or {}))
+        status = problem.status
+    except cp.error.SolverError as exc:  # pragma: no cover - reported, not raised
+        status = f"solver_error: {exc}"
+    if status not in ("optimal", "optimal_inaccurate"):
+        return status, float("nan"), {"objective": float("nan"), "residual": -np.inf}
+
+    Gv = np.asarray(G.value)
+    F = np.asarray(Y.value) @ np.linalg.inv(Gv)
+    values = [np.asarray(M.value) for M in lmis]
+    total = float(gamma.value) + (float(s0.value) if free_moves == 1 else 0.0)
+    variables = {
+        "F": F,
+        "Y": np.asarray(Y.value),
+        "G": Gv,
+        "Q": [np.asarray(Qj.value) for Qj in Qs],
+        "Z": None if Z is None else np.asarray(Z.value),
+        "H": None if Z is None else np.asarray(Z.value) @ np.linalg.inv(Gv),
+        "u0": None if u0 is None else np.asarray(u0.value),
+        "gamma_feedback": float(gamma.value),
+        "slack": {k: float(v.value) for k, v in (("u", s_u), ("y", s_y)) if v is not None},
+        "lam": lam,
+        "objective": float(objective.value),
+        "margin": None if margin is None else float(margin.value),
+        "abs_min_eig": min(float(np.linalg.eigvalsh((M + M.T) / 2)[0]) for M in values),
+        "lmis": values,
+        "residual": min(relative_min_eig(M) for M in values),
+    }
+    return status, total, variables
+
+
+def reference_upper(*args: Any, rtol: float = 1e-7, max_steps: int = 40, **kwargs: Any) -> float:
+    """The smallest level found at which the form has a strictly feasible point, checked in numpy.
+
+    Bisection between Clarabel's minimum (not trusted: its point may violate the LMIs slightly)
+    and a level at which the maximal-margin problem returns a point where every LMI has a
+    positive smallest eigenvalue and the objective is below the level: the optimum is ``<=`` the
+    returned value whatever the solver's accuracy. Arguments as :func:`reference_gamma` (with
+    ``lam`` given for a disturbance).
+    """
+    status, g0, _ = reference_gamma(*args, **kwargs)
+    if not np.isfinite(g0):
+        raise RuntimeError(f"reference not solved: {status}")
+
+    def certified(level: float) -> bool:
+        status, _, var = reference_gamma(*args, level=level, **kwargs)
+        ok = status in ("optimal", "optimal_inaccurate")
+        return ok and var["abs_min_eig"] > 0.0 and var["objective"] <= level
+
+    lo, hi = g0, g0
+    for k in range(30):
+        if certified(hi):
+            break
+        lo = hi
+        hi = g0 + max(abs(g0), 1e-12) * 1e-6 * 2.0**k
+    else:
+        raise RuntimeError("no certified level")
+    for _ in range(max_steps):
+        if hi - lo <= rtol * abs(hi):
+            break
+        mid = 0.5 * (lo + hi)
+        if certified(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def solution_values(sol: Any) -> dict[str, Any]:
+    """The variables of an :class:`lmi.LMISolution` in the form ``reference_gamma(at=...)`` takes."""
+    G = sol.G if sol.G is not None else sol.Q
+    return {
+        "gamma": sol.gamma, "Y": sol.Y, "Q": sol.Q, "G": sol.G, "Q_vertices": sol.Q_vertices,
+        "Z": None if sol.H is None else sol.H @ G, "u0": sol.u0, "slack": sol.slack, "lam": sol.lam,
+    }
+
+
+def realised_cost(
+    A_seq: list[np.ndarray], B_seq: list[np.ndarray], Q1: np.ndarray, R: np.ndarray, x0: np.ndarray,
+    law: Any,
+) -> tuple[float, float, np.ndarray]:
+    """Closed-loop cost ``sum x' Q1 x + u' R u`` along a given plant sequence, the largest ``|u|``
+    (componentwise) and the final state; ``law(x, k)`` returns the input."""
+    x = np.asarray(x0, float)
+    total = 0.0
+    u_peak = 0.0
+    for k, (A, B) in enumerate(zip(A_seq, B_seq, strict=True)):
+        u = np.atleast_1d(law(x, k))
+        total += float(x @ Q1 @ x + u @ R @ u)
+        u_peak = max(u_peak, float(np.max(np.abs(u))))
+        x = A @ x + B @ u
+    return total, u_peak, x
+
