@@ -190,6 +190,64 @@ _SUITES: dict[str, tuple[str, str, str, str, str, str]] = {
 }
 
 
+def _names(text: str) -> list[str]:
+    parts = [part.strip() for part in text.split(",")]
+    if not text.strip() or any(not part for part in parts):
+        raise argparse.ArgumentTypeError(f"expected names separated by commas, found {text!r}")
+    return parts
+
+
+def _cmd_bench_methods(args: argparse.Namespace) -> int:
+    from benchmarks.suites.methods import run_methods
+
+    outcome = run_methods(
+        args.out,
+        short=args.short,
+        problems=args.problems,
+        methods=args.methods,
+        progress=None if not args.no_progress else False,
+        fresh=args.fresh,
+    )
+    ex = outcome.execution
+    if ex is not None and ex.interrupted:
+        print(
+            f"rmpc: interrupted; {len(ex.unfinished)} cases not run; re-run the same command to resume",
+            file=sys.stderr,
+        )
+    return _report_suite("methods", outcome, args.out)
+
+
+def _add_methods(bsub: Any) -> None:
+    from benchmarks.suites.methods import METHODS
+    from benchmarks.suites.methods_problems import PROBLEMS
+
+    methods = bsub.add_parser(
+        "methods",
+        help="the robust MPC forms head to head on the field's test problems",
+        description="Solve every test problem (Kothare's examples 1 and 2, MUP's demo system, paper P's "
+        "satellite at 2 and 8 vertices, paper W's wheel satellite, the 14-state flexible model) with every "
+        "form of RMPC (" + ", ".join(METHODS) + "): gamma at the start state, the feasible region along "
+        "fixed directions, the closed-loop cost, solve times next to cvxpy + Clarabel, statuses. Writes "
+        "results.json, results.md, results.csv, run.json, figures/*.png and cases/*.json (each finished "
+        "case; re-running the same command resumes). Exit status: 0 all done, 1 some cases failed, "
+        "2 bad input, 130 interrupted.",
+    )
+    methods.add_argument("--out", required=True, type=_out_dir, metavar="DIR", help="output directory")
+    methods.add_argument(
+        "--short", action="store_true", help="a smoke run (four small problems, few directions, short loops)"
+    )
+    methods.add_argument(
+        "--problems", type=_names, default=None, metavar=",".join(list(PROBLEMS)[:2]) + ",...",
+        help="run only these problems (" + ", ".join(PROBLEMS) + ")",
+    )
+    methods.add_argument(
+        "--methods", type=_names, default=None, metavar="kothare,vertex,...", help="run only these methods"
+    )
+    methods.add_argument("--fresh", action="store_true", help="ignore the cases stored by an earlier run")
+    methods.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    methods.set_defaults(func=_cmd_bench_methods)
+
+
 def _add_suite(bsub: Any, name: str, workers_help: str) -> None:
     module, runner, help_text, description, short_help, metavar = _SUITES[name]
     status = "Exit status: 0 all done, 1 some cases failed, 2 bad input, 130 interrupted."
@@ -254,7 +312,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         "of scenarios.",
     )
     bsub = bench.add_subparsers(
-        dest="bench_command", required=True, metavar="{paper,faults,mrp,flexible,sweep}"
+        dest="bench_command", required=True, metavar="{paper,faults,mrp,flexible,methods,sweep}"
     )
     workers_help = "worker processes on this machine (default: one per CPU; 0: run in this process)"
     paper = bsub.add_parser(
@@ -293,6 +351,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
 
     for name in _SUITES:
         _add_suite(bsub, name, workers_help)
+    _add_methods(bsub)
 
     sweep = bsub.add_parser(
         "sweep",

@@ -1,0 +1,854 @@
+"""The benchmark suite "methods": the field's robust MPC forms head to head (``rmpc bench methods``).
+
+Every problem of :mod:`benchmarks.suites.methods_problems` is solved by every form of
+:class:`rmpc.RMPC` in :data:`METHODS`; one record per problem and method holds
+
+- ``status``, ``gamma``, ``iterations`` of the solve at the start state ``x0``;
+- ``region``: the largest feasible multiple ``t`` of fixed directions (``t d`` certified
+  ``"optimal"``; the directions have the scaled size of ``x0``, the first is ``x0`` itself, so
+  ``t = 1`` reaches as far as the start state), found by bracketing and bisection;
+- ``closed_loop_cost``: ``sum x'Q x + u'R u`` over the problem's horizon on its fixed plant (the
+  nominal model), applying ``ctrl.step``; ``closed_loop_cost_switching`` on a seeded sequence
+  of vertices;
+- ``solve_time_p50`` / ``solve_time_p95``: wall time of the steps that solved (``time.perf_counter``
+  around ``ctrl.step``, certification included), and ``cvxpy_time_p50``: wall time of
+  ``ctrl.solve`` with ``backend="cvxpy"`` (the same LMIs through cvxpy + Clarabel) on the first
+  states of the closed loop, next to the toolkit's ipm on the same states;
+- ``status_counts`` of the closed-loop steps and ``skip_reason`` where a method does not apply.
+
+Each finished record is stored in ``DIR/cases/`` at once; running the same command again skips
+them (``fresh=True`` starts over), so an interrupted run resumes. :func:`run_methods` writes
+``results.json``, ``results.md``, ``results.csv``, ``run.json`` and ``figures/*.png``.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from benchmarks.core.execute import ExecOutcome
+from benchmarks.core.jsonable import json_safe
+from benchmarks.core.progress import CaseProgress
+from benchmarks.core.suite import SuiteOutcome, write_records, write_rows_csv, write_run_info
+from benchmarks.suites.methods_problems import PROBLEMS, SHORT_PROBLEMS, MethodsProblem, build_problem
+from toolkit_common.errors import ConfigError
+
+__all__ = ["METHODS", "MethodsSettings", "evaluate", "method_options", "run_methods"]
+
+#: Method -> what it is (the options of :class:`rmpc.RMPC` are in :func:`method_options`).
+METHODS: dict[str, str] = {
+    "kothare": "Kothare, Balakrishnan & Morari 1996: one Lyapunov matrix, worst-case cost (the defaults)",
+    "vertex": "Cuzzola, Geromel & Morari 2002: one Q_j per vertex and a slack G (constant uncertainty)",
+    "vertex_pairs": "Mao 2003: Q_j per vertex over every vertex pair (uncertainty may switch each sample)",
+    "nominal": "Wan & Kothare 2003: cost bound on the nominal model, robust invariance on every vertex",
+    "free_move": "one free first move u(k), the feedback law from k+1 on",
+    "auxiliary_saturation": "Cao & Lin 2005: u = sat(F x) with an auxiliary gain H carrying the peak bound",
+    "soft": "Oravec & Bakosova 2016: soft input (and output) bounds with linear slack penalties",
+    "disturbance": "bounded disturbance E w, ||w|| <= w_max: an invariant ellipsoid under it",
+}
+
+#: The soft method's slack weights.
+SOFT_WEIGHT: float = 1e3
+
+#: Methods whose ``gamma`` bounds the worst-case cost (the nominal form bounds the nominal one, the
+#: soft form adds the slack price): the ones ranked by gamma.
+GAMMA_COMPARABLE: tuple[str, ...] = ("kothare", "vertex", "vertex_pairs", "free_move", "auxiliary_saturation")
+
+#: Relative difference below which two methods tie in the report's ranking.
+TIE_TOLERANCE: float = 0.001
+
+#: Version of the record layout; a stored case of another version is run again.
+RECORD_VERSION = 1
+
+
+@dataclass(frozen=True)
+class MethodsSettings:
+    """How much the suite measures per case (full run or ``--short``).
+
+    Attributes
+    ----------
+    directions_2d, directions : int
+        Region directions for 2-state problems (evenly spaced angles, drawn as a picture) and for
+        the others (``x0`` and seeded random directions).
+    rel_tol : float
+        Relative width at which the bisection of ``t`` stops.
+    t_max : float
+        The largest multiple tried (a region reaching it is reported as ``>= t_max``).
+    steps_factor : float
+        Fraction of each problem's closed-loop horizon.
+    cvxpy_states : int
+        How many closed-loop states are also solved by cvxpy + Clarabel.
+    slow_solve_s : float
+        A method whose solve at ``x0`` takes longer skips the region and the closed loop (recorded).
+    region_budget_s, loop_budget_s, cvxpy_budget_s : float
+        Wall-time budgets of the region, the two closed loops together and the cvxpy solves: a
+        phase that runs past its budget stops, and the record says where (``notes``; a region or a
+        cost that is not complete is ``None``).
+    seed : int
+        Seed of the random directions and the switching sequence.
+    """
+
+    directions_2d: int = 24
+    directions: int = 6
+    rel_tol: float = 0.02
+    t_max: float = 1024.0
+    steps_factor: float = 1.0
+    cvxpy_states: int = 3
+    slow_solve_s: float = 20.0
+    region_budget_s: float = 240.0
+    loop_budget_s: float = 240.0
+    cvxpy_budget_s: float = 60.0
+    seed: int = 0
+
+    @classmethod
+    def short(cls) -> MethodsSettings:
+        """The settings of ``--short``: a smoke run that checks the set-up."""
+        return cls(
+            directions_2d=6,
+            directions=2,
+            rel_tol=0.1,
+            t_max=64.0,
+            steps_factor=0.25,
+            cvxpy_states=1,
+            slow_solve_s=5.0,
+            region_budget_s=15.0,
+            loop_budget_s=15.0,
+            cvxpy_budget_s=10.0,
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """The settings as a plain dict (stored with every record)."""
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+def method_options(problem: MethodsProblem, method: str) -> tuple[dict[str, Any] | None, str | None, bool]:
+    """The options of :class:`rmpc.RMPC` for ``method`` on ``problem``.
+
+    Returns
+    -------
+    options : dict or None
+        Keyword arguments added to the problem's own (``None`` when the method is skipped).
+    skip_reason : str or None
+        Why the method does not apply to the problem.
+    comparable : bool
+        Whether the method solves the problem's own bounds (the auxiliary saturation needs a peak
+        bound: on a problem that bounds ``||u||_2`` it runs with ``|u_l| <= u_max`` instead).
+    """
+    if method not in METHODS:
+        raise ConfigError("method", "one of " + ", ".join(METHODS), repr(method))
+    if method == "kothare":
+        return {}, None, True
+    if method in ("vertex", "vertex_pairs"):
+        return {"lyapunov": method}, None, True
+    if method == "nominal":
+        return {"cost": "nominal"}, None, True
+    if method == "free_move":
+        return {"free_moves": 1}, None, True
+    if method == "auxiliary_saturation":
+        comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
+        return {"saturation": "auxiliary", "input_constraint": "peak"}, None, comparable
+    if method == "soft":
+        weights = {"u": SOFT_WEIGHT}
+        if problem.y_max is not None:
+            weights["y"] = SOFT_WEIGHT
+        return {"soft": weights}, None, True
+    e, w_max = problem.disturbance
+    if w_max <= 0.0:
+        return None, "the problem has no input bound to size the disturbance by", True
+    return {"disturbance": (e, w_max)}, None, True
+
+
+def _controller(problem: MethodsProblem, options: dict[str, Any], backend: str = "ipm") -> Any:
+    from rmpc import RMPC
+
+    kwargs: dict[str, Any] = {"input_constraint": problem.input_constraint, "backend": backend}
+    if problem.output_matrix is not None:
+        kwargs.update(output_matrix=problem.output_matrix, y_max=problem.y_max)
+    kwargs.update(options)
+    return RMPC(problem.plant, problem.Q, problem.R, u_max=problem.u_max, **kwargs)
+
+
+def _directions(problem: MethodsProblem, settings: MethodsSettings) -> np.ndarray:
+    """Unit-size directions (rows): the scaled size of ``x0``; the first is ``x0`` (n > 2)."""
+    scale = problem.region_scale
+    size = float(np.linalg.norm(problem.x0 / scale))
+    if problem.n_states == 2:
+        angles = np.linspace(0.0, 2.0 * np.pi, settings.directions_2d, endpoint=False)
+        base = np.arctan2(problem.x0[1] / scale[1], problem.x0[0] / scale[0])
+        v = np.stack([np.cos(base + angles), np.sin(base + angles)], axis=1)
+    else:
+        rng = np.random.default_rng(settings.seed)
+        v = rng.standard_normal((max(settings.directions - 1, 0), problem.n_states))
+        v = np.vstack([problem.x0 / scale, v])
+        v = v / np.linalg.norm(v, axis=1, keepdims=True)
+    return size * v * scale
+
+
+class _OverBudget(Exception):
+    """A phase of a case ran past its time budget."""
+
+
+def _feasible(ctrl: Any, x: np.ndarray, counts: dict[str, int], deadline: float, last: list[str]) -> bool:
+    if time.perf_counter() > deadline:
+        raise _OverBudget
+    sol = ctrl.solve(x)
+    counts[sol.status] = counts.get(sol.status, 0) + 1
+    if sol.status != "optimal":
+        last[0] = sol.status
+    return sol.status == "optimal"
+
+
+def region_along(
+    ctrl: Any, d: np.ndarray, settings: MethodsSettings, counts: dict[str, int], deadline: float = np.inf
+) -> tuple[float, str]:
+    """The largest multiple ``t`` (to ``rel_tol``) with ``t d`` certified feasible, and what stopped it.
+
+    Feasibility is star-shaped (the LMIs at ``t x`` with ``t < 1`` are met by the same variables),
+    so bracketing by doubling or halving from ``t = 1`` and bisecting finds the boundary. The
+    second value is the status of the last solve that failed above ``t`` (``"infeasible"``, a
+    solver failure word) or ``"cap"`` when ``t`` reached ``t_max``. Raises ``_OverBudget`` past
+    ``deadline`` (a ``time.perf_counter`` value).
+    """
+    last = ["cap"]
+    lo, hi = 0.0, 1.0
+    if _feasible(ctrl, d, counts, deadline, last):
+        lo = 1.0
+        while True:
+            hi = 2.0 * lo
+            if hi > settings.t_max:
+                return settings.t_max, "cap"
+            if not _feasible(ctrl, hi * d, counts, deadline, last):
+                break
+            lo = hi
+    else:
+        t = 1.0
+        while True:
+            t /= 2.0
+            if t < 1.0 / settings.t_max:
+                return 0.0, last[0]
+            if _feasible(ctrl, t * d, counts, deadline, last):
+                lo, hi = t, 2.0 * t
+                break
+    while hi - lo > settings.rel_tol * lo:
+        mid = 0.5 * (lo + hi)
+        if _feasible(ctrl, mid * d, counts, deadline, last):
+            lo = mid
+        else:
+            hi = mid
+    return lo, last[0]
+
+
+def _closed_loop(
+    ctrl: Any,
+    problem: MethodsProblem,
+    steps: int,
+    plants: Sequence[tuple[np.ndarray, np.ndarray]],
+    deadline: float = np.inf,
+) -> dict[str, Any]:
+    """Run ``ctrl.step`` on ``plants[k]`` for ``steps`` samples; cost, step times, statuses, states.
+
+    Past ``deadline`` the run stops: ``done`` < ``steps`` and the cost covers the steps run.
+    """
+    ctrl.reset()
+    x = problem.x0.copy()
+    cost = 0.0
+    times: list[float] = []
+    counts: dict[str, int] = {}
+    states = [x.copy()]
+    max_u = 0.0
+    done = 0
+    for k in range(steps):
+        if time.perf_counter() > deadline:
+            break
+        done = k + 1
+        start = time.perf_counter()
+        u = np.asarray(ctrl.step(x), dtype=float)
+        elapsed = time.perf_counter() - start
+        info = ctrl.last
+        status = str(info.status) if info is not None else "none"
+        counts[status] = counts.get(status, 0) + 1
+        if status != "reused":
+            times.append(elapsed)
+        cost += float(x @ problem.Q @ x + u @ problem.R @ u)
+        max_u = max(max_u, float(np.max(np.abs(u))))
+        a, b = plants[k]
+        x = a @ x + b @ u
+        states.append(x.copy())
+        if not np.all(np.isfinite(x)):
+            counts["diverged"] = counts.get("diverged", 0) + 1
+            cost = float("inf")
+            break
+    return {
+        "cost": cost,
+        "times": times,
+        "counts": counts,
+        "states": np.array(states),
+        "max_abs_u": max_u,
+        "final_norm": float(np.linalg.norm(states[-1])),
+        "done": done,
+    }
+
+
+def _percentile(values: Sequence[float], q: float) -> float | None:
+    return float(np.percentile(values, q)) if len(values) else None
+
+
+def _cvxpy_times(
+    problem: MethodsProblem, options: dict[str, Any], states: Sequence[np.ndarray], deadline: float = np.inf
+) -> dict[str, Any]:
+    """cvxpy + Clarabel on ``states`` next to the ipm on the same states (wall time of ``solve``)."""
+    out: dict[str, Any] = {"cvxpy_statuses": {}, "cvxpy_gamma": None, "cvxpy_error": None}
+    try:
+        ref = _controller(problem, options, backend="cvxpy")
+    except Exception as err:  # a form the cvxpy back-end does not build is a note, not a crash
+        out["cvxpy_error"] = f"{type(err).__name__}: {err}"
+        return out
+    ipm = _controller(problem, options)
+    cv_times, ipm_times = [], []
+    for i, x in enumerate(states):
+        if i and time.perf_counter() > deadline:
+            break
+        start = time.perf_counter()
+        with warnings.catch_warnings():  # cvxpy's "may be inaccurate": the status says it
+            warnings.simplefilter("ignore", UserWarning)
+            sol = ref.solve(x)
+        cv_times.append(time.perf_counter() - start)
+        out["cvxpy_statuses"][sol.status] = out["cvxpy_statuses"].get(sol.status, 0) + 1
+        if i == 0:
+            out["cvxpy_gamma"] = sol.gamma
+            out["cvxpy_status_x0"] = sol.status
+        start = time.perf_counter()
+        ipm.solve(x)
+        ipm_times.append(time.perf_counter() - start)
+    out["cvxpy_time_p50"] = _percentile(cv_times, 50)
+    out["ipm_time_same_states_p50"] = _percentile(ipm_times, 50)
+    out["cvxpy_states"] = len(cv_times)
+    return out
+
+
+def _switching(problem: MethodsProblem, steps: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, problem.plant.n_vertices, size=steps)
+    return [
+        problem.plant.vertex(int(j)) if hasattr(problem.plant, "vertex") else problem.plant.vertices[j]
+        for j in idx
+    ]
+
+
+def _base_record(problem: MethodsProblem, method: str, settings: MethodsSettings) -> dict[str, Any]:
+    return {
+        "problem": problem.name,
+        "method": method,
+        "status": None,
+        "gamma": None,
+        "iterations": None,
+        "solve_time_p50": None,
+        "solve_time_p95": None,
+        "cvxpy_time_p50": None,
+        "region": None,
+        "closed_loop_cost": None,
+        "closed_loop_cost_switching": None,
+        "status_counts": {},
+        "skip_reason": None,
+        "comparable": True,
+        "notes": [],
+        "settings": {
+            "options": {},
+            "n_states": problem.n_states,
+            "n_inputs": int(problem.plant.n_inputs),
+            "n_vertices": int(problem.plant.n_vertices),
+            "dt": float(problem.plant.dt),
+            "u_max": problem.u_max,
+            "input_constraint": problem.input_constraint,
+            "x0": problem.x0.tolist(),
+            "suite": settings.as_dict(),
+            "record_version": RECORD_VERSION,
+        },
+    }
+
+
+def _options_json(options: dict[str, Any]) -> dict[str, Any]:
+    out = dict(options)
+    if "disturbance" in out:
+        e, w_max = out["disturbance"]
+        out["disturbance"] = {"E_shape": list(np.shape(e)), "w_max": w_max}
+    return out
+
+
+def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) -> tuple[dict[str, Any], dict]:
+    """Measure ``method`` on ``problem``: the record and the data of the figures.
+
+    Never raises for a failing solver or an option this build does not have: the record says
+    what happened (``status``, ``skip_reason``, ``notes``).
+    """
+    start_case = time.perf_counter()
+    rec = _base_record(problem, method, settings)
+    extra: dict[str, Any] = {}
+    options, reason, comparable = method_options(problem, method)
+    rec["comparable"] = comparable
+    if options is None:
+        rec["status"], rec["skip_reason"] = "skipped", reason
+        return rec, extra
+    rec["settings"]["options"] = _options_json(options)
+    if not comparable:
+        rec["notes"].append("runs with the peak bound |u_l| <= u_max: not the problem's ||u||_2 bound")
+    try:
+        ctrl = _controller(problem, options)
+    except (TypeError, ValueError) as err:
+        rec["status"] = "skipped"
+        rec["skip_reason"] = f"RMPC does not take these options: {type(err).__name__}: {err}"
+        return rec, extra
+    start = time.perf_counter()
+    sol = ctrl.solve(problem.x0)
+    x0_time = time.perf_counter() - start
+    rec.update(status=sol.status, gamma=sol.gamma, iterations=sol.iterations)
+    rec["x0_solve_time"] = x0_time
+    if x0_time > settings.slow_solve_s:
+        rec["skip_reason"] = (
+            f"one solve at x0 took {x0_time:.1f} s (> {settings.slow_solve_s:g} s): no region, closed loop "
+            "or cvxpy run"
+        )
+        rec["solve_time_p50"] = rec["solve_time_p95"] = x0_time
+        rec["case_time_s"] = time.perf_counter() - start_case
+        return rec, extra
+    # the region
+    dirs = _directions(problem, settings)
+    region_counts: dict[str, int] = {}
+    deadline = time.perf_counter() + settings.region_budget_s
+    ts, limits = [], []
+    try:
+        for d in dirs:
+            t, why = region_along(ctrl, d, settings, region_counts, deadline)
+            ts.append(t)
+            limits.append(why)
+    except _OverBudget:
+        rec["notes"].append(
+            f"region: {len(ts)} of {len(dirs)} directions within its {settings.region_budget_s:g} s budget"
+        )
+        rec["region_partial"] = {"t": ts, "limits": limits, "status_counts": region_counts}
+        ts = []
+    if ts:
+        _region(rec, ts, limits, region_counts, problem, settings)
+        extra["region_points"] = (np.array(ts)[:, None] * dirs).tolist()
+    # the closed loop: fixed plant, then switching vertices
+    steps = max(2, round(problem.steps * settings.steps_factor))
+    deadline = time.perf_counter() + settings.loop_budget_s
+    fixed = _closed_loop(ctrl, problem, steps, [problem.true_plant] * steps, deadline)
+    switching = _closed_loop(ctrl, problem, steps, _switching(problem, steps, settings.seed), deadline)
+    for name, run in (("closed_loop_cost", fixed), ("closed_loop_cost_switching", switching)):
+        if run["done"] == steps:
+            rec[name] = run["cost"]
+        else:
+            rec["notes"].append(
+                f"{name}: stopped after {run['done']} of {steps} steps ({settings.loop_budget_s:g} s budget)"
+            )
+    rec["closed_loop_steps"] = steps
+    rec["closed_loop_max_abs_u"] = fixed["max_abs_u"]
+    rec["closed_loop_final_norm"] = fixed["final_norm"]
+    times = fixed["times"] + switching["times"]
+    rec["solve_time_p50"] = _percentile(times, 50)
+    rec["solve_time_p95"] = _percentile(times, 95)
+    rec["solves"] = len(times)
+    counts: dict[str, int] = {}
+    for c in (fixed["counts"], switching["counts"]):
+        for k, v in c.items():
+            counts[k] = counts.get(k, 0) + v
+    rec["status_counts"] = counts
+    extra["trajectory"] = fixed["states"].tolist()
+    # cvxpy + Clarabel on the first states of the closed loop
+    cv_states = list(fixed["states"][: max(1, settings.cvxpy_states)])
+    cv = _cvxpy_times(problem, options, cv_states, time.perf_counter() + settings.cvxpy_budget_s)
+    rec.update(cv)
+    if rec["cvxpy_time_p50"] and rec.get("ipm_time_same_states_p50"):
+        rec["cvxpy_ratio"] = rec["cvxpy_time_p50"] / rec["ipm_time_same_states_p50"]
+    rec["case_time_s"] = time.perf_counter() - start_case
+    return rec, extra
+
+
+def _region(
+    rec: dict[str, Any],
+    ts: list[float],
+    limits: list[str],
+    counts: dict[str, int],
+    problem: MethodsProblem,
+    settings: MethodsSettings,
+) -> None:
+    ended: dict[str, int] = {}
+    for why in limits:
+        ended[why] = ended.get(why, 0) + 1
+    rec["region"] = {
+        "t": ts,
+        "limits": limits,
+        "ended_by": ended,
+        "geo_mean_t": float(np.exp(np.mean(np.log(np.maximum(ts, 1.0 / settings.t_max))))),
+        "min_t": float(min(ts)),
+        "t_x0": float(ts[0]) if problem.n_states > 2 else None,
+        "capped": bool(max(ts) >= settings.t_max),
+        "directions": len(ts),
+        "status_counts": counts,
+    }
+
+
+# -- running, storing, resuming ----------------------------------------------------------------
+
+
+def _chosen(known: Sequence[str], asked: Sequence[str] | None, arg: str) -> list[str]:
+    chosen = list(known) if asked is None else list(asked)
+    for name in chosen:
+        if name not in known:
+            raise ConfigError(arg, "names among " + ", ".join(known), repr(name))
+    if not chosen:
+        raise ConfigError(arg, "one or more names among " + ", ".join(known), "none")
+    return chosen
+
+
+def _case_path(out: Path, problem: str, method: str) -> Path:
+    return out / "cases" / f"{problem}__{method}.json"
+
+
+def _load_case(path: Path, settings: MethodsSettings) -> dict[str, Any] | None:
+    """The stored case at ``path`` if it was measured with the same settings and record layout."""
+    try:
+        stored = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    rec = stored.get("record") if isinstance(stored, dict) else None
+    if not isinstance(rec, dict) or stored.get("settings") != json_safe(settings.as_dict()):
+        return None
+    if rec.get("settings", {}).get("record_version") != RECORD_VERSION:
+        return None
+    return stored
+
+
+def _store_case(path: Path, settings: MethodsSettings, rec: dict[str, Any], extra: dict[str, Any]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    payload = {"settings": settings.as_dict(), "record": rec, "extra": extra}
+    tmp.write_text(json.dumps(json_safe(payload), allow_nan=False) + "\n", encoding="utf-8")
+    tmp.replace(path)  # atomic: an interrupt leaves the old file or the new one
+
+
+def run_methods(
+    out: str | Path,
+    short: bool = False,
+    problems: Sequence[str] | None = None,
+    methods: Sequence[str] | None = None,
+    progress: bool | None = None,
+    fresh: bool = False,
+) -> SuiteOutcome:
+    """Run every chosen problem x method and write the report into ``out`` (created if needed).
+
+    Parameters
+    ----------
+    out : str or Path
+        Output directory; ``out/cases/`` keeps each finished case, so the same command resumes.
+    short : bool
+        A smoke run: :data:`~benchmarks.suites.methods_problems.SHORT_PROBLEMS` by default and
+        :meth:`MethodsSettings.short`.
+    problems, methods : sequence of str, optional
+        Run only these (default: all; with ``short`` the short problems).
+    progress : bool, optional
+        Force the progress bar on or off (default: on a terminal).
+    fresh : bool
+        Ignore the stored cases and measure everything again.
+
+    Returns
+    -------
+    SuiteOutcome
+        Records in problem x method order; ``execution.interrupted`` after Ctrl-C (the files
+        then hold the finished cases).
+    """
+    settings = MethodsSettings.short() if short else MethodsSettings()
+    default_problems = list(SHORT_PROBLEMS) if short else list(PROBLEMS)
+    chosen_p = _chosen(list(PROBLEMS), default_problems if problems is None else problems, "--problems")
+    chosen_m = _chosen(list(METHODS), methods, "--methods")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    execution = ExecOutcome()
+    results: dict[tuple[str, str], dict[str, Any]] = {}
+    failures: list[dict[str, Any]] = []
+    keys = [(p, m) for p in chosen_p for m in chosen_m]
+    resumed = 0
+    with CaseProgress(len(keys), "rmpc bench methods", progress) as bar:
+        built: dict[str, MethodsProblem] = {}
+        try:
+            for p, m in keys:
+                path = _case_path(out, p, m)
+                stored = None if fresh else _load_case(path, settings)
+                if stored is not None:
+                    results[(p, m)] = stored
+                    resumed += 1
+                    bar.advance(f"{p}/{m} (stored)")
+                    continue
+                try:
+                    if p not in built:
+                        built[p] = build_problem(p)
+                    rec, extra = evaluate(built[p], m, settings)
+                except Exception as err:  # a failing case is data, not a crash of the suite
+                    failures.append(
+                        {"experiment": p, "key": f"{p}__{m}", "error": f"{type(err).__name__}: {err}"}
+                    )
+                    bar.advance(f"{p}/{m}", ok=False)
+                    continue
+                _store_case(path, settings, rec, extra)
+                results[(p, m)] = json_safe({"record": rec, "extra": extra})
+                execution.finished.append(f"{p}__{m}")
+                bar.advance(f"{p}/{m}")
+        except KeyboardInterrupt:
+            execution.interrupted = True
+            execution.unfinished = [f"{p}__{m}" for p, m in keys if (p, m) not in results]
+    outcome = SuiteOutcome(
+        records=[results[k]["record"] for k in keys if k in results],
+        failures=failures,
+        wall_time_s=time.perf_counter() - start,
+        execution=execution,
+        executor="this process (one case at a time, for clean timings)",
+    )
+    extras = {k: results[k].get("extra", {}) for k in keys if k in results}
+    outcome.files = write_methods_report(out, outcome, extras, settings, len(keys), resumed, short)
+    return outcome
+
+
+# -- the report -------------------------------------------------------------------------------
+
+
+def _fmt(value: float | None, spec: str = ".4g") -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _ms(value: float | None) -> str:
+    return "-" if value is None else f"{1e3 * value:.1f}"
+
+
+def region_ratio(rec: dict[str, Any], base: dict[str, Any] | None) -> float | None:
+    """Geometric mean over the directions of ``t(method) / t(kothare)`` (directions where both > 0)."""
+    if base is None or rec.get("region") is None or base.get("region") is None:
+        return None
+    a, b = np.asarray(rec["region"]["t"]), np.asarray(base["region"]["t"])
+    ok = (a > 0) & (b > 0)
+    if a.shape != b.shape or not ok.any():
+        return None
+    return float(np.exp(np.mean(np.log(a[ok] / b[ok]))))
+
+
+def table_row(rec: dict[str, Any], base: dict[str, Any] | None) -> dict[str, str]:
+    """The report's row of one record (``base``: the same problem's Kothare record)."""
+    region = rec.get("region")
+    counts = rec.get("status_counts") or {}
+    ratio = region_ratio(rec, base)
+    if region is None:
+        reach = "-"
+    else:
+        cap = ">= " if region["capped"] else ""
+        reach = f"{region['min_t']:.3g} / {cap}{region['geo_mean_t']:.3g}"
+    cv = rec.get("cvxpy_time_p50")
+    return {
+        "method": rec["method"] + ("" if rec.get("comparable", True) else " (peak bound)"),
+        "status at x0": str(rec["status"]),
+        "gamma": _fmt(rec.get("gamma")),
+        "iter": _fmt(rec.get("iterations"), "d") if rec.get("iterations") is not None else "-",
+        "region min / geo-mean t": reach,
+        "region vs kothare": _fmt(ratio, ".3f"),
+        "region ended by": "-"
+        if region is None
+        else ", ".join(f"{k} {v}" for k, v in sorted(region.get("ended_by", {}).items())),
+        "cost (nominal plant)": _fmt(rec.get("closed_loop_cost")),
+        "cost (switching)": _fmt(rec.get("closed_loop_cost_switching")),
+        "solve p50 / p95 (ms)": f"{_ms(rec.get('solve_time_p50'))} / {_ms(rec.get('solve_time_p95'))}",
+        "cvxpy p50 (ms)": _ms(cv),
+        "cvxpy / ipm": _fmt(rec.get("cvxpy_ratio"), ".1f"),
+        "step statuses": ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "-",
+    }
+
+
+def _best(recs: list[dict[str, Any]], key: Any, largest: bool) -> dict[str, Any] | None:
+    cands = [r for r in recs if key(r) is not None and np.isfinite(key(r))]
+    if not cands:
+        return None
+    return (max if largest else min)(cands, key=key)
+
+
+def _ties(recs: list[dict[str, Any]], key: Any, best: dict[str, Any], rel: float = TIE_TOLERANCE) -> str:
+    """`` (tied: a, b)`` for the other methods within ``rel`` of the best value, else ``""``."""
+    v = key(best)
+    tied = [
+        r["method"]
+        for r in recs
+        if r is not best and key(r) is not None and abs(key(r) - v) <= rel * max(abs(v), 1e-300)
+    ]
+    return f" (tied within {rel:.1%}: {', '.join(tied)})" if tied else ""
+
+
+def least_conservative(records: list[dict[str, Any]]) -> list[str]:
+    """Per problem: the smallest worst-case gamma, the largest region and the lowest closed-loop cost."""
+    lines = []
+    for p in dict.fromkeys(r["problem"] for r in records):
+        recs = [r for r in records if r["problem"] == p and r.get("comparable", True)]
+        base = next((r for r in recs if r["method"] == "kothare"), None)
+        parts = []
+        gam = _best(
+            [r for r in recs if r["method"] in GAMMA_COMPARABLE and r["status"] == "optimal"],
+            lambda r: r.get("gamma"),
+            largest=False,
+        )
+        if gam is not None:
+            ref = (
+                f" (kothare {base['gamma']:.4g}, {base['status']})"
+                if base and base.get("gamma") is not None
+                else ""
+            )
+            ranked = [r for r in recs if r["method"] in GAMMA_COMPARABLE and r["status"] == "optimal"]
+            parts.append(
+                f"smallest worst-case gamma: {gam['method']} {gam['gamma']:.4g}{ref}"
+                + _ties(ranked, lambda r: r.get("gamma"), gam)
+            )
+        hard = [r for r in recs if r["method"] != "soft"]  # soft bounds enlarge the region by relaxing them
+
+        def ratio(r: dict[str, Any], b: dict[str, Any] | None = base) -> float | None:
+            return region_ratio(r, b)
+
+        reg = _best(hard, ratio, largest=True)
+        if reg is not None:
+            parts.append(
+                f"largest region (hard bounds): {reg['method']} ({ratio(reg):.3f} x kothare's, "
+                "geometric mean)"
+                + _ties(hard, ratio, reg)
+            )
+        cost = _best(recs, lambda r: r.get("closed_loop_cost"), largest=False)
+        if cost is not None:
+            ref = (
+                f" (kothare {base['closed_loop_cost']:.4g})"
+                if base and base.get("closed_loop_cost") is not None
+                else ""
+            )
+            parts.append(
+                f"lowest closed-loop cost: {cost['method']} {cost['closed_loop_cost']:.4g}{ref}"
+                + _ties(recs, lambda r: r.get("closed_loop_cost"), cost)
+            )
+        if parts:
+            lines.append(f"- **{p}**: " + "; ".join(parts) + ".")
+    return lines
+
+
+def write_methods_report(
+    out: Path,
+    outcome: SuiteOutcome,
+    extras: dict[tuple[str, str], dict[str, Any]],
+    settings: MethodsSettings,
+    n_cases: int,
+    resumed: int,
+    short: bool,
+) -> list[Path]:
+    """Write ``results.json``, ``results.csv``, ``run.json``, ``results.md`` and the figures."""
+    from benchmarks.reports.methods_figures import plot_regions, plot_summary
+    from benchmarks.reports.sections import failed_cases, run_lines, settings_section
+    from benchmarks.reports.tables import to_markdown
+    from benchmarks.suites.methods_problems import SUITE_CHOICES
+
+    records = outcome.records
+    files: list[Path] = [write_records(out, records)]
+    rows = [{"problem": r["problem"], **table_row(r, _kothare(records, r["problem"]))} for r in records]
+    csv_path = write_rows_csv(out / "results.csv", rows)
+    if csv_path is not None:
+        files.append(csv_path)
+    info = write_run_info(out, "rmpc bench methods", outcome, n_cases, None, None, ("short", float(short)))
+    (out / "figures").mkdir(exist_ok=True)
+    figures: dict[str, Path] = {}
+    for p in dict.fromkeys(r["problem"] for r in records):
+        recs = [r for r in records if r["problem"] == p]
+        if recs[0]["settings"]["n_states"] == 2:
+            pts = {r["method"]: extras.get((p, r["method"]), {}).get("region_points") for r in recs}
+            trajs = {r["method"]: extras.get((p, r["method"]), {}).get("trajectory") for r in recs}
+            path = plot_regions(p, pts, trajs, recs[0]["settings"]["x0"], out / "figures" / f"region_{p}.png")
+            if path is not None:
+                figures[p] = path
+                files.append(path)
+    summary = plot_summary(records, out / "figures" / "summary.png")
+    if summary is not None:
+        files.append(summary)
+    scale = "short run (a smoke run: few directions, short horizons; no measurement)" if short else "full run"
+    lines = [
+        "# Benchmark suite `methods`: the robust MPC forms head to head",
+        "",
+        *run_lines(info, scale),
+        *(
+            [f"{resumed} cases were taken from an earlier run of the same command (`cases/`)."]
+            if resumed
+            else []
+        ),
+        "",
+        "Per problem and method: the status and `gamma` of the solve at the start state `x0`; the "
+        "feasible region as the largest certified multiple `t` of fixed directions (scaled to the "
+        "size of `x0`, so `t = 1` reaches as far as `x0`; smallest and geometric mean over the "
+        f"directions, `>=` where a direction reached the cap {settings.t_max:g}) and its ratio to "
+        "Kothare's direction by direction, and what ended each direction (`infeasible`: the solver's "
+        "certificate; a solver failure word: the form gave up there; `cap`); the closed-loop cost "
+        "`sum x'Q x + u'R u` on the nominal "
+        "plant and on a seeded switching sequence of vertices; the wall time of the closed-loop steps "
+        "that solved (p50 / p95, certification included) and of cvxpy + Clarabel on the same LMIs "
+        f"at the first {settings.cvxpy_states} closed-loop states (ratio to the toolkit's ipm on "
+        "those states). `gamma` of the nominal form bounds the nominal cost, that of the soft form "
+        "includes the slack price; the ranking by gamma leaves both out.",
+        "",
+        "## Which form is least conservative where",
+        "",
+        *least_conservative(records),
+        "",
+    ]
+    for p in dict.fromkeys(r["problem"] for r in records):
+        recs = [r for r in records if r["problem"] == p]
+        s = recs[0]["settings"]
+        lines += [
+            f"## {p}",
+            "",
+            f"{s['n_states']} states, {s['n_inputs']} inputs, {s['n_vertices']} vertices, dt {s['dt']:g} s, "
+            f"{s['input_constraint']} bound {s['u_max']:g}; x0 = {np.round(s['x0'], 4).tolist()}.",
+            "",
+        ]
+        prows = [table_row(r, _kothare(records, p)) for r in recs]
+        lines += [to_markdown(list(prows[0]), [list(row.values()) for row in prows]), ""]
+        notes = [f"- {r['method']}: {r['skip_reason']}" for r in recs if r.get("skip_reason")] + [
+            f"- {r['method']}: {n}" for r in recs for n in r.get("notes", [])
+        ]
+        lines += notes + ([""] if notes else [])
+        if p in figures:
+            lines += [f"![{p}]({figures[p].relative_to(out).as_posix()})", ""]
+    if summary is not None:
+        lines += [
+            "## Regions and costs against Kothare's",
+            "",
+            f"![summary]({summary.relative_to(out).as_posix()})",
+            "",
+        ]
+    lines += failed_cases(outcome.failures)
+    rows_s = [(k, v, why) for k, v, why in SUITE_CHOICES]
+    rows_s.append(
+        (
+            "region",
+            f"{settings.directions_2d} angles (2 states) / {settings.directions} directions, "
+            f"bisection to {settings.rel_tol:g} relative",
+            "suite settings",
+        )
+    )
+    rows_s.append(("seed", str(settings.seed), "directions and switching sequence"))
+    lines += settings_section(
+        "The problems' data and the suite's own choices (`benchmarks/suites/methods_problems.py`).",
+        rows_s,
+        "Every method sees the same problem, start state, directions and plants; a method that does not "
+        "apply, or that this build does not offer, is recorded with its reason.",
+    )
+    (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
+    files += [out / "run.json", out / "results.md"]
+    return files
+
+
+def _kothare(records: list[dict[str, Any]], problem: str) -> dict[str, Any] | None:
+    return next((r for r in records if r["problem"] == problem and r["method"] == "kothare"), None)

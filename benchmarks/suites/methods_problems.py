@@ -1,0 +1,303 @@
+"""The problems of ``rmpc bench methods``: the field's test systems and the toolkit's satellites.
+
+Each builder returns a :class:`MethodsProblem`: the polytope, the weights and bounds, the start
+state, the plant the closed loop runs on and what the suite varies around them. The values come
+from the publications (Kothare's examples, MUP's demo system) or from the toolkit's suites
+(paper P's, paper W's and the flexible satellite's weights in ``benchmarks/families``); what the
+suite adds is listed in :data:`SUITE_CHOICES`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "DISTURBANCE_FRACTION",
+    "PROBLEMS",
+    "SHORT_PROBLEMS",
+    "SUITE_CHOICES",
+    "MethodsProblem",
+    "build_problem",
+]
+
+#: The disturbance of the "disturbance" method: ``E`` = the nominal ``B`` (an input-channel
+#: disturbance), ``w_max`` = this fraction of the input bound.
+DISTURBANCE_FRACTION: float = 0.05
+
+
+@dataclass(frozen=True)
+class MethodsProblem:
+    """One test problem of the methods suite.
+
+    Attributes
+    ----------
+    name, title, source : str
+        Key, one-line description and where the data come from.
+    plant : models.PolytopicModel
+        The polytope the controllers are designed on (its ``nominal`` is the nominal model).
+    Q, R : ndarray
+        State and input weights.
+    u_max : float
+        The input bound.
+    input_constraint : str
+        ``"peak"`` or ``"ellipsoid"``.
+    x0 : ndarray
+        The start state (gamma, the closed loop, and the unit of the region's multiples).
+    true_plant : (A, B)
+        The fixed plant of the closed loop (an interior plant of the polytope).
+    steps : int
+        Closed-loop horizon (samples).
+    region_scale : ndarray
+        Per-state scale of the region's directions (directions are uniform in scaled coordinates).
+    output_matrix, y_max : ndarray or None
+        Output bounds ``|C x| <= y_max``, where the problem has them.
+    """
+
+    name: str
+    title: str
+    source: str
+    plant: Any
+    Q: np.ndarray
+    R: np.ndarray
+    u_max: float
+    input_constraint: str
+    x0: np.ndarray
+    true_plant: tuple[np.ndarray, np.ndarray]
+    steps: int
+    region_scale: np.ndarray
+    output_matrix: np.ndarray | None = None
+    y_max: np.ndarray | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def n_states(self) -> int:
+        """Number of states."""
+        return int(self.plant.n_states)
+
+    @property
+    def disturbance(self) -> tuple[np.ndarray, float]:
+        """``(E, w_max)`` of the "disturbance" method: the nominal ``B`` and a fraction of ``u_max``."""
+        return np.asarray(self.plant.nominal[1]), DISTURBANCE_FRACTION * float(self.u_max)
+
+
+def _kothare_ex1() -> MethodsProblem:
+    from models import PolytopicModel
+
+    def a_of(alpha: float) -> np.ndarray:
+        return np.array([[1.0, 0.1], [0.0, 1.0 - 0.1 * alpha]])
+
+    b = np.array([[0.0], [0.1 * 0.787]])
+    plant = PolytopicModel([(a_of(0.1), b), (a_of(10.0), b)], dt=0.1, nominal=(a_of(1.0), b))
+    return MethodsProblem(
+        name="kothare_ex1",
+        title="Kothare's example 1: angular positioning, alpha in [0.1, 10]",
+        source="Kothare, Balakrishnan & Morari, Automatica 32(10), 1996, example 1",
+        plant=plant,
+        Q=np.diag([1.0, 0.0]),
+        R=np.array([[2e-5]]),
+        u_max=2.0,
+        input_constraint="peak",
+        x0=np.array([0.05, 0.0]),
+        true_plant=plant.nominal,
+        steps=40,
+        region_scale=np.array([1.0, 1.0]),
+    )
+
+
+def _kothare_ex2() -> MethodsProblem:
+    from models import PolytopicModel
+
+    def a_of(k: float) -> np.ndarray:
+        return np.array(
+            [
+                [1.0, 0.0, 0.1, 0.0],
+                [0.0, 1.0, 0.0, 0.1],
+                [-0.1 * k, 0.1 * k, 1.0, 0.0],
+                [0.1 * k, -0.1 * k, 0.0, 1.0],
+            ]
+        )
+
+    b = np.array([[0.0], [0.0], [0.1], [0.0]])
+    plant = PolytopicModel([(a_of(0.5), b), (a_of(10.0), b)], dt=0.1, nominal=(a_of(1.0), b))
+    return MethodsProblem(
+        name="kothare_ex2",
+        title="Kothare's example 2: two masses and a spring, k in [0.5, 10]",
+        source=(
+            "Kothare, Balakrishnan & Morari, Automatica 32(10), 1996, example 2 "
+            "(as MUP's benchmark writes it)"
+        ),
+        plant=plant,
+        Q=np.eye(4),
+        R=np.eye(1),
+        u_max=1.0,
+        input_constraint="peak",
+        x0=np.array([1.0, 1.0, 0.0, 0.0]),
+        true_plant=plant.nominal,
+        steps=40,
+        region_scale=np.ones(4),
+    )
+
+
+def _mup_demo() -> MethodsProblem:
+    from models import PolytopicModel
+
+    b = np.array([[-1.45], [-0.70]])
+    a1 = np.array([[0.93, 0.51], [0.38, 0.83]])
+    a2 = np.array([[0.06, 0.26], [1.80, 0.87]])
+    a3 = np.array([[0.50, 0.39], [1.10, 0.85]])
+    plant = PolytopicModel([(a1, b), (a2, b)], dt=1.0, nominal=(a3, b))
+    return MethodsProblem(
+        name="mup_demo",
+        title="MUP's demo system: two vertices, |u| <= 10, |x_i| <= 10",
+        source="Oravec & Bakosova's MUP toolbox, demo system (vertices A1, A2; nominal A3)",
+        plant=plant,
+        Q=np.eye(2),
+        R=np.eye(1),
+        u_max=10.0,
+        input_constraint="peak",
+        x0=np.array([3.0, 0.0]),
+        true_plant=plant.nominal,
+        steps=20,
+        region_scale=np.array([1.0, 1.0]),
+        output_matrix=np.eye(2),
+        y_max=np.array([10.0, 10.0]),
+        notes=("the nominal A3 lies close to (not exactly on) the segment between A1 and A2",),
+    )
+
+
+def _paper_p(mode: str) -> MethodsProblem:
+    from benchmarks.families.rigid import defaults
+    from models import RigidSatellite
+
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    plant = sat.polytope(x0, dt=defaults.DT, spread=defaults.SPREAD, mode=mode)
+    s = defaults.CONTROLLER_DEFAULTS["RMPC"]
+    n_v = plant.n_vertices
+    return MethodsProblem(
+        name=f"paper_p_{n_v}v",
+        title=f"Paper P's rigid satellite, inertia +-{defaults.SPREAD:g} ({mode!r}, {n_v} vertices)",
+        source="paper P's satellite and start state; weights of benchmarks/families/rigid",
+        plant=plant,
+        Q=np.diag(s["Q_diag"]),
+        R=np.diag(s["R_diag"]),
+        u_max=float(defaults.U_MAX),
+        input_constraint=str(s["input_constraint"]),
+        x0=np.asarray(x0, dtype=float),
+        true_plant=plant.nominal,
+        steps=150,
+        region_scale=np.array([1.0, 1.0, 1.0, 0.1, 0.1, 0.1]),
+    )
+
+
+def _paper_w() -> MethodsProblem:
+    from benchmarks.families.wheel import defaults
+    from models import WheelSatellite
+    from models.wheels.scenarios import paper_w_scenario
+
+    sat = WheelSatellite.paper_w()
+    plant = sat.polytope(dt=defaults.DT, effectiveness="single_outage")
+    s = defaults.CONTROLLER_DEFAULTS["RMPC"]
+    x0 = paper_w_scenario("S1").initial_state()[:6]
+    return MethodsProblem(
+        name="paper_w",
+        title=f"Paper W's wheel satellite, single-outage polytope ({plant.n_vertices} vertices)",
+        source="paper W's satellite, scenario S1's start attitude; weights of benchmarks/families/wheel",
+        plant=plant,
+        Q=np.diag(s["Q_diag"]),
+        R=np.diag(s["R_diag"]),
+        u_max=float(defaults.U_MAX),
+        input_constraint=str(s["input_constraint"]),
+        x0=np.asarray(x0, dtype=float),
+        true_plant=plant.nominal,
+        steps=100,
+        region_scale=np.array([1.0, 1.0, 1.0, 0.1, 0.1, 0.1]),
+    )
+
+
+def _flexible() -> MethodsProblem:
+    from benchmarks.families.flexible import defaults
+    from benchmarks.families.flexible.controllers import linear_weights
+    from models import FlexibleSatellite
+    from models.attitude.quaternion import quat_from_axis_angle
+
+    sat = FlexibleSatellite.di_gennaro()
+    dt = defaults.LINEAR_PERIOD
+    plant = sat.polytope(dt=dt, attitude="quaternion", mode="groups")
+    s = defaults.CONTROLLER_DEFAULTS["RMPC"]
+    Q, R = linear_weights(s, sat.n_modes)
+    angle = defaults.EXPERIMENT_ANGLES["small"]
+    q = quat_from_axis_angle(np.ones(3) / np.sqrt(3.0), np.deg2rad(angle))
+    x0 = sat.linear_state(sat.state(q))
+    n = plant.n_states
+    return MethodsProblem(
+        name=f"flexible_{plant.n_vertices}v",
+        title=f"The flexible satellite, {n} states, 'groups' polytope ({plant.n_vertices} vertices)",
+        source="Di Gennaro's 4 modes; the polytope, weights, period and small slew of the flexible family",
+        plant=plant,
+        Q=Q,
+        R=R,
+        u_max=float(defaults.U_MAX),
+        input_constraint=str(s["input_constraint"]),
+        x0=np.asarray(x0, dtype=float),
+        true_plant=plant.nominal,
+        steps=40,
+        region_scale=np.array([1.0] * 3 + [0.1] * 3 + [0.1] * (n - 6)),
+    )
+
+
+#: Problem name -> builder, in the report's order.
+PROBLEMS: dict[str, Callable[[], MethodsProblem]] = {
+    "kothare_ex1": _kothare_ex1,
+    "kothare_ex2": _kothare_ex2,
+    "mup_demo": _mup_demo,
+    "paper_p_2v": lambda: _paper_p("scalar"),
+    "paper_p_8v": lambda: _paper_p("box"),
+    "paper_w": _paper_w,
+    "flexible_8v": _flexible,
+}
+
+#: The problems of ``--short``.
+SHORT_PROBLEMS: tuple[str, ...] = ("kothare_ex1", "kothare_ex2", "mup_demo", "paper_p_2v")
+
+
+def build_problem(name: str) -> MethodsProblem:
+    """The problem called ``name`` (a key of :data:`PROBLEMS`)."""
+    problem = PROBLEMS[name]()
+    if problem.name != name:  # the names are the contract of the records
+        raise AssertionError(f"problem {name!r} built as {problem.name!r}")
+    return problem
+
+
+#: What the suite chooses (setting, value, why), for the report's settings table.
+SUITE_CHOICES: tuple[tuple[str, str, str], ...] = (
+    (
+        "closed-loop plant",
+        "the polytope's nominal model (Kothare's alpha = 1 and k = 1, MUP's A3, the satellites' own)",
+        "a fixed interior plant, the same for every method",
+    ),
+    (
+        "switching plant",
+        "a vertex drawn at every sample (seeded), the same sequence for every method",
+        "the time-varying uncertainty the vertex-pair form is made for",
+    ),
+    (
+        "disturbance method",
+        f"E = nominal B, w_max = {DISTURBANCE_FRACTION:g} u_max; the closed loop itself runs without it",
+        "an input-channel disturbance of a size every problem can carry",
+    ),
+    (
+        "soft method",
+        "weights 1e3 on the input slack (and the output slack where there are output bounds)",
+        "large enough for the hard answer where the hard problem is feasible",
+    ),
+    (
+        "auxiliary saturation",
+        "peak bound |u_l| <= u_max; where the problem bounds ||u||_2 the record is marked not comparable",
+        "sat(F x) is componentwise",
+    ),
+)

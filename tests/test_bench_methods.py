@@ -1,0 +1,166 @@
+"""``rmpc bench methods``: the short path on one small problem, the records, resuming, the region search."""
+
+from __future__ import annotations
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from benchmarks.suites import methods as suite
+from benchmarks.suites.methods import (
+    MethodsSettings,
+    least_conservative,
+    method_options,
+    region_along,
+    run_methods,
+)
+from benchmarks.suites.methods_problems import build_problem
+
+API_FIELDS = (
+    "problem",
+    "method",
+    "status",
+    "gamma",
+    "solve_time_p50",
+    "solve_time_p95",
+    "cvxpy_time_p50",
+    "region",
+    "closed_loop_cost",
+)
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("methods")
+    outcome = run_methods(
+        out, short=True, problems=["kothare_ex1"], methods=["kothare", "vertex"], progress=False
+    )
+    return out, outcome
+
+
+def test_short_run_writes_records_report_and_figures(short_run):
+    out, outcome = short_run
+    assert not outcome.failures and not outcome.execution.interrupted
+    records = json.loads((out / "results.json").read_text())
+    assert [(r["problem"], r["method"]) for r in records] == [
+        ("kothare_ex1", "kothare"),
+        ("kothare_ex1", "vertex"),
+    ]
+    for rec in records:
+        missing = [f for f in API_FIELDS if f not in rec]
+        assert not missing, missing
+        assert rec["status"] == "optimal" and rec["gamma"] > 0
+        assert rec["solve_time_p50"] <= rec["solve_time_p95"]
+        assert rec["cvxpy_time_p50"] > 0 and rec["closed_loop_cost"] > 0
+        assert len(rec["region"]["t"]) == MethodsSettings.short().directions_2d
+    report = (out / "results.md").read_text()
+    assert "## kothare_ex1" in report and "least conservative" in report
+    assert (out / "figures" / "region_kothare_ex1.png").stat().st_size > 0
+    assert len(list((out / "cases").glob("*.json"))) == 2
+
+
+def test_an_interrupted_run_resumes_where_it_stopped(tmp_path, monkeypatch):
+    real = suite.evaluate
+    calls: list[str] = []
+
+    def interrupt_second(problem, method, settings):
+        calls.append(method)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(problem, method, settings)
+
+    monkeypatch.setattr(suite, "evaluate", interrupt_second)
+    args = dict(short=True, problems=["kothare_ex1"], methods=["kothare", "nominal"], progress=False)
+    first = run_methods(tmp_path, **args)
+    assert first.execution.interrupted and first.execution.unfinished == ["kothare_ex1__nominal"]
+    assert [r["method"] for r in json.loads((tmp_path / "results.json").read_text())] == ["kothare"]
+
+    calls.clear()
+    monkeypatch.setattr(suite, "evaluate", lambda p, m, s: (calls.append(m), real(p, m, s))[1])
+    second = run_methods(tmp_path, **args)
+    assert calls == ["nominal"]  # the stored case is not measured again
+    assert [r["method"] for r in second.records] == ["kothare", "nominal"]
+    assert second.records[0] == first.records[0]
+    assert "1 cases were taken from an earlier run" in (tmp_path / "results.md").read_text()
+
+
+def test_a_stored_case_of_other_settings_is_measured_again(tmp_path, monkeypatch):
+    args = dict(problems=["kothare_ex1"], methods=["kothare"], progress=False)
+    run_methods(tmp_path, short=True, **args)
+    calls: list[str] = []
+    real = suite.evaluate
+    monkeypatch.setattr(suite, "evaluate", lambda p, m, s: (calls.append(m), real(p, m, s))[1])
+    monkeypatch.setattr(
+        MethodsSettings,
+        "short",
+        classmethod(lambda cls: cls(directions_2d=4, t_max=8.0, steps_factor=0.1, cvxpy_states=1)),
+    )
+    run_methods(tmp_path, short=True, **args)
+    assert calls == ["kothare"]
+
+
+class _Threshold:
+    """A controller stub feasible exactly for ``|x| <= limit`` (failure word above)."""
+
+    def __init__(self, limit: float, word: str = "infeasible") -> None:
+        self.limit, self.word, self.solves = limit, word, 0
+
+    def solve(self, x):
+        self.solves += 1
+        ok = np.linalg.norm(x) <= self.limit
+        return SimpleNamespace(status="optimal" if ok else self.word)
+
+
+@pytest.mark.parametrize("limit", [0.3, 1.0, 3.3, 40.0])
+def test_region_search_brackets_the_boundary(limit):
+    settings = MethodsSettings(rel_tol=0.02, t_max=64.0)
+    counts: dict[str, int] = {}
+    t, why = region_along(_Threshold(limit, "numerical_error"), np.array([1.0, 0.0]), settings, counts)
+    assert limit / (1 + settings.rel_tol) <= t <= limit
+    assert why == "numerical_error" and counts["optimal"] >= 1
+
+
+def test_region_search_stops_at_the_cap_and_at_zero():
+    settings = MethodsSettings(t_max=16.0)
+    assert region_along(_Threshold(1e9), np.array([1.0]), settings, {}) == (16.0, "cap")
+    assert region_along(_Threshold(1e-9), np.array([1.0]), settings, {}) == (0.0, "infeasible")
+
+
+def test_method_options_follow_the_problem():
+    p = build_problem("paper_p_2v")  # ||u||_2 bound, three inputs
+    options, _reason, comparable = method_options(p, "auxiliary_saturation")
+    assert options == {"saturation": "auxiliary", "input_constraint": "peak"} and not comparable
+    mup = build_problem("mup_demo")  # output bounds: the soft form softens them too
+    assert method_options(mup, "soft")[0] == {"soft": {"u": suite.SOFT_WEIGHT, "y": suite.SOFT_WEIGHT}}
+    assert method_options(build_problem("kothare_ex1"), "soft")[0] == {"soft": {"u": suite.SOFT_WEIGHT}}
+    e, w_max = method_options(mup, "disturbance")[0]["disturbance"]
+    assert e.shape == (2, 1) and w_max == pytest.approx(0.05 * 10.0)
+
+
+def test_the_ranking_is_read_from_the_records():
+    def rec(method, gamma, t, cost, status="optimal"):
+        return {
+            "problem": "p",
+            "method": method,
+            "status": status,
+            "gamma": gamma,
+            "comparable": True,
+            "region": {"t": t},
+            "closed_loop_cost": cost,
+        }
+
+    records = [
+        rec("kothare", 10.0, [1.0, 2.0], 5.0),
+        rec("vertex", 8.0, [2.0, 4.0], 6.0),
+        rec("nominal", 1.0, [1.0, 1.0], 4.0),
+        rec("vertex_pairs", 7.0, [1.0, 2.0], 5.5, "inaccurate"),
+        rec("soft", 10.0, [64.0, 64.0], 5.0),  # relaxes the bounds: not in the region ranking
+        rec("free_move", 9.0, [2.0, 4.0], 6.0),
+    ]
+    (line,) = least_conservative(records)
+    assert "smallest worst-case gamma: vertex 8" in line  # nominal bounds another cost, pairs not optimal
+    assert "largest region (hard bounds): vertex (2.000 x kothare's, geometric mean) (tied" in line
+    assert "(tied within 0.1%: free_move)" in line
+    assert "lowest closed-loop cost: nominal 4" in line
