@@ -158,8 +158,9 @@ def run(cases: Sequence[str], backends: Sequence[str], repeats: int) -> dict[str
 
 def _markdown(res: dict[str, Any]) -> str:
     lines = ["# Off-line nested design: design time per back-end", "",
-             f"machine: {res['machine']}", f"load average before / after: {res['load_before']} / "
-             f"{res['load_after']}", f"repeats: {res['repeats']} (fresh problem each, construction counted)", "",
+             f"machine: {res['machine']}",
+             f"load average before / after: {res['load_before']} / {res['load_after']}",
+             f"repeats: {res['repeats']} (fresh problem each, construction counted)", "",
              "| case | back-end | median (s) | min / max (s) | ellipsoids | complete | stop reason |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for name, entry in res["cases"].items():
@@ -167,8 +168,9 @@ def _markdown(res: dict[str, Any]) -> str:
             if backend not in entry:
                 continue
             e = entry[backend]
-            lines.append(f"| {name} | {backend} | {e['median_s']:.2f} | {e['min_s']:.2f} / {e['max_s']:.2f} | "
-                         f"{e['last']['n_ellipsoids']} | {e['complete_all']} | {e['last']['stop_reason']} |")
+            lines.append(f"| {name} | {backend} | {e['median_s']:.2f} | {e['min_s']:.2f} / "
+                         f"{e['max_s']:.2f} | {e['last']['n_ellipsoids']} | {e['complete_all']} | "
+                         f"{e['last']['stop_reason']} |")
     lines += ["", "Gamma per ellipsoid (last repeat) and |gamma_ipm - gamma_cvxpy| / gamma_cvxpy:", ""]
     for name, entry in res["cases"].items():
         lines.append(f"- {name}: " + "; ".join(
@@ -180,7 +182,8 @@ def _markdown(res: dict[str, Any]) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line: ``python -m benchmarks.offline_timing --out DIR``."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.offline_timing", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.offline_timing",
+                                     description=(__doc__ or "").split("\n")[0])
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))

@@ -1,7 +1,8 @@
 """:meth:`lmi.offline.NestedKothareProblem.solve` returns a solver failure as a status, never
-raises it: when cvxpy's solver raises ``SolverError`` (``backend="cvxpy"``, for the first ellipsoid
-and for a nested one), the entry says ``"solver_error"``, carries the solver's message and no solution. An entry
-that failed cannot be the outer ellipsoid of the next one: that is refused, naming ``outer``."""
+raises it: when cvxpy's solver raises ``SolverError`` (``backend="cvxpy"``, for the first
+ellipsoid and for a nested one), the entry says ``"solver_error"``, carries the solver's message
+and no solution. An entry that failed cannot be the outer ellipsoid of the next one: that is
+refused, naming ``outer``."""
 
 from __future__ import annotations
 
