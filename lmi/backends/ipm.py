@@ -124,6 +124,12 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
+def _nest_args(outer: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """``(outer,)`` for the nesting block, ``()`` without it: the on-line problem's stages are
+    called exactly as they are without the nesting option."""
+    return () if outer is None else (outer,)
+
+
 class IPMKothare(KothareBackend):
     """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`, Clarabel as its fallback.
 
@@ -313,12 +319,12 @@ class IPMKothare(KothareBackend):
                 return self._unscale(raw, norm)
         u_max, y_max = us, ys
         if self._phase_one:
-            raw = self._decide(raw, xs, u_max, y_max, qs)
+            raw = self._decide(raw, xs, u_max, y_max, *_nest_args(qs))
             if raw.status == INFEASIBLE:
                 return raw
         if not self._fallback:
             return self._unscale(raw, norm)
-        backup = self.fallback_solver.solve(xs, u_max, y_max, qs)
+        backup = self.fallback_solver.solve(xs, u_max, y_max, *_nest_args(qs))
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
         return self._unscale(dataclasses.replace(
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
@@ -405,7 +411,7 @@ class IPMKothare(KothareBackend):
         word = res.status
         cert = None
         if res.status == "infeasible":
-            cert = self.farkas_check(res.Z, xs, u_max, y_max, outer)
+            cert = self.farkas_check(res.Z, xs, u_max, y_max, *_nest_args(outer))
             if not cert.ok:
                 word = "infeasible (unchecked)"
         iterations = (raw.iterations or 0) + res.iterations
@@ -460,7 +466,7 @@ class IPMKothare(KothareBackend):
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
         if res.status == "infeasible":
-            cert = self.farkas_check(res.Z, x, u_max, y_max, outer)
+            cert = self.farkas_check(res.Z, x, u_max, y_max, *_nest_args(outer))
             if cert.ok:
                 return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
                                  infeasibility=cert)
