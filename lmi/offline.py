@@ -9,10 +9,16 @@ more LMI, the nesting ``Q_{i-1} - Q_i >= 0``, so that the invariant ellipsoids
 unknowns of step ``i``, and the previous solution, scaled to the new state, satisfies it, so
 every design state strictly inside the previous ellipsoid gives a feasible problem.
 
-The LMIs are the cvxpy formulation of :mod:`lmi.backends.cvxpy` (same delta form and
-scalings, so the design is well conditioned at ``Ts = 0.01`` s) with the extra constraints
-added; the design is off-line and not time-critical. Every stored ellipsoid is certified by
-:func:`lmi.certify` (the LMIs recomputed in numpy) and by the recomputed nesting margin.
+By default (``backend="ipm"``) the LMIs are those of the on-line problem on the toolkit's
+interior-point method (:class:`lmi.backends.ipm.IPMKothare`: the conic data of
+:class:`~lmi.backends.conic.KothareConic`, state scaling, factored coefficients, warm starts,
+the rebalanced retry, phase one and the Clarabel fallback) with one more block, the nesting
+``Q_{i-1} - Q_i >= 0`` (``nesting=True``); the first design state is solved without it, i.e.
+exactly as the on-line problem. ``backend="clarabel"`` hands the same conic data to Clarabel,
+and ``backend="cvxpy"`` writes the LMIs with cvxpy (the formulation of
+:mod:`lmi.backends.cvxpy`, any installed conic solver). Every stored ellipsoid is certified by
+:func:`lmi.certify` (the LMIs recomputed in numpy) and by the recomputed nesting margin, whatever
+the back-end.
 
 Wan & Kothare's condition (18) for interpolating between neighbours,
 ``Q_i^-1 - (A_j + B_j F_{i+1})' Q_i^-1 (A_j + B_j F_{i+1}) > 0`` for every vertex ``j``, is
@@ -29,11 +35,13 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 from typing import Any
 
-import cvxpy as cp
 import numpy as np
 from numpy.typing import ArrayLike
 
-from lmi.backends.cvxpy import CvxpyKothare
+from lmi.backends.base import KothareBackend, RawResult
+from lmi.backends.clarabel import ClarabelKothare
+from lmi.backends.conic import KothareConic
+from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.status import CVXPY_STATUS_MAP, INACCURATE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
@@ -103,6 +111,9 @@ class NestedEllipsoid:
         :func:`nesting_margin` of ``(Q_{i-1}, Q_i)``; NaN for the first ellipsoid.
     solve_time : float
     solver_status : str
+    iterations : int or None
+        The solver's iterations, summed over its stages (``None`` where the back-end does not
+        count them, as through cvxpy).
     """
 
     status: str
@@ -115,6 +126,7 @@ class NestedEllipsoid:
     nesting_margin: float
     solve_time: float
     solver_status: str
+    iterations: int | None = None
 
     @property
     def ok(self) -> bool:
@@ -177,10 +189,17 @@ class NestedKothareProblem:
     ----------
     A, B, Q, R, dt, input_constraint, u_max, output_matrix, y_max, formulation
         As :class:`lmi.KothareProblem`.
-    solver : str
-        Any installed cvxpy conic solver (default ``"CLARABEL"``).
+    backend : {"ipm", "clarabel", "cvxpy"}
+        ``"ipm"`` (default): the on-line problem's interior-point back-end
+        (:class:`lmi.backends.ipm.IPMKothare`) with the nesting block; ``"clarabel"``: the same
+        conic data handed to Clarabel; ``"cvxpy"``: the LMIs written with cvxpy, solved by
+        ``solver``.
+    solver : str, optional
+        With ``backend="cvxpy"``: any installed cvxpy conic solver (default ``"CLARABEL"``);
+        ``None`` otherwise.
     solver_options : dict, optional
-        Solver settings, validated as in :mod:`lmi.backends.cvxpy`.
+        Solver settings, validated by the back-end (:data:`lmi.backends.ipm.DEFAULT_IPM_OPTIONS`,
+        :func:`lmi.backends.clarabel.clarabel_settings`, :mod:`lmi.backends.cvxpy`).
     certificate_tol : float
         Every recomputed relative margin (Kothare LMIs, nesting) must be ``>= -tol``.
     interpolation_tol : float
@@ -215,7 +234,8 @@ class NestedKothareProblem:
         u_max: ArrayLike | None = None,
         output_matrix: ArrayLike | None = None,
         y_max: ArrayLike | None = None,
-        solver: str = "CLARABEL",
+        backend: str = "ipm",
+        solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
         formulation: Formulation = "delta_shared",
         certificate_tol: float = 1e-7,
@@ -231,18 +251,52 @@ class NestedKothareProblem:
             )
         self.certificate_tol = check_positive(certificate_tol, "certificate_tol")
         self.interpolation_tol = check_positive(interpolation_tol, "interpolation_tol", allow_zero=True)
+        # The first design state is the on-line problem (no nesting block); the others go to a
+        # back-end whose data have the nesting block.
+        self._plain: KothareBackend
+        self._nest: KothareBackend
+        if backend == "ipm":
+            if solver is not None:
+                raise InvalidArgumentError("solver", "None with backend='ipm'", repr(solver))
+            self._plain = IPMKothare(self.data, solver_options)
+            self._nest = IPMKothare(self.data, solver_options, nesting=True)
+        elif backend == "clarabel":
+            if solver not in (None, "clarabel", "CLARABEL"):
+                raise InvalidArgumentError("solver", "None with backend='clarabel'", repr(solver))
+            self._plain = ClarabelKothare(self.data, solver_options)
+            self._nest = ClarabelKothare(self.data, solver_options,
+                                         conic=KothareConic(self.data, nesting=True))
+        elif backend == "cvxpy":
+            self._setup_cvxpy(solver or "CLARABEL", solver_options)
+        else:
+            raise InvalidArgumentError("backend", "'ipm', 'clarabel' or 'cvxpy'", repr(backend))
+        self._kind = backend
+
+    def _setup_cvxpy(self, solver: str, solver_options: dict[str, Any] | None) -> None:
+        import cvxpy as cp  # ~0.5 s to import: only for this back-end
+
+        from lmi.backends.cvxpy import CvxpyKothare
+
         self._base = CvxpyKothare(self.data, solver, solver_options)
         n = self.data.n
         base = self._base
         # gamma_s = dt gamma in the delta formulations (see lmi.backends.conic).
-        self._gamma_scale = 1.0 if formulation == "standard" else self.data.dt
+        self._gamma_scale = 1.0 if self.data.formulation == "standard" else self.data.dt
         self._outer = cp.Parameter((n, n), symmetric=True)
         extra = [self._outer - base.Qv >> 0]
         self._nested = cp.Problem(cp.Minimize(base.gs), [*base.problem.constraints, *extra])
 
     @property
     def backend(self) -> str:
-        return self._base.name
+        """``"ipm"``, ``"clarabel"`` or ``"cvxpy:SOLVER"``."""
+        return self._base.name if self._kind == "cvxpy" else self._plain.name
+
+    def reset(self) -> None:
+        """Forget what earlier solves left behind (the IPM's warm starts and rebalanced
+        coordinates); every design starts with this, so a table does not depend on earlier ones."""
+        if self._kind != "cvxpy":
+            self._plain.reset()
+            self._nest.reset()
 
     # -- one design state ----------------------------------------------------------------
     def solve(self, x: ArrayLike, outer: NestedEllipsoid | None = None) -> NestedEllipsoid:
@@ -258,6 +312,30 @@ class NestedKothareProblem:
             raise InvalidArgumentError("x", "a non-zero design state", "x = 0")
         if outer is not None and (outer.Q is None or not outer.ok):
             raise InvalidArgumentError("outer", "a certified NestedEllipsoid", f"status {outer.status!r}")
+        if self._kind != "cvxpy":
+            return self._solve_conic(x, s, outer)
+        return self._solve_cvxpy(x, s, outer)
+
+    def _solve_conic(self, x: np.ndarray, s: float, outer: NestedEllipsoid | None) -> NestedEllipsoid:
+        """The ``"ipm"`` and ``"clarabel"`` back-ends: the normalised problem, ``Q_outer / s^2``."""
+        d = self.data
+        if outer is None:
+            raw: RawResult = self._plain.solve(x / s, d.u_max / s, d.y_max / s)
+        else:
+            assert outer.Q is not None
+            q_out = 0.5 * (outer.Q + outer.Q.T) / s**2
+            raw = self._nest.solve(x / s, d.u_max / s, d.y_max / s, q_out)  # type: ignore[call-arg]
+        if raw.Q is None or raw.Y is None:
+            return NestedEllipsoid(raw.status, x, np.nan, None, None, None, None, np.nan, raw.solve_time,
+                                   raw.solver_status, raw.iterations)
+        q_mat = 0.5 * (raw.Q + raw.Q.T) * s**2
+        return self._finish(raw.status, raw.solver_status, x, raw.gamma * s**2, q_mat, raw.Y * s**2, outer,
+                            raw.solve_time, raw.iterations)
+
+    def _solve_cvxpy(self, x: np.ndarray, s: float, outer: NestedEllipsoid | None) -> NestedEllipsoid:
+        import cvxpy as cp
+
+        d = self.data
         base = self._base
         base.x.value = x / s
         if base.inv_u is not None:
@@ -292,7 +370,7 @@ class NestedKothareProblem:
 
     def _finish(
         self, status: str, raw: str, x: np.ndarray, gamma: float, q_mat: np.ndarray,
-        y_mat: np.ndarray, outer: NestedEllipsoid | None, elapsed: float,
+        y_mat: np.ndarray, outer: NestedEllipsoid | None, elapsed: float, iterations: int | None = None,
     ) -> NestedEllipsoid:
         tol = self.certificate_tol
         cert = certify(self.data, x, gamma, q_mat, y_mat, tol=tol)
@@ -310,7 +388,7 @@ class NestedKothareProblem:
         )
         if status in (OPTIMAL, INACCURATE):
             status = OPTIMAL if checks_ok else UNCERTIFIED
-        return NestedEllipsoid(status, x, gamma, q_mat, y_mat, f_mat, cert, nest, elapsed, raw)
+        return NestedEllipsoid(status, x, gamma, q_mat, y_mat, f_mat, cert, nest, elapsed, raw, iterations)
 
     # -- sequences -------------------------------------------------------------------------
     def _table(
@@ -344,6 +422,7 @@ class NestedKothareProblem:
                 "states", "non-zero design states", f"x = 0 at row {int(np.argmin(norms))}"
             )
         start = time.perf_counter()
+        self.reset()
         entries: list[NestedEllipsoid] = []
         skipped: list[tuple[int, float]] = []
         for k, x in enumerate(pts):
@@ -393,6 +472,7 @@ class NestedKothareProblem:
         start = time.perf_counter()
         if float(np.linalg.norm(x)) == 0.0:
             raise InvalidArgumentError("x0", "a non-zero design state", "x0 = 0")
+        self.reset()
         entries: list[NestedEllipsoid] = []
         steps = 0
         while True:

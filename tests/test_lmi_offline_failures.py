@@ -1,7 +1,8 @@
 """:meth:`lmi.offline.NestedKothareProblem.solve` returns a solver failure as a status, never
-raises it: when cvxpy's solver raises ``SolverError`` (for the first ellipsoid and for a nested
-one), the entry says ``"solver_error"``, carries the solver's message and no solution. An entry
-that failed cannot be the outer ellipsoid of the next one: that is refused, naming ``outer``."""
+raises it: when cvxpy's solver raises ``SolverError`` (``backend="cvxpy"``, for the first
+ellipsoid and for a nested one), the entry says ``"solver_error"``, carries the solver's message
+and no solution. An entry that failed cannot be the outer ellipsoid of the next one: that is
+refused, naming ``outer``."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ B = [[[0.0], [0.1 * 0.787]]] * 2
 
 def _problem() -> NestedKothareProblem:
     return NestedKothareProblem(A, B, Q=np.diag([1.0, 0.0]), R=[[2e-5]], dt=0.1,
-                                input_constraint="peak", u_max=2.0)
+                                input_constraint="peak", u_max=2.0, backend="cvxpy")
 
 
 def _raise(*args: object, **kwargs: object) -> None:

@@ -446,8 +446,8 @@ def _reach_lines() -> list[str]:
         "ellipsoid meeting the bound at a fixed cost bound, one SDP by cvxpy + Clarabel, checked without "
         f"the solver): {measured}. {_reach_verdict(reach)} The toolkit's ipm on the RMPC's problem, "
         f"cold at rest on the slew axis, {ipm_reach_sentence(_ipm_along_slew(poly, Q, R, direction))}. "
-        f"F4 slews {defaults.EXPERIMENT_ANGLES['small']:g} deg; the OfflineRMPC tables use Clarabel on the "
-        f"'delta' form; {shared}.",
+        f"F4 slews {defaults.EXPERIMENT_ANGLES['small']:g} deg; the OfflineRMPC tables use the toolkit's ipm "
+        f"on the 'delta' form; {shared}.",
     ]
 
 

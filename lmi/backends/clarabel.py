@@ -90,10 +90,13 @@ class ClarabelKothare(KothareBackend):
         self._blas = SingleThreadBlas()
         self.conic = KothareConic(data) if conic is None else conic
 
-    def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
-        """Solve at the (normalised) state ``x`` with the (normalised) bounds."""
+    def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
+              outer: np.ndarray | None = None) -> RawResult:
+        """Solve at the (normalised) state ``x`` with the (normalised) bounds; ``outer``: the
+        constant of the nesting block, for conic data that have it
+        (:meth:`~lmi.backends.conic.KothareConic.b_vector`)."""
         conic = self.conic
-        b = conic.b_vector(x)
+        b = conic.b_vector(x, outer)
         a_mat = conic.a_matrix(u_max, y_max)
         start = time.perf_counter()
         try:

@@ -31,6 +31,12 @@ Formulations (see ``docs/theory.rst``):
 (:class:`~lmi.backends.clarabel.ClarabelKothare`, which hands it to Clarabel) and the
 interior-point back-end (:class:`~lmi.backends.ipm.IPMKothare`, which keeps each cone as a
 matrix and falls back to a Clarabel back-end on the same data).
+
+The off-line nested design (:class:`lmi.offline.NestedKothareProblem`, Wan & Kothare 2003) adds
+one block with ``nesting=True``: ``Q_outer - Q >= 0``, its constant ``Q_outer`` (the previous
+ellipsoid's ``Q`` at the normalised state, in these data's coordinates) given per solve like
+the state (:meth:`KothareConic.b_vector`). It is the last cone, so the other cones, their
+offsets and rows are those of the problem without it.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ from scipy import sparse
 
 from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 from lmi.data import KothareData
+from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["KothareConic"]
 
@@ -79,10 +86,14 @@ class KothareConic:
         The zero quadratic term (Clarabel's ``P``).
     q_affine, y_affine : AffineMatrix
         ``Q`` and ``Y`` as affine functions of ``z``.
+    nesting : bool
+        Whether the last cone is the nesting block ``Q_outer - Q >= 0`` (constructor argument;
+        its constant is given to :meth:`b_vector`).
     """
 
-    def __init__(self, data: KothareData) -> None:
+    def __init__(self, data: KothareData, *, nesting: bool = False) -> None:
         self.data = data
+        self.nesting = bool(nesting)
         n, m = data.n, data.m
         self.n_q = n * (n + 1) // 2
         self.n_y = m * n
@@ -149,6 +160,9 @@ class KothareConic:
                 add_bounded(zv, g.lmul(data.C_out), "y")
             add_unit_diagonal(zv)
         self.scaled_rows = scaled_rows
+        # 5. the nesting Q_outer - Q >= 0 (off-line design): constant filled per solve, last cone
+        if self.nesting:
+            blocks.append((self._psd_rows(-q)[0], None, clarabel.PSDTriangleConeT(n)))
 
         self.offsets = np.cumsum([0] + [blk[0].shape[0] for blk in blocks])
         a_full = np.vstack([blk[0] for blk in blocks])
@@ -212,8 +226,10 @@ class KothareConic:
         return -sv[1:].T, sv[0]
 
     # -- per solve ----------------------------------------------------------------------
-    def b_vector(self, x: np.ndarray) -> np.ndarray:
-        """``b`` at the (normalised) state ``x``: the state block ``[[1, x'], [x, 0]]``."""
+    def b_vector(self, x: np.ndarray, outer: np.ndarray | None = None) -> np.ndarray:
+        """``b`` at the (normalised) state ``x``: the state block ``[[1, x'], [x, 0]]``; with the
+        nesting block, its constant ``outer`` (``Q_outer`` in these data's coordinates, at the
+        normalised state), required then and refused otherwise."""
         n = self.data.n
         b = self.b_static.copy()
         const = np.zeros((n + 1, n + 1))
@@ -221,6 +237,13 @@ class KothareConic:
         const[0, 1:] = x
         const[1:, 0] = x
         b[self.offsets[0] : self.offsets[1]] = svec_matrix(const)
+        if (outer is None) == self.nesting:
+            raise InvalidArgumentError(
+                "outer", "Q_outer with the nesting block, None without it",
+                "None" if outer is None else "a matrix for data without the nesting block",
+            )
+        if outer is not None:
+            b[self.offsets[-2] : self.offsets[-1]] = svec_matrix(0.5 * (outer + outer.T))
         return b
 
     def a_matrix(self, u_max: np.ndarray, y_max: np.ndarray) -> sparse.csc_matrix:

@@ -7,6 +7,10 @@ the state block's constant and the bound scalings of the input (and output) bloc
 are written in place. Successive solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`). A
 solve that fails goes to phase one and then to a :class:`~lmi.backends.clarabel.ClarabelKothare`
 the back-end owns, built on the same conic data (:meth:`IPMKothare.solve`).
+
+With ``nesting=True`` the conic data have one more block, the nesting ``Q_outer - Q >= 0`` of
+the off-line design (:class:`lmi.offline.NestedKothareProblem`), and every solve takes the outer
+``Q`` (:meth:`IPMKothare.solve`); without it nothing differs from the on-line problem.
 """
 
 from __future__ import annotations
@@ -120,6 +124,12 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     return merged
 
 
+def _nest_args(outer: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """``(outer,)`` for the nesting block, ``()`` without it: the on-line problem's stages are
+    called exactly as they are without the nesting option."""
+    return () if outer is None else (outer,)
+
+
 class IPMKothare(KothareBackend):
     """Kothare problem solved by :class:`lmi.ipm.BlockLMISolver`, Clarabel as its fallback.
 
@@ -134,12 +144,23 @@ class IPMKothare(KothareBackend):
         The conic data of ``data``.
     fallback_solver : ClarabelKothare
         The Clarabel back-end on the same ``conic``, which gets the solves that fail.
+
+    Parameters
+    ----------
+    data : KothareData
+    options : dict, optional
+        Settings over :data:`DEFAULT_IPM_OPTIONS`.
+    nesting : bool
+        Add the nesting block ``Q_outer - Q >= 0`` of the off-line design (the last block); every
+        solve then takes ``outer``. Default ``False``: the on-line problem.
     """
 
     name = "ipm"
 
-    def __init__(self, data: KothareData, options: dict[str, Any] | None = None) -> None:
+    def __init__(self, data: KothareData, options: dict[str, Any] | None = None, *,
+                 nesting: bool = False) -> None:
         merged = _check_options(dict(options or {}))
+        self.nesting = bool(nesting)
         t = state_scaling(data) if merged.pop("state_scaling") else np.ones(data.n)
         self.original_data = data
         self._warm_start = merged.pop("warm_start")
@@ -171,7 +192,7 @@ class IPMKothare(KothareBackend):
         self._t = t
         self._scaled = bool(t.ndim == 2 or np.any(t != 1.0))
         self.data = scale_data(data, t) if self._scaled else data
-        conic = self.conic = KothareConic(self.data)
+        conic = self.conic = KothareConic(self.data, nesting=self.nesting)
         self.fallback_solver = ClarabelKothare(self.data, None, conic=conic)
         a_dense = conic.A.toarray()
         h = conic.b_static
@@ -202,6 +223,7 @@ class IPMKothare(KothareBackend):
                 mask[cols[pick], rows[pick]] = True
                 parts.append((mask, idx, kind))
             self._scaled_blocks.append((j, parts))
+        self._nest_block = len(blocks) - 1 if self.nesting else None
         self._solver = BlockLMISolver(conic.objective, blocks, factors=self._block_factors(len(blocks)),
                                       **self._solver_options)
 
@@ -215,7 +237,8 @@ class IPMKothare(KothareBackend):
         cost = cost_block_factors(self.data, VariableLayout.of(n, m, 1, o_y, o_w))
         return [None, *cost, *([None] * (count - 1 - len(cost)))]
 
-    def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> None:
+    def _update_blocks(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
+                       outer: np.ndarray | None = None) -> None:
         n = self.data.n
         const = np.zeros((n + 1, n + 1))
         const[0, 0] = 1.0
@@ -229,10 +252,19 @@ class IPMKothare(KothareBackend):
                 bounds = u_max if kind == "u" else y_max
                 scale[mask] = 1.0 / (bounds[0] if bounds.size == 1 else bounds[idx])
             self._solver.set_block(j, const_j, coef_j * scale)
+        if outer is not None:
+            assert self._nest_block is not None
+            self._solver.set_block(self._nest_block, outer)
 
-    def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+    def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
+              outer: np.ndarray | None = None) -> RawResult:
         """Solve with the IPM; a failure goes to phase one, then (unless proved infeasible) to
         Clarabel.
+
+        ``outer`` (required with ``nesting``, refused without): the outer ellipsoid's ``Q`` at
+        the normalised state ``x``, in the caller's coordinates, i.e. ``Q_outer / ||x_orig||^2``
+        for the design state ``x_orig = ||x_orig|| x``. Every stage maps it into the coordinates it
+        solves in, as it maps the state (:meth:`_outer_scaled`).
 
         A solve that ends ``"infeasible"`` (its dual iterate a Farkas ray, see
         :meth:`lmi.ipm.BlockLMISolver.solve`) is checked by :func:`lmi.infeasibility.check_farkas`
@@ -259,8 +291,14 @@ class IPMKothare(KothareBackend):
         unchanged.
         Times and iterations are the sums over every stage.
         """
+        if (outer is None) == self.nesting:
+            raise InvalidArgumentError(
+                "outer", "Q_outer with nesting=True, None without",
+                "None" if outer is None else "a matrix for a back-end without the nesting block",
+            )
         xs, us, ys, norm = self._balanced(x, u_max, y_max)
-        raw = self._solve_ipm(xs, us, ys)
+        qs = self._outer_scaled(outer, norm)
+        raw = self._solve_ipm(xs, us, ys, qs)
         if raw.status == OPTIMAL:
             return self._unscale(raw, norm)
         if raw.status == INFEASIBLE:
@@ -270,7 +308,8 @@ class IPMKothare(KothareBackend):
             start = time.perf_counter()
             self._build(t_new)
             xs, us, ys, norm = self._balanced(x, u_max, y_max)
-            retry = self._solve_ipm(xs, us, ys)
+            qs = self._outer_scaled(outer, norm)
+            retry = self._solve_ipm(xs, us, ys, qs)
             raw = dataclasses.replace(
                 retry, solver_status=f"{raw.solver_status}; rebalanced {retry.solver_status}",
                 iterations=(raw.iterations or 0) + (retry.iterations or 0),
@@ -280,12 +319,12 @@ class IPMKothare(KothareBackend):
                 return self._unscale(raw, norm)
         u_max, y_max = us, ys
         if self._phase_one:
-            raw = self._decide(raw, xs, u_max, y_max)
+            raw = self._decide(raw, xs, u_max, y_max, *_nest_args(qs))
             if raw.status == INFEASIBLE:
                 return raw
         if not self._fallback:
             return self._unscale(raw, norm)
-        backup = self.fallback_solver.solve(xs, u_max, y_max)
+        backup = self.fallback_solver.solve(xs, u_max, y_max, *_nest_args(qs))
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
         return self._unscale(dataclasses.replace(
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
@@ -302,6 +341,24 @@ class IPMKothare(KothareBackend):
         xs = x / self._t if self._t.ndim == 1 else np.linalg.solve(self._t, x)
         norm = float(np.linalg.norm(xs))
         return xs / norm, u_max / norm, y_max / norm, norm
+
+    def _outer_scaled(self, outer: np.ndarray | None, norm: float) -> np.ndarray | None:
+        """``Q_outer`` (at the normalised state, caller's coordinates) in the solver's:
+        ``T^-1 Q_outer T^-T / norm^2``, as ``Q~`` is to ``Q`` (:meth:`_unscale` is the inverse), with
+        ``norm`` the length of the state in these coordinates (:meth:`_balanced`). Unscaled, the
+        matrix as given (symmetrised)."""
+        if outer is None:
+            return None
+        sym = 0.5 * (outer + outer.T)
+        if not self._scaled:
+            return sym
+        t = self._t
+        if t.ndim == 1:
+            mapped = sym / np.outer(t, t)
+        else:
+            mapped = np.linalg.solve(t, np.linalg.solve(t, sym).T)
+        mapped = mapped / norm**2
+        return 0.5 * (mapped + mapped.T)
 
     def _rebalanced_scaling(self, raw: RawResult, xs: np.ndarray) -> np.ndarray | None:
         """Coordinates balanced on the failed solve ``raw`` at the normalised state ``xs``
@@ -339,7 +396,8 @@ class IPMKothare(KothareBackend):
         step = low * float(np.linalg.norm(np.linalg.solve(low, xs)))
         return self._t[:, None] * step if self._t.ndim == 1 else self._t @ step
 
-    def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+    def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
+                outer: np.ndarray | None = None) -> RawResult:
         """Phase one after the failed solve ``raw`` (blocks already at this state): ``raw`` as
         ``"infeasible"`` with the checked certificate, or ``raw`` with phase one's word, time
         and iterations added."""
@@ -353,7 +411,7 @@ class IPMKothare(KothareBackend):
         word = res.status
         cert = None
         if res.status == "infeasible":
-            cert = self.farkas_check(res.Z, xs, u_max, y_max)
+            cert = self.farkas_check(res.Z, xs, u_max, y_max, *_nest_args(outer))
             if not cert.ok:
                 word = "infeasible (unchecked)"
         iterations = (raw.iterations or 0) + res.iterations
@@ -365,10 +423,11 @@ class IPMKothare(KothareBackend):
                                    iterations=iterations, solve_time=elapsed)
 
     def farkas_check(self, z_blocks: list[np.ndarray], xs: np.ndarray, u_max: np.ndarray,
-                     y_max: np.ndarray) -> InfeasibilityCertificate:
+                     y_max: np.ndarray, outer: np.ndarray | None = None) -> InfeasibilityCertificate:
         """Check multipliers ``Z`` (one block per LMI block of the solver) as a Farkas certificate
         on the conic data Clarabel would be given at this (normalised, balanced) state and
-        bounds: ``A`` with the bound rows scaled, ``b`` with the state block."""
+        bounds: ``A`` with the bound rows scaled, ``b`` with the state block (and the nesting
+        block's ``outer``, in the solver's coordinates)."""
         parts, cones = [], []
         for cone, zj, rows in zip(self.conic.cones, z_blocks, self._block_rows, strict=True):
             if isinstance(cone, clarabel.PSDTriangleConeT):
@@ -378,7 +437,8 @@ class IPMKothare(KothareBackend):
                 parts.append(np.diag(zj).copy())
                 cones.append(("nonneg", rows.stop - rows.start))
         conic = self.conic
-        return check_farkas(conic.a_matrix(u_max, y_max), conic.b_vector(xs), cones, np.concatenate(parts))
+        return check_farkas(conic.a_matrix(u_max, y_max), conic.b_vector(xs, outer), cones,
+                            np.concatenate(parts))
 
     def _unscale(self, raw: RawResult, norm: float) -> RawResult:
         """Back to the caller's coordinates and state: ``Q = T Q~ T' norm^2``, ``Y = Y~ T' norm^2``,
@@ -392,10 +452,11 @@ class IPMKothare(KothareBackend):
         return dataclasses.replace(raw, gamma=raw.gamma * s2, Q=raw.Q * np.outer(t, t) * s2,
                                    Y=raw.Y * t[None, :] * s2)
 
-    def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
+    def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
+                   outer: np.ndarray | None = None) -> RawResult:
         start = time.perf_counter()
         try:
-            self._update_blocks(x, u_max, y_max)
+            self._update_blocks(x, u_max, y_max, outer)
             with self._blas.limit():
                 res = self._solver.solve(warm_start=self._warm_start)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
@@ -405,7 +466,7 @@ class IPMKothare(KothareBackend):
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
         if res.status == "infeasible":
-            cert = self.farkas_check(res.Z, x, u_max, y_max)
+            cert = self.farkas_check(res.Z, x, u_max, y_max, *_nest_args(outer))
             if cert.ok:
                 return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
                                  infeasibility=cert)

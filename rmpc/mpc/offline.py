@@ -25,7 +25,7 @@ from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_bool, check_choice, check_positive
 
-if TYPE_CHECKING:  # lmi.offline imports cvxpy (~0.5 s); it is imported when a controller is built
+if TYPE_CHECKING:  # lmi.offline is imported when a controller is built
     from lmi.offline import OfflineTable
 
 __all__ = ["OUTSIDE", "OfflineRMPC"]
@@ -71,8 +71,13 @@ class OfflineRMPC:
         Interpolate between neighbouring gains (default). Between neighbours where Wan &
         Kothare's condition (18) fails, the outer gain is applied instead (recorded in
         ``table.interpolable``).
+    backend : {"ipm", "clarabel", "cvxpy"}
+        The design's back-end (:class:`lmi.offline.NestedKothareProblem`): ``"ipm"`` (default),
+        the on-line problem's interior-point method with the nesting block; ``"cvxpy"`` with
+        ``solver`` (default ``"CLARABEL"``) the LMIs written with cvxpy.
     solver, solver_options, formulation, certificate_tol
-        Passed to :class:`lmi.offline.NestedKothareProblem`.
+        Passed to :class:`lmi.offline.NestedKothareProblem` (``solver`` only with
+        ``backend="cvxpy"``).
 
     Attributes
     ----------
@@ -122,7 +127,8 @@ class OfflineRMPC:
         shrink: float = 0.5,
         path: Literal["ray", "trajectory"] = "ray",
         interpolate: bool = True,
-        solver: str = "CLARABEL",
+        backend: str = "ipm",
+        solver: str | None = None,
         solver_options: dict[str, Any] | None = None,
         formulation: Literal["delta", "delta_shared", "standard"] = "delta_shared",
         certificate_tol: float = 1e-7,
@@ -143,7 +149,8 @@ class OfflineRMPC:
 
         self.problem = NestedKothareProblem(
             plant.A, plant.B, Q, R, dt=plant.dt, input_constraint=input_constraint, u_max=u_max,
-            output_matrix=output_matrix, y_max=y_max, solver=solver, solver_options=solver_options,
+            output_matrix=output_matrix, y_max=y_max, backend=backend, solver=solver,
+            solver_options=solver_options,
             formulation=formulation, certificate_tol=certificate_tol,
         )
         self.n_ellipsoids = int(n_ellipsoids)

@@ -209,7 +209,7 @@ def settings_rows() -> list[tuple[str, str, str]]:
             "OfflineRMPC",
             "6 ellipsoids along the ray of the initial state, shrink 0.5, interpolation; LMIs in the "
             "'delta' form (one cost block per vertex; Clarabel on 'delta_shared' is measured in the F4 "
-            "notes)",
+            "notes), designed on the toolkit's ipm",
             "toolkit (Wan & Kothare 2003)",
         ),
         (
