@@ -194,7 +194,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
     for k, sign in enumerate(signs):
         tag = "" if sign is None else f"_s{k}"
         ys = y_sign(sign)
-        if shared:
+        if shared and prog.wants(f"cost_shared{tag}"):
             w_dt = prog.var(f"W{k}") * fd.dt
             cost_rows = [g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)] if p else [ys.T.rmul(rh.T)]
             gam_blocks = ([prog.times(gamma, np.eye(p))] if p else []) + [prog.times(gamma, np.eye(m))]
@@ -205,20 +205,27 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
             extra = (p if p else 0) + m
             scale = np.diag(np.concatenate([np.full(n, 1.0 / root), np.full(extra, root)]))
             prog.add(f"cost_shared{tag}", prog.bmat(rows), congruence=scale)
+        if shared:
+            w_dt = prog.var(f"W{k}") * fd.dt
             for i, j in vertex_pairs:
+                if not prog.wants(f"cost_{i}_{j}{tag}"):
+                    continue
                 mid = g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])
                 block = prog.bmat([[top(i) - w_dt, mid.T], [mid, q_next(j)]])
                 prog.add(f"cost_{i}_{j}{tag}", block, congruence=delta(0, 1.0))
         elif opts.cost == "worst_case":
             for i, j in vertex_pairs:
-                prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys),
-                         congruence=cost_delta)
-        else:
+                if prog.wants(f"cost_{i}_{j}{tag}"):
+                    prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys),
+                             congruence=cost_delta)
+        elif prog.wants(f"cost_nominal{tag}"):
             assert fd.A0 is not None and fd.B0 is not None
             prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys),
                      congruence=cost_delta)
         if disturbed or opts.cost == "nominal":
             for i, j in vertex_pairs:
+                if not prog.wants(f"invariance_{i}_{j}{tag}"):
+                    continue
                 block = invariance_block(fd.A[i], fd.B[i], top(i), q_next(j), ys)
                 prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)

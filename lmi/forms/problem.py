@@ -318,13 +318,17 @@ class FormProblem:
             if solver is None:
                 prog = self._symbolic(fd)
                 solver = BlockLMISolver(self._c, prog.solver_blocks(), **settings)
+                solver.form_blocks = {name: j for j, name in enumerate(prog.blocks)}
+                solver.form_static = _static_blocks(prog, fd)
                 if keep:
                     self._solvers[key] = solver
                 warm = False
             else:
-                consts = write(Program(self.layout, {}), self.options, fd).constants()
-                for j, const in enumerate(consts):
-                    solver.set_block(j, const)
+                # only the blocks whose constant changes with the state and the bounds
+                changing = Program(self.layout, {}, skip=solver.form_static)
+                consts = write(changing, self.options, fd).constants()
+                for name, const in consts.items():
+                    solver.set_block(solver.form_blocks[name], const)
                 warm = bool(self._settings["warm_start"])
             res = solver.solve(warm_start=warm)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
@@ -389,7 +393,7 @@ class FormProblem:
                 self._solvers[key] = built
         problem, z, params = built
         consts = write(Program(self.layout, {}), self.options, fd).constants()
-        for param, const in zip(params, consts, strict=True):
+        for param, const in zip(params, consts.values(), strict=True):
             param.value = const
         start = time.perf_counter()
         try:
@@ -463,6 +467,15 @@ class FormProblem:
             else:
                 out[name] = val
         return out
+
+
+def _static_blocks(prog: Program, fd: FormData) -> frozenset[str]:
+    """The blocks whose constant part is zero whatever the state and the bounds: the cost blocks,
+    and the invariance blocks without a disturbance (their ``w_max E`` scales with the state)."""
+    disturbed = fd.E is not None and fd.w_max > 0.0
+    names = [name for name in prog.blocks
+             if name.startswith("cost") or (name.startswith("invariance") and not disturbed)]
+    return frozenset(name for name in names if not np.any(prog.blocks[name].coef[0]))
 
 
 def _inner_ellipsoid(q_vertices: tuple[np.ndarray, ...]) -> np.ndarray | None:

@@ -108,9 +108,11 @@ class Program:
         the given matrix (a missing one is zero), and the blocks are constant matrices.
     """
 
-    def __init__(self, layout: Layout, values: Mapping[str, np.ndarray] | None = None) -> None:
+    def __init__(self, layout: Layout, values: Mapping[str, np.ndarray] | None = None,
+                 skip: frozenset[str] = frozenset()) -> None:
         self.layout = layout
         self.numeric = values is not None
+        self.skip = skip
         self._values = dict(values or {})
         self.n_vars = 0 if self.numeric else layout.size
         self.blocks: dict[str, AffineMatrix] = {}
@@ -139,6 +141,10 @@ class Program:
 
     def bmat(self, rows: list[list[AffineMatrix | None]]) -> AffineMatrix:
         return AffineMatrix.bmat(rows, self.n_vars)
+
+    def wants(self, name: str) -> bool:
+        """Whether block ``name`` is to be written (``skip``: blocks the caller has already)."""
+        return name not in self.skip
 
     def add(self, name: str, block: AffineMatrix, congruence: np.ndarray | None = None) -> None:
         """Require ``block >= 0`` (its symmetric part).
@@ -169,10 +175,10 @@ class Program:
             out.append((coef[0], -coef[1:]))
         return out
 
-    def constants(self) -> list[np.ndarray]:
+    def constants(self) -> dict[str, np.ndarray]:
         """The constant part of each block as the solvers get it (a numeric program: the blocks'
         values)."""
-        return [self.solver_coef(name)[0] for name in self.blocks]
+        return {name: self.solver_coef(name)[0] for name in self.blocks}
 
     def conic_rows(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
         """``(A, b, orders)`` with ``svec(M_j(z)) = b_j - A_j z`` stacked over the blocks
@@ -187,12 +193,19 @@ class Program:
 
     def margins(self) -> dict[str, float]:
         """Of a numeric program: each block's smallest eigenvalue relative to its largest."""
-        out = {}
+        mats = {}
         for name, block in self.blocks.items():
-            out[name] = relative_margin(block.coef[0])
+            mats[name] = block.coef[0]
             if name in self._congruences:
-                out[name + "_delta"] = relative_margin(self.solver_coef(name)[0])
-        return out
+                mats[name + "_delta"] = self.solver_coef(name)[0]
+        out: dict[str, float] = {}
+        by_order: dict[int, list[str]] = {}
+        for name, mat in mats.items():
+            by_order.setdefault(mat.shape[0], []).append(name)
+        for names in by_order.values():  # one batched eigenvalue call per block order
+            for name, margin in zip(names, relative_margins(np.stack([mats[k] for k in names])), strict=True):
+                out[name] = margin
+        return {name: out[name] for name in mats}
 
 
 def relative_margin(mat: np.ndarray) -> float:
@@ -203,3 +216,12 @@ def relative_margin(mat: np.ndarray) -> float:
     lam = np.linalg.eigvalsh(sym)
     scale = max(float(np.max(np.abs(lam))), np.finfo(float).tiny)
     return float(lam[0] / scale)
+
+
+def relative_margins(stack: np.ndarray) -> list[float]:
+    """:func:`relative_margin` of each matrix of a ``(count, k, k)`` stack."""
+    sym = 0.5 * (stack + np.swapaxes(stack, 1, 2))
+    finite = np.all(np.isfinite(sym), axis=(1, 2))
+    lam = np.linalg.eigvalsh(np.where(finite[:, None, None], sym, 0.0))
+    scale = np.maximum(np.max(np.abs(lam), axis=1), np.finfo(float).tiny)
+    return [float(v) if ok else -np.inf for v, ok in zip(lam[:, 0] / scale, finite, strict=True)]
