@@ -44,6 +44,7 @@ from lmi.backends.conic import KothareConic
 from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
+from lmi.forms import FormProblem
 from lmi.status import CVXPY_STATUS_MAP, INACCURATE, OPTIMAL, SOLVER_ERROR, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_positive
@@ -204,6 +205,18 @@ class NestedKothareProblem:
         Every recomputed relative margin (Kothare LMIs, nesting) must be ``>= -tol``.
     interpolation_tol : float
         Condition (18) is taken to hold when its relative margin is ``> interpolation_tol``.
+    cost : {"worst_case", "nominal"}
+        ``"nominal"``: each ellipsoid minimises the cost bound on the nominal model with robust
+        invariance on every vertex (Wan & Kothare, "Efficient robust constrained model
+        predictive control with a time varying terminal constraint set", Systems & Control
+        Letters 48, 2003; the LMIs of :mod:`lmi.forms`, solved by :class:`lmi.forms.FormProblem`
+        with the nesting block, certified block by block). Needs ``nominal``.
+    lyapunov : {"common"}
+        The nesting argument (each ellipsoid invariant under its own gain, nested inside the
+        previous one) needs one Lyapunov matrix per ellipsoid: the vertex forms, whose
+        invariant set depends on the unknown plant, are refused with an error.
+    nominal : (A0, B0), optional
+        The nominal model for ``cost="nominal"``.
 
     Examples
     --------
@@ -240,11 +253,34 @@ class NestedKothareProblem:
         formulation: Formulation = "delta_shared",
         certificate_tol: float = 1e-7,
         interpolation_tol: float = 1e-9,
+        cost: str = "worst_case",
+        lyapunov: str = "common",
+        nominal: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> None:
         self.data: KothareData = build_kothare_data(
             A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
             output_matrix=output_matrix, y_max=y_max, formulation=formulation,
         )
+        if lyapunov != "common":
+            raise InvalidArgumentError(
+                "lyapunov", "'common' (the off-line design nests one invariant ellipsoid per gain; a "
+                "vertex form's invariant set depends on the unknown plant)", repr(lyapunov),
+            )
+        if cost not in ("worst_case", "nominal"):
+            raise InvalidArgumentError("cost", "'worst_case' or 'nominal'", repr(cost))
+        self.cost = cost
+        self._forms: FormProblem | None = None
+        if cost == "nominal":
+            if formulation != "delta_shared":
+                raise InvalidArgumentError("formulation, cost", "the default formulation with cost='nominal' "
+                                           "(the forms' own delta congruence)", repr(formulation))
+            if backend == "cvxpy" and solver not in (None, "CLARABEL", "clarabel"):
+                raise InvalidArgumentError("solver", "None or 'CLARABEL' with cost='nominal'", repr(solver))
+            self._forms = FormProblem(
+                A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
+                output_matrix=output_matrix, y_max=y_max, nominal=nominal, cost="nominal",
+                backend=backend, solver_options=solver_options, certificate_tol=certificate_tol,
+            )
         if solver_options is not None and not isinstance(solver_options, dict):
             raise InvalidArgumentError(
                 "solver_options", "a dict of solver settings", type(solver_options).__name__
@@ -255,6 +291,9 @@ class NestedKothareProblem:
         # back-end whose data have the nesting block.
         self._plain: KothareBackend
         self._nest: KothareBackend
+        if self._forms is not None:
+            self._kind = "forms"
+            return
         if backend == "ipm":
             if solver is not None:
                 raise InvalidArgumentError("solver", "None with backend='ipm'", repr(solver))
@@ -294,7 +333,9 @@ class NestedKothareProblem:
     def reset(self) -> None:
         """Forget what earlier solves left behind (the IPM's warm starts and rebalanced
         coordinates); every design starts with this, so a table does not depend on earlier ones."""
-        if self._kind != "cvxpy":
+        if self._forms is not None:
+            self._forms.reset()
+        elif self._kind != "cvxpy":
             self._plain.reset()
             self._nest.reset()
 
@@ -312,9 +353,26 @@ class NestedKothareProblem:
             raise InvalidArgumentError("x", "a non-zero design state", "x = 0")
         if outer is not None and (outer.Q is None or not outer.ok):
             raise InvalidArgumentError("outer", "a certified NestedEllipsoid", f"status {outer.status!r}")
+        if self._forms is not None:
+            return self._solve_forms(x, outer)
         if self._kind != "cvxpy":
             return self._solve_conic(x, s, outer)
         return self._solve_cvxpy(x, s, outer)
+
+    def _solve_forms(self, x: np.ndarray, outer: NestedEllipsoid | None) -> NestedEllipsoid:
+        """The nominal cost: :class:`lmi.forms.FormProblem` with the nesting block, its own
+        certificate (every block, the nesting one included), and the nesting margin again."""
+        assert self._forms is not None
+        sol = self._forms.solve(x, q_outer=None if outer is None else outer.Q)
+        if sol.Q is None:
+            return NestedEllipsoid(sol.status, x, np.nan, None, None, None, None, np.nan, sol.solve_time,
+                                   sol.solver_status, sol.iterations)
+        nest = np.nan if outer is None or outer.Q is None else nesting_margin(outer.Q, sol.Q)
+        status = sol.status
+        if status == OPTIMAL and nest < -self.certificate_tol:
+            status = UNCERTIFIED
+        return NestedEllipsoid(status, x, sol.gamma, sol.Q, sol.Y, sol.F, sol.certificate, nest,
+                               sol.solve_time, sol.solver_status, sol.iterations)
 
     def _solve_conic(self, x: np.ndarray, s: float, outer: NestedEllipsoid | None) -> NestedEllipsoid:
         """The ``"ipm"`` and ``"clarabel"`` back-ends: the normalised problem, ``Q_outer / s^2``."""

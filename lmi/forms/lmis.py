@@ -46,6 +46,7 @@ class FormData:
     w_max: float
     lam: float
     dt: float = 1.0
+    q_outer: np.ndarray | None = None  # the off-line design's previous ellipsoid (common Q only)
 
     @property
     def n(self) -> int:
@@ -228,6 +229,8 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
                     continue
                 block = invariance_block(fd.A[i], fd.B[i], top(i), q_next(j), ys)
                 prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
+    if fd.q_outer is not None:  # Wan & Kothare's nesting, Q_outer - Q >= 0
+        prog.add("nesting", prog.const(fd.q_outer) - lyap[0])
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)
     _bound_blocks(prog, opts, fd, top, y_sign, signs, lyap)
     return prog

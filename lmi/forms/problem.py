@@ -153,12 +153,14 @@ class FormProblem:
                     "output bounds larger than the disturbance's own reach ||c_r E|| w_max",
                     f"y_max - ||C E|| w_max = {tight.tolist()}",
                 )
+        # the nesting block's Q_outer / ||x||^2 of the solve under way (set by every solve)
+        self._q_outer: np.ndarray | None = None
         use_scaling = self._settings.pop("state_scaling", True) if backend == "ipm" else False
         self._t = state_scaling(data) if use_scaling else np.ones(data.n)
         template = self._form_data(np.ones(data.n), data.u_max, data.y_max, 0.0, 1.0)
         self.layout: Layout = declare(self.options, template)
         self._c = objective(self.options, self.layout)
-        self._solvers: dict[float, Any] = {}
+        self._solvers: dict[tuple, Any] = {}
         self._blas = SingleThreadBlas()
 
     # -- checks ----------------------------------------------------------------------------
@@ -209,7 +211,9 @@ class FormProblem:
         y_tight = y_max
         if self._E is not None and data.C_out is not None:
             y_tight = y_max - np.linalg.norm(data.C_out @ self._E, axis=1) * w_max
+        q_outer = self._q_outer
         return FormData(
+            q_outer=None if q_outer is None else ti[:, None] * q_outer * ti[None, :],
             A=a, B=b, A0=a0, B0=b0, Q1h=data.Q1h * t[None, :], Rh=data.Rh,
             input_constraint=data.input_constraint,
             C_out=None if data.C_out is None else data.C_out * t[None, :],
@@ -222,15 +226,26 @@ class FormProblem:
         """Forget the solvers built so far (their warm starts): the next solve starts afresh."""
         self._solvers.clear()
 
-    def solve(self, x: ArrayLike, u_max: ArrayLike | None = None) -> LMISolution:
-        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised."""
+    def solve(self, x: ArrayLike, u_max: ArrayLike | None = None, q_outer: ArrayLike | None = None
+              ) -> LMISolution:
+        """Solve at the state ``x`` (non-zero); failures come back as a status, never raised.
+
+        ``q_outer``: with the common Lyapunov function, also ``Q_outer - Q >= 0`` (the off-line
+        design's nesting, :class:`lmi.offline.NestedKothareProblem`; certified as the block
+        ``"nesting"``).
+        """
         x = as_vector(x, "x", self.data.n)
+        if q_outer is not None:
+            if self.options.lyapunov != "common":
+                raise InvalidArgumentError("q_outer", "None unless lyapunov='common'", "a matrix")
+            q_outer = as_matrix(q_outer, "q_outer", (self.data.n, self.data.n))
         scale = float(np.linalg.norm(x))
         if scale == 0.0:
             expected = "a non-zero state (the problem is degenerate at the origin)"
             raise InvalidArgumentError("x", expected, "x = 0")
         bound = self.data.u_max if u_max is None else self.input_bound(u_max)
         xs, us, ys = x / scale, bound / scale, self.data.y_max / scale
+        self._q_outer = None if q_outer is None else 0.5 * (q_outer + q_outer.T) / scale**2
         dist = self.options.disturbance
         w_max = 0.0 if dist is None else dist.w_max / scale
         if w_max > 0.0 and dist is not None and dist.lam is None:
@@ -311,7 +326,7 @@ class FormProblem:
 
     def _solve_ipm(self, fd: FormData, keep: bool = True) -> _Solved:
         settings = {k: v for k, v in self._settings.items() if k not in ("fallback", "warm_start")}
-        key = ("ipm", fd.lam)
+        key = ("ipm", fd.lam, fd.q_outer is not None)
         solver = self._solvers.get(key)
         start = time.perf_counter()
         try:
@@ -374,7 +389,7 @@ class FormProblem:
     def _solve_cvxpy(self, fd: FormData, keep: bool = True) -> _Solved:
         import cvxpy as cp
 
-        key = ("cvxpy", fd.lam)
+        key = ("cvxpy", fd.lam, fd.q_outer is not None)
         built = self._solvers.get(key)
         if built is None:
             prog = self._symbolic(fd)

@@ -78,6 +78,12 @@ class OfflineRMPC:
     solver, solver_options, formulation, certificate_tol
         Passed to :class:`lmi.offline.NestedKothareProblem` (``solver`` only with
         ``backend="cvxpy"``).
+    cost : {"worst_case", "nominal"}
+        ``"nominal"``: each ellipsoid bounds the cost on ``plant.nominal`` with robust invariance
+        on every vertex (the nominal form of :mod:`lmi.forms`, nested).
+    lyapunov : {"common"}
+        The only Lyapunov form the nesting argument holds for (see
+        :class:`lmi.offline.NestedKothareProblem`); the vertex forms raise an error.
 
     Attributes
     ----------
@@ -132,6 +138,8 @@ class OfflineRMPC:
         solver_options: dict[str, Any] | None = None,
         formulation: Literal["delta", "delta_shared", "standard"] = "delta_shared",
         certificate_tol: float = 1e-7,
+        cost: Literal["worst_case", "nominal"] = "worst_case",
+        lyapunov: Literal["common"] = "common",
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
@@ -152,6 +160,7 @@ class OfflineRMPC:
             output_matrix=output_matrix, y_max=y_max, backend=backend, solver=solver,
             solver_options=solver_options,
             formulation=formulation, certificate_tol=certificate_tol,
+            cost=cost, lyapunov=lyapunov, nominal=plant.nominal,
         )
         self.n_ellipsoids = int(n_ellipsoids)
         self.shrink = float(shrink)
