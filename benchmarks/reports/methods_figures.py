@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -58,28 +57,12 @@ def plot_regions(
     return path
 
 
-def plot_summary(records: Sequence[Mapping[str, Any]], path: Path) -> Path | None:
-    """Two heat maps, problem x method: region and closed-loop cost, each over Kothare's."""
-    from benchmarks.suites.methods import METHODS, region_ratio
-
-    problems = list(dict.fromkeys(r["problem"] for r in records))
-    methods = [m for m in METHODS if any(r["method"] == m for r in records)]
+def plot_summary(problems: Sequence[str], methods: Sequence[str], region: np.ndarray, cost: np.ndarray,
+                 path: Path) -> Path | None:
+    """Two heat maps, problem x method: region and closed-loop cost, each over Kothare's
+    (``region`` and ``cost`` of shape ``(len(problems), len(methods))``, NaN where unknown)."""
     if not problems or not methods:
         return None
-    region = np.full((len(problems), len(methods)), np.nan)
-    cost = np.full_like(region, np.nan)
-    for i, p in enumerate(problems):
-        base = next((r for r in records if r["problem"] == p and r["method"] == "kothare"), None)
-        for j, m in enumerate(methods):
-            rec = next((r for r in records if r["problem"] == p and r["method"] == m), None)
-            if rec is None or base is None:
-                continue
-            ratio = region_ratio(rec, base)
-            if ratio is not None:
-                region[i, j] = ratio
-            c, c0 = rec.get("closed_loop_cost"), base.get("closed_loop_cost")
-            if c is not None and c0 and np.isfinite(c):
-                cost[i, j] = c / c0
     fig = Figure(figsize=(11.0, 1.2 + 0.55 * len(problems) * 2), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(2, 1)

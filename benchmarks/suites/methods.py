@@ -633,6 +633,28 @@ def _ms(value: float | None) -> str:
     return "-" if value is None else f"{1e3 * value:.1f}"
 
 
+def summary_ratios(records: list[dict[str, Any]]) -> tuple[list[str], list[str], np.ndarray, np.ndarray]:
+    """Problems, methods and the matrices (problem x method) of the region and of the closed-loop
+    cost on the nominal plant, each over Kothare's (NaN where a record or a value is missing)."""
+    problems = list(dict.fromkeys(r["problem"] for r in records))
+    methods = [m for m in METHODS if any(r["method"] == m for r in records)]
+    region = np.full((len(problems), len(methods)), np.nan)
+    cost = np.full_like(region, np.nan)
+    for i, p in enumerate(problems):
+        base = next((r for r in records if r["problem"] == p and r["method"] == "kothare"), None)
+        for j, m in enumerate(methods):
+            rec = next((r for r in records if r["problem"] == p and r["method"] == m), None)
+            if rec is None or base is None:
+                continue
+            ratio = region_ratio(rec, base)
+            if ratio is not None:
+                region[i, j] = ratio
+            c, c0 = rec.get("closed_loop_cost"), base.get("closed_loop_cost")
+            if c is not None and c0 and np.isfinite(c):
+                cost[i, j] = c / c0
+    return problems, methods, region, cost
+
+
 def region_ratio(rec: dict[str, Any], base: dict[str, Any] | None) -> float | None:
     """Geometric mean over the directions of ``t(method) / t(kothare)`` (directions where both > 0)."""
     if base is None or rec.get("region") is None or base.get("region") is None:
@@ -776,7 +798,7 @@ def write_methods_report(
             if path is not None:
                 figures[p] = path
                 files.append(path)
-    summary = plot_summary(records, out / "figures" / "summary.png")
+    summary = plot_summary(*summary_ratios(records), out / "figures" / "summary.png")
     if summary is not None:
         files.append(summary)
     scale = "short run (a smoke run: few directions, short horizons; no measurement)" if short else "full run"
