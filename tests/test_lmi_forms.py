@@ -135,3 +135,13 @@ def test_rmpc_keeps_kothares_problem_for_the_default_form():
 def test_a_disturbance_that_reaches_past_an_output_bound_is_refused():
     with pytest.raises(Exception, match="disturbance, y_max"):
         FormProblem(**MUP, disturbance=(np.array([[100.0], [0.0]]), 0.2))
+
+
+def test_a_form_too_large_for_dense_coefficients_is_refused(monkeypatch):
+    import lmi.forms.problem as problem
+
+    # Kothare's example 2: "vertex" 7 blocks in 51 variables, about 0.39 MB; "vertex_pairs" 9, 0.55 MB
+    monkeypatch.setattr(problem, "MAX_COEFFICIENT_BYTES", 4.5e5)
+    FormProblem(**EX2, lyapunov="vertex", backend="ipm")
+    with pytest.raises(Exception, match=r"lyapunov, saturation.*blocks of orders up to"):
+        FormProblem(**EX2, lyapunov="vertex_pairs", backend="ipm")

@@ -45,7 +45,14 @@ from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_positive
 
-__all__ = ["LAMBDA_GRID", "FormProblem"]
+__all__ = ["LAMBDA_GRID", "MAX_COEFFICIENT_BYTES", "FormProblem"]
+
+#: The largest memory the dense block coefficients of a form may take (bytes); a larger form is
+#: refused at construction with an error that says its size. The 14-state flexible satellite over 8
+#: vertices (3 inputs, peak bound) is estimated at 0.4 GB with ``"vertex"`` (41 blocks, 1184
+#: variables), 1.7 GB with ``"vertex_pairs"`` (97 blocks) and 1.5 GB with the auxiliary saturation
+#: (76 blocks, 1030 variables).
+MAX_COEFFICIENT_BYTES = 4e9
 
 #: The contraction factors tried first when the disturbance form searches ``lam``; the best is
 #: then refined by :data:`LAMBDA_REFINE` golden-section steps inside its neighbours' interval.
@@ -160,10 +167,25 @@ class FormProblem:
         template = self._form_data(np.ones(data.n), data.u_max, data.y_max, 0.0, 1.0)
         self.layout: Layout = declare(self.options, template)
         self._c = objective(self.options, self.layout)
+        self._check_size(template)
         self._solvers: dict[tuple, Any] = {}
         self._blas = SingleThreadBlas()
 
     # -- checks ----------------------------------------------------------------------------
+    def _check_size(self, template: FormData) -> None:
+        """Refuse a form whose dense block coefficients would not fit in :data:`MAX_COEFFICIENT_BYTES`
+        (the blocks are held as dense ``(n_vars + 1, k, k)`` arrays, about three copies of each)."""
+        orders = [b.shape[0] for b in write(Program(self.layout, {}), self.options, template).blocks.values()]
+        need = 3.0 * 8.0 * (self.layout.size + 1) * sum(k * k for k in orders)
+        if need > MAX_COEFFICIENT_BYTES:
+            raise InvalidArgumentError(
+                "lyapunov, saturation",
+                f"a form whose LMIs fit in {MAX_COEFFICIENT_BYTES / 1e9:g} GB as dense coefficients (fewer "
+                "vertices, the common Lyapunov function, or no auxiliary saturation)",
+                f"{len(orders)} blocks of orders up to {max(orders)} in {self.layout.size} variables, "
+                f"about {need / 1e9:.1f} GB",
+            )
+
     def _check_nominal(self, nominal: Any) -> tuple[np.ndarray, np.ndarray] | None:
         n, m = self.data.n, self.data.m
         if nominal is None:
