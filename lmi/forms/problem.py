@@ -31,7 +31,7 @@ from lmi.forms.program import Layout, Program
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
 from lmi.kothare import KothareProblem, LMISolution
-from lmi.scaling import state_scaling
+from lmi.scaling import MIN_SPREAD, state_scaling
 from lmi.status import (
     CLARABEL_STATUS_MAP,
     CVXPY_STATUS_MAP,
@@ -90,7 +90,11 @@ class FormProblem:
         ``fallback``), Clarabel's own API, or cvxpy with Clarabel (the same LMIs, the reference).
     solver_options : dict, optional
         For ``"ipm"``: ``fallback`` (bool, default true), ``warm_start`` (bool, default true),
-        ``state_scaling`` (bool, default true) and :class:`lmi.BlockLMISolver`'s settings
+        ``state_scaling`` (bool, default true), ``phase_one`` (bool, default true: a failed solve
+        runs :meth:`lmi.BlockLMISolver.phase_one`, whose checked Farkas certificate makes it
+        ``"infeasible"``, before the fallback), ``rebalance`` (bool, default true: a failed solve
+        is retried cold in coordinates balanced on its last Lyapunov matrix, kept for the next
+        solves) and :class:`lmi.BlockLMISolver`'s settings
         (``tol_feas``, ``max_iter``, ...). For ``"clarabel"``/``"cvxpy"``: Clarabel's settings.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed block's relative margin is ``>= -tol``.
@@ -164,6 +168,7 @@ class FormProblem:
         self._q_outer: np.ndarray | None = None
         use_scaling = self._settings.pop("state_scaling", True) if backend == "ipm" else False
         self._t = state_scaling(data) if use_scaling else np.ones(data.n)
+        self._t0 = self._t  # a rebalanced retry replaces _t; reset() restores this
         template = self._form_data(np.ones(data.n), data.u_max, data.y_max, 0.0, 1.0)
         self.layout: Layout = declare(self.options, template)
         self._c = objective(self.options, self.layout)
@@ -202,14 +207,16 @@ class FormProblem:
             raise InvalidArgumentError("solver_options", "a dict of solver settings", type(options).__name__)
         opts = dict(options or {})
         if self.backend == "ipm":
-            known = {"fallback", "warm_start", "state_scaling", "tol_feas", "tol_gap_abs", "tol_gap_rel",
-                     "max_iter", "warm_max_iter", "warm_gap", "warm_feas", "infeasibility_radius"}
+            known = {"fallback", "warm_start", "state_scaling", "phase_one", "rebalance", "tol_feas",
+                     "tol_gap_abs", "tol_gap_rel", "max_iter", "warm_max_iter", "warm_gap", "warm_feas",
+                     "infeasibility_radius"}
             unknown = sorted(set(opts) - known)
             if unknown:
                 raise InvalidArgumentError("solver_options", f"settings among {sorted(known)}",
                                            f"unknown setting(s) {unknown}")
             merged: dict[str, Any] = {"fallback": True, "warm_start": True, "state_scaling": True,
-                                      "tol_gap_abs": 1e-12, "max_iter": 100}
+                                      "phase_one": True, "rebalance": True, "tol_gap_abs": 1e-12,
+                                      "max_iter": 100}
             merged.update(opts)
             return merged
         from lmi.backends.clarabel import clarabel_settings
@@ -222,31 +229,33 @@ class FormProblem:
                    t: np.ndarray | None = None) -> FormData:
         """The LMIs' numbers in the coordinates ``x = T x~`` (``T = diag(t)``)."""
         data = self.data
-        t = self._t if t is None else t
-        ti = 1.0 / t
-        a = ti[None, :, None] * data.A * t[None, None, :]
-        b = ti[None, :, None] * data.B
+        t = _as_matrix(self._t if t is None else t)
+        ti = np.linalg.inv(t)
+        a = ti @ data.A @ t
+        b = ti @ data.B
         a0 = b0 = None
         if self._nominal is not None:
-            a0 = ti[:, None] * self._nominal[0] * t[None, :]
-            b0 = ti[:, None] * self._nominal[1]
+            a0 = ti @ self._nominal[0] @ t
+            b0 = ti @ self._nominal[1]
         y_tight = y_max
         if self._E is not None and data.C_out is not None:
             y_tight = y_max - np.linalg.norm(data.C_out @ self._E, axis=1) * w_max
         q_outer = self._q_outer
         return FormData(
-            q_outer=None if q_outer is None else ti[:, None] * q_outer * ti[None, :],
-            A=a, B=b, A0=a0, B0=b0, Q1h=data.Q1h * t[None, :], Rh=data.Rh,
+            q_outer=None if q_outer is None else ti @ q_outer @ ti.T,
+            A=a, B=b, A0=a0, B0=b0, Q1h=data.Q1h @ t, Rh=data.Rh,
             input_constraint=data.input_constraint,
-            C_out=None if data.C_out is None else data.C_out * t[None, :],
-            E=None if self._E is None else ti[:, None] * self._E,
-            x=ti * x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam, dt=data.dt,
+            C_out=None if data.C_out is None else data.C_out @ t,
+            E=None if self._E is None else ti @ self._E,
+            x=ti @ x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam, dt=data.dt,
         )
 
     # -- solve ---------------------------------------------------------------------------------
     def reset(self) -> None:
-        """Forget the solvers built so far (their warm starts): the next solve starts afresh."""
+        """Forget the solvers built so far (their warm starts) and any rebalanced coordinates: the
+        next solve gives what a freshly built problem gives."""
         self._solvers.clear()
+        self._t = self._t0
 
     def solve(self, x: ArrayLike, u_max: ArrayLike | None = None, q_outer: ArrayLike | None = None
               ) -> LMISolution:
@@ -330,7 +339,19 @@ class FormProblem:
                   w_max: float, lam: float, keep: bool = True) -> LMISolution:
         fd = self._form_data(xs, us, ys, w_max, lam)
         if self.backend == "ipm":
-            solved = self._solve_ipm(fd, keep)
+            solved = self._solve_ipm(fd, keep, phase_one=False)
+            t_new = self._rebalanced(solved, xs) if solved.status not in (OPTIMAL, INFEASIBLE) else None
+            if t_new is None and solved.status not in (OPTIMAL, INFEASIBLE):
+                solved = self._phase_one(fd, solved)
+            elif t_new is not None:
+                # retry cold in coordinates balanced on the failed run's Q; kept for the next solves
+                first, self._t = solved, t_new
+                self._solvers.clear()
+                fd = self._form_data(xs, us, ys, w_max, lam)
+                solved = self._solve_ipm(fd, keep)
+                solved.solve_time += first.solve_time
+                solved.iterations = (solved.iterations or 0) + (first.iterations or 0)
+                solved.solver_status = f"{first.solver_status}; rebalanced {solved.solver_status}"
             proved = solved.infeasibility is not None and solved.infeasibility.ok
             if solved.status != OPTIMAL and not proved and self._settings["fallback"]:
                 first = solved
@@ -343,11 +364,30 @@ class FormProblem:
             solved = self._solve_cvxpy(fd, keep)
         return self._finish(solved, x, scale, xs, us, ys, w_max, lam)
 
+    def _rebalanced(self, solved: _Solved, xs: np.ndarray) -> np.ndarray | None:
+        """Coordinates balanced on a failed run's Lyapunov matrix (the mean of the ``Q_j`` in the
+        vertex forms), as :meth:`lmi.backends.ipm.IPMKothare._rebalanced_scaling` does for
+        Kothare's problem: ``T L ||L^-1 x||`` with ``L`` its Cholesky factor; ``None`` when the run
+        gave nothing to balance on (no iterate, not positive definite, or already balanced)."""
+        if not self._settings["rebalance"] or solved.z is None or not np.all(np.isfinite(solved.z)):
+            return None
+        values = self.layout.values(solved.z)
+        names = [name for name in values if name[0] == "Q"]
+        q_mat = sum(values[name] for name in names) / len(names)
+        q_mat = 0.5 * (q_mat + q_mat.T)
+        lam = np.linalg.eigvalsh(q_mat)
+        if not (lam[0] > 0.0 and lam[-1] > MIN_SPREAD * lam[0]):
+            return None
+        low = np.linalg.cholesky(q_mat)
+        xt = np.linalg.solve(_as_matrix(self._t), xs)
+        return _as_matrix(self._t) @ (low * float(np.linalg.norm(np.linalg.solve(low, xt))))
+
     def _symbolic(self, fd: FormData) -> Program:
         return write(Program(self.layout), self.options, fd)
 
-    def _solve_ipm(self, fd: FormData, keep: bool = True) -> _Solved:
-        settings = {k: v for k, v in self._settings.items() if k not in ("fallback", "warm_start")}
+    def _solve_ipm(self, fd: FormData, keep: bool = True, phase_one: bool = True) -> _Solved:
+        own = ("fallback", "warm_start", "phase_one", "rebalance")  # FormProblem's settings
+        settings = {k: v for k, v in self._settings.items() if k not in own}
         key = ("ipm", fd.lam, fd.q_outer is not None)
         solver = self._solvers.get(key)
         start = time.perf_counter()
@@ -370,15 +410,41 @@ class FormProblem:
             res = solver.solve(warm_start=warm)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
-        if res.status == INFEASIBLE:
-            # the run's Farkas ray, checked on the conic data of the problem as solved
-            a_rows, b, orders = self._symbolic(fd).conic_rows()
-            y = np.concatenate([svec_matrix(z_block) for z_block in res.Z])
-            proof = check_farkas(a_rows, b, [("psd", k) for k in orders], y)
+        word = res.solver_status or res.status
+        if res.status == INFEASIBLE:  # the run's own Farkas ray
+            proof = self._check_ray(fd, res.Z)
             status = INFEASIBLE if proof.ok else NUMERICAL_ERROR
-            word = res.solver_status or res.status
             return _Solved(status, word, None, res.iterations, res.solve_time, proof)
-        return _Solved(res.status, res.solver_status or res.status, res.x, res.iterations, res.solve_time)
+        solved = _Solved(res.status, word, res.x, res.iterations, res.solve_time)
+        return self._phase_one(fd, solved) if phase_one and res.status != OPTIMAL else solved
+
+    def _phase_one(self, fd: FormData, failed: _Solved) -> _Solved:
+        """After a failed solve near the edge of the feasible region: phase one looks for a proof
+        of infeasibility (as :mod:`lmi.backends.ipm` does for Kothare's problem) before the
+        fallback is asked; ``failed`` with phase one's word added otherwise."""
+        solver = self._solvers.get(("ipm", fd.lam, fd.q_outer is not None))
+        if not self._settings["phase_one"] or solver is None:
+            return failed
+        start = time.perf_counter()
+        try:
+            one = solver.phase_one()
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
+            failed.solver_status += f"; phase one {err!r}"
+            return failed
+        its = (failed.iterations or 0) + one.iterations
+        elapsed = failed.solve_time + time.perf_counter() - start
+        word = f"{failed.solver_status}; phase one {one.status}"
+        if one.status == INFEASIBLE and one.Z is not None:
+            proof = self._check_ray(fd, one.Z)
+            if proof.ok:
+                return _Solved(INFEASIBLE, word, None, its, elapsed, proof)
+        return _Solved(failed.status, word, failed.z, its, elapsed)
+
+    def _check_ray(self, fd: FormData, z_blocks: list[np.ndarray]) -> InfeasibilityCertificate:
+        """A Farkas ray of the ipm, checked on the conic data of the problem as solved."""
+        a_rows, b, orders = self._symbolic(fd).conic_rows()
+        y = np.concatenate([svec_matrix(z_block) for z_block in z_blocks])
+        return check_farkas(a_rows, b, [("psd", k) for k in orders], y)
 
     def _clarabel_data(self, fd: FormData) -> tuple[np.ndarray, np.ndarray, list[int]]:
         return self._symbolic(fd).conic_rows()
@@ -494,16 +560,21 @@ class FormProblem:
 
     def _original(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Variables of the scaled coordinates ``x = T x~`` mapped back (``Q = T Q~ T``, ...)."""
-        t = self._t
+        t = _as_matrix(self._t)
         out = {}
         for name, val in values.items():
             if name == "G" or name[0] in "QW":  # G, Q, Q_j and the shared W
-                out[name] = t[:, None] * val * t[None, :]
+                out[name] = t @ val @ t.T
             elif name in ("Y", "Z"):
-                out[name] = val * t[None, :]
+                out[name] = val @ t.T
             else:
                 out[name] = val
         return out
+
+
+def _as_matrix(t: np.ndarray) -> np.ndarray:
+    """The coordinates ``x = T x~``: a diagonal given as a vector, or the full matrix."""
+    return np.diag(t) if t.ndim == 1 else t
 
 
 def _static_blocks(prog: Program, fd: FormData) -> frozenset[str]:
