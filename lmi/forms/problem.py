@@ -388,7 +388,7 @@ class FormProblem:
     def _solve_ipm(self, fd: FormData, keep: bool = True, phase_one: bool = True) -> _Solved:
         own = ("fallback", "warm_start", "phase_one", "rebalance")  # FormProblem's settings
         settings = {k: v for k, v in self._settings.items() if k not in own}
-        key = ("ipm", fd.lam, fd.q_outer is not None)
+        key = _solver_key("ipm", fd)
         solver = self._solvers.get(key)
         start = time.perf_counter()
         try:
@@ -422,7 +422,7 @@ class FormProblem:
         """After a failed solve near the edge of the feasible region: phase one looks for a proof
         of infeasibility (as :mod:`lmi.backends.ipm` does for Kothare's problem) before the
         fallback is asked; ``failed`` with phase one's word added otherwise."""
-        solver = self._solvers.get(("ipm", fd.lam, fd.q_outer is not None))
+        solver = self._solvers.get(_solver_key("ipm", fd))
         if not self._settings["phase_one"] or solver is None:
             return failed
         start = time.perf_counter()
@@ -477,7 +477,7 @@ class FormProblem:
     def _solve_cvxpy(self, fd: FormData, keep: bool = True) -> _Solved:
         import cvxpy as cp
 
-        key = ("cvxpy", fd.lam, fd.q_outer is not None)
+        key = _solver_key("cvxpy", fd)
         built = self._solvers.get(key)
         if built is None:
             prog = self._symbolic(fd)
@@ -570,6 +570,11 @@ class FormProblem:
             else:
                 out[name] = val
         return out
+
+
+def _solver_key(backend: str, fd: FormData) -> tuple:
+    """What a kept solver is built for: its back-end, the contraction factor and the nesting block."""
+    return (backend, fd.lam, fd.q_outer is not None)
 
 
 def _as_matrix(t: np.ndarray) -> np.ndarray:

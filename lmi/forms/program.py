@@ -16,7 +16,7 @@ import numpy as np
 
 from lmi.affine import AffineMatrix, svec_matrix
 
-__all__ = ["Layout", "Program", "relative_margin"]
+__all__ = ["Layout", "Program", "relative_margins"]
 
 
 @dataclass(frozen=True)
@@ -208,18 +208,9 @@ class Program:
         return {name: out[name] for name in mats}
 
 
-def relative_margin(mat: np.ndarray) -> float:
-    """Smallest eigenvalue of the symmetric part divided by the largest absolute eigenvalue."""
-    sym = 0.5 * (mat + mat.T)
-    if not np.all(np.isfinite(sym)):
-        return -np.inf
-    lam = np.linalg.eigvalsh(sym)
-    scale = max(float(np.max(np.abs(lam))), np.finfo(float).tiny)
-    return float(lam[0] / scale)
-
-
 def relative_margins(stack: np.ndarray) -> list[float]:
-    """:func:`relative_margin` of each matrix of a ``(count, k, k)`` stack."""
+    """Of each matrix of a ``(count, k, k)`` stack: the smallest eigenvalue of its symmetric part
+    divided by the largest absolute eigenvalue (``-inf`` for a matrix that is not finite)."""
     sym = 0.5 * (stack + np.swapaxes(stack, 1, 2))
     finite = np.all(np.isfinite(sym), axis=(1, 2))
     lam = np.linalg.eigvalsh(np.where(finite[:, None, None], sym, 0.0))
