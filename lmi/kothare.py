@@ -62,6 +62,10 @@ class LMISolution:
         first move ``u0``, the auxiliary gain ``H`` of the saturation-aware form, the soft
         constraints' slacks ``{"u": s_u, "y": s_y}`` (squared units) and the disturbance
         form's contraction factor ``lam``.
+    gamma_dual : float or None
+        The back-end's own dual bound on the optimal ``gamma`` (Clarabel's dual objective; with
+        ``gamma`` it brackets the optimum to the accuracy the solver actually reached, whatever
+        its status says); ``None`` where the back-end reports none.
     """
 
     status: str
@@ -82,6 +86,7 @@ class LMISolution:
     H: np.ndarray | None = field(default=None, repr=False)
     slack: dict[str, float] | None = field(default=None, repr=False)
     lam: float | None = field(default=None, repr=False)
+    gamma_dual: float | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -314,4 +319,5 @@ class KothareProblem:
         return LMISolution(
             status, gamma, q_mat, y_mat, f_mat, raw.solve_time, raw.iterations, raw.solver_status,
             cert, self.backend, x,
+            gamma_dual=None if raw.gamma_dual is None else raw.gamma_dual * s2,
         )

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from reference_checks import assert_gamma_in_reference_bracket
 
 from benchmarks.stress import make_problem
 from lmi import KothareProblem
@@ -136,16 +137,21 @@ def test_kothare_factors_reproduce_the_coefficients_and_the_ipm_agrees(formulati
     """Building the IPM back-end checks every cost block's factored form against its
     coefficients; on a stress-set problem feasible by construction (10 states, 2 inputs, 3
     vertices: 76-134 variables, so ``H`` is formed from the factors) the IPM (default
-    tolerances 1e-8, no fallback) then gives the ``gamma`` of Clarabel at 1e-10 within 1e-7
-    relative."""
+    tolerances 1e-8, no fallback) then ends optimal and certified with a ``gamma`` inside the
+    bracket of Clarabel asked for 1e-10 (its certified primal and its dual objective, each
+    widened by the certificates' 1e-7).
+
+    Clarabel's status is not the criterion: on the SkylakeX kernels it reaches 1e-10 here
+    ("optimal"); on an AMD EPYC (OpenBLAS's Haswell kernels) it stopped at its reduced
+    tolerances on ``delta_shared`` ("inaccurate"), with a point the certificate accepts."""
     prob = make_problem(10, 2, 3, "feasible", 0, constraint)
     kwargs = {**prob.kothare_kwargs(), "formulation": formulation}
     ipm = KothareProblem(backend="ipm", solver_options={"fallback": False}, **kwargs)
     ref = KothareProblem(backend="clarabel", solver_options=TIGHT, **kwargs)
     got, want = ipm.solve(prob.x), ref.solve(prob.x)
     assert ipm._backend._solver._direct  # the factored path was the one taken
-    assert got.status == want.status == "optimal"
-    assert abs(got.gamma - want.gamma) <= 1e-7 * want.gamma
+    assert got.status == "optimal"
+    assert_gamma_in_reference_bracket(got, want)
 
 
 def flexible_problem(backend: str, options: dict) -> tuple[KothareProblem, np.ndarray]:

@@ -35,6 +35,9 @@ class RawResult:
     solve_time: float
     #: A checked proof of infeasibility (the IPM's phase one), when the status is "infeasible".
     infeasibility: InfeasibilityCertificate | None = None
+    #: The back-end's own dual bound on the optimal ``gamma`` (Clarabel's dual objective), in
+    #: the units of :attr:`gamma`; ``None`` where the back-end reports none.
+    gamma_dual: float | None = None
 
 
 class KothareBackend(ABC):

@@ -115,4 +115,6 @@ class ClarabelKothare(KothareBackend):
             return RawResult(status, raw, np.nan, None, None, int(sol.iterations), elapsed)
         z = np.asarray(sol.x)
         q_mat, y_mat = conic.variables(z)
-        return RawResult(status, raw, self.gamma(z[0]), q_mat, y_mat, int(sol.iterations), elapsed)
+        dual = float(sol.obj_val_dual)
+        return RawResult(status, raw, self.gamma(z[0]), q_mat, y_mat, int(sol.iterations), elapsed,
+                         gamma_dual=self.gamma(dual) if np.isfinite(dual) else None)

@@ -31,7 +31,9 @@ Measured pitfalls shape the defaults (GIPC QPs of paper P's satellite, ``|du| <=
   an infeasible problem comes back as ``"max_iterations"``. Re-solving in the same solver
   object from a cold start was no cure (it also ran to ``max_iter``), so a warm-started
   solve that ends non-optimal is repeated once in a freshly built solver (``init`` + cold
-  solve; ``retry_cold``, ``QPResult.info["retried_cold"]``).
+  solve; ``retry_cold``, ``QPResult.info["retried_cold"]``). ``QPResult.info`` also holds the
+  outer iterations of the answer's solve (``"outer_iterations"``) and, after a setup, of the
+  cold solve that came before it (``"first_solve_outer_iterations"``, 0 without one).
 * Time: proxsuite 0.8 has no time limit, and an outer iteration may run up to ``max_iter_in``
   inner ones. At a state of 1e8, one ``GIPC.step`` ran 54-76 s: 10000 outer iterations of
   about 1450 inner ones each, to ``max_iter``. With a finite ``time_limit`` a solve runs in
@@ -299,13 +301,15 @@ class ProxQPBackend(QPBackend):
         start = time.perf_counter()
         deadline = start + self.settings.time_limit
         spent = [0.0, 0]
+        first_outer = 0
         if self._fresh:  # the cold solve after init, then the call goes on as after any solve
             try:  # as when setup made this solve: a solver that refuses the data is a status
                 inner, outer, timed_out = self._run(deadline, spent)
             except Exception as err:  # the binding's own exception types
                 return self._failed(f"first solve failed: {type(err).__name__}: {err}", start)
             if timed_out:
-                return self._report(Status.TIME_LIMIT, inner, outer, start, False)
+                return self._report(Status.TIME_LIMIT, inner, outer, start, False, outer)
+            first_outer = outer
             self._set_guess(self._solver.results.info.status == _O.PROXQP_SOLVED)
         warm = self._solver.settings.initial_guess == _WARM
         inner, outer, timed_out = self._run(deadline, spent)
@@ -322,7 +326,7 @@ class ProxQPBackend(QPBackend):
                 return self._failed(f"rebuild failed: {type(err).__name__}: {err}", start)
             status = Status.TIME_LIMIT if timed_out else self.map_status(self._solver.results.info.status)
             retried = True
-        return self._report(status, inner, outer, start, retried)
+        return self._report(status, inner, outer, start, retried, first_outer)
 
     def _failed(self, raw: str, start: float) -> QPResult:
         self._set_guess(False)
@@ -330,7 +334,9 @@ class ProxQPBackend(QPBackend):
             Status.NUMERICAL_ERROR, raw, None, None, None, -1, time.perf_counter() - start, SolverResiduals()
         )
 
-    def _report(self, status: Status, inner: int, outer: int, start: float, retried: bool) -> QPResult:
+    def _report(
+        self, status: Status, inner: int, outer: int, start: float, retried: bool, first_outer: int = 0
+    ) -> QPResult:
         elapsed = time.perf_counter() - start
         res = self._solver.results
         info = res.info
@@ -342,5 +348,5 @@ class ProxQPBackend(QPBackend):
             SolverResiduals(
                 primal=float(info.pri_res), dual=float(info.dua_res), gap=float(info.duality_gap)
             ),
-            {"retried_cold": retried, "outer_iterations": outer},
+            {"retried_cold": retried, "outer_iterations": outer, "first_solve_outer_iterations": first_outer},
         )
