@@ -136,6 +136,29 @@ def run_one(choice: str, out: Path, pytest_args: list[str]) -> RunResult:
     return result
 
 
+def stored_result(choice: str, out: Path) -> RunResult | None:
+    """A finished run of ``choice`` in ``out``: its JSON, or else its complete JUnit file (a run
+    whose pytest finished after this script was stopped), or ``None``."""
+    tag = choice.replace(":", "-t")
+    path, junit = out / f"{tag}.json", out / f"{tag}.xml"
+    if path.exists():
+        return RunResult(**json.loads(path.read_text()))
+    if not junit.exists():
+        return None
+    try:
+        coretype, threads = parse_choice(choice)
+        result = RunResult(choice, coretype, threads, kernels_used(environment(coretype, threads)))
+        read_junit(junit, result)
+    except ET.ParseError:  # pytest still writing, or stopped mid-file
+        return None
+    suite = ET.parse(junit).getroot()
+    suite = suite if suite.tag == "testsuite" else suite.find("testsuite")
+    result.seconds = float(suite.get("time", "0")) if suite is not None else 0.0
+    result.exit_code = 1 if result.failed or result.errors else 0
+    path.write_text(json.dumps(asdict(result), indent=2) + "\n")
+    return result
+
+
 def write_report(results: list[RunResult], out: Path, pytest_args: list[str]) -> None:
     """``report.json`` and ``report.md`` from the runs' results."""
     (out / "report.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
@@ -178,10 +201,9 @@ def main(argv: list[str] | None = None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     stored: dict[str, RunResult] = {}
     for c in choices:
-        path = args.out / f"{c.replace(':', '-t')}.json"
-        if path.exists() and not args.fresh:
-            stored[c] = RunResult(**json.loads(path.read_text()))
-            print(f"{c}: kept from {path}", file=sys.stderr)
+        if not args.fresh and (kept := stored_result(c, args.out)) is not None:
+            stored[c] = kept
+            print(f"{c}: kept from {args.out}", file=sys.stderr)
     todo = [c for c in choices if c not in stored]
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for result in pool.map(lambda c: run_one(c, args.out, args.pytest_args), todo):
