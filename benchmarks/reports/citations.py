@@ -85,7 +85,7 @@ class Reference:
 
     @property
     def unknown(self) -> tuple[str, ...]:
-        """The fields of :data:`FIELDS` the source documents do not give."""
+        """The fields of ``FIELDS`` (authors, title, venue, year) the source documents do not give."""
         given = {"authors": bool(self.authors), "title": self.title is not None,
                  "venue": self.venue is not None, "year": self.year is not None}
         return tuple(f for f in FIELDS if not given[f])
