@@ -33,6 +33,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.families.wheel.family",
     "benchmarks.families.wheel.plant",
     "benchmarks.mutation.operators",
+    "benchmarks.reports.citations",
     "benchmarks.reports.figure_style",
     "benchmarks.reports.sections",
     "benchmarks.reports.tables",

@@ -42,6 +42,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.wheel import defaults
+from benchmarks.reports.citations import citation_line
 from benchmarks.reports.sections import failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "fault_cases", "run_faults"]
@@ -496,6 +497,7 @@ def _markdown(
     lines = [
         "# Benchmark suite `faults`: paper W's scenarios S1-S4 (W1-W4)",
         "",
+        citation_line("W"), "",
         *run_lines(info, scale, versions_in_run_json=True),
         "",
         "Nonlinear four-wheel satellite (records: `plant` = \"wheel\"), RK4 at 5 ms inside the 40 ms hold; "

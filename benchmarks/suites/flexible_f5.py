@@ -1,6 +1,7 @@
 """Experiment F5 of the flexible suite: paper S's baselines head to head on F1's V-slew.
 
-Paper S (Persian review, 2023-24) surveys the industrial baselines for flexible spacecraft; F5
+Paper S (Fathi and Bolandi's survey of flexible satellites, in Persian) surveys the industrial
+baselines for flexible spacecraft; F5
 runs six of them on F1's 160 deg V-slew (the same plant, disturbance, 2 N m clip, 0.01 s period
 and length) and measures them with F1's metrics: PD and PD with the disturbance observer
 (:class:`rmpc.AttitudePD`), adaptive SMC (:class:`rmpc.AdaptiveSMC`), nonlinear PD

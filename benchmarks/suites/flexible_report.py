@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks.families.flexible import defaults
+from benchmarks.reports.citations import citation_line
 from benchmarks.reports.sections import dash, failed_cases, rows_table, run_lines, settings_section, statuses
 from benchmarks.suites.flexible_claims import flexible_claims_markdown
 
@@ -492,6 +493,7 @@ def results_markdown(
         "# Benchmark suite `flexible`: paper V's study on the flexible satellite (F1-F4, F6) and paper S's "
         "baselines (F5)",
         "",
+        citation_line("V", "S"), "",
         *run_lines(info, scale),
         "",
         'The published 4-mode plant with PZT patches (records: `plant` = "flexible"; the record\'s '

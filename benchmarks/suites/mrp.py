@@ -35,6 +35,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.mrp import defaults
+from benchmarks.reports.citations import citation_line
 from benchmarks.reports.sections import dash, failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "mrp_cases", "run_mrp"]
@@ -215,6 +216,7 @@ def _write(
     lines = [
         "# Benchmark suite `mrp`: paper M's scenarios M1-M3",
         "",
+        citation_line("M"), "",
         *run_lines(info, scale),
         "",
         f"Every controller at a {CONTROL_PERIOD:g} s period on the same truth plant "

@@ -36,6 +36,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.rigid import defaults
+from benchmarks.reports.citations import citation_line
 from benchmarks.reports.sections import failed_cases, run_lines, settings_section
 from benchmarks.reports.tables import metric_table, to_markdown, write_tables
 from models import PAPER_P_INERTIA
@@ -239,7 +240,7 @@ def _markdown(
     from benchmarks.families.rigid.defaults import rationale, settings_rows
     from benchmarks.suites.paper_claims import assess_claims, claims_markdown
 
-    lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", ""]
+    lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", "", citation_line("P"), ""]
     lines += [
         *run_lines(info, f"duration scale {info['duration_scale']:g}", versions_in_run_json=True),
         "",

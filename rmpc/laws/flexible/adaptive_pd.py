@@ -1,6 +1,7 @@
 """Adaptive-gain PD attitude control (one of paper S's surveyed baselines).
 
-Paper S (Persian review, 2023-24) lists PD with gains adapted online among the baselines without
+Paper S (Fathi and Bolandi's survey of flexible satellites, in Persian) lists PD with gains adapted
+online among the baselines without
 a law. The toolkit's law (**assumed**): ``u = -k_d w - k_p q_v`` on the error quaternion with
 scalar gains that grow with the error and leak back to their initial values, kept in a box by
 projection::

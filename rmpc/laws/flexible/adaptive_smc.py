@@ -1,6 +1,7 @@
 """Adaptive sliding-mode attitude control (paper S's adaptive SMC baseline).
 
-Source: paper S (Persian review, 2023-24) prints the adaptive part (**certain**), added to an
+Source: paper S (Fathi and Bolandi's survey of flexible satellites, in Persian) prints the adaptive
+part (**certain**), added to an
 SMC equivalent control::
 
     u_ad = -(s / ||s||) (b0h + p1h Phi1)   if ||s|| >= s_b,   else -(s / s_b) (b0h + p1h Phi1)

@@ -1,6 +1,7 @@
 """Quaternion PD attitude control, optionally with a disturbance observer (paper S's baselines).
 
-Source: paper S (Persian review, 2023-24), section on PD/PID control of flexible spacecraft:
+Source: paper S (Fathi and Bolandi's survey of flexible satellites, in Persian), section on PD/PID
+control of flexible spacecraft:
 ``u = -K_d w - K_p rho`` (**certain**), the industrial anchor, with ``rho = q_v`` of the error
 quaternion here; vibration decays only by the structural damping. With
 ``disturbance_observer=True``, paper S's ``u = -K_d w - K_p rho - d_hat`` (**certain**), ``d_hat``

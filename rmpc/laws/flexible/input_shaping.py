@@ -1,6 +1,7 @@
 """Input shaping in front of a PD attitude loop (one of paper S's surveyed baselines).
 
-Paper S (Persian review, 2023-24) lists input shaping among the feed-forward baselines. The
+Paper S (Fathi and Bolandi's survey of flexible satellites, in Persian) lists input shaping among
+the feed-forward baselines. The
 shapers are those of N. C. Singer and W. P. Seering, "Preshaping command inputs to reduce system
 vibration", ASME Journal of Dynamic Systems, Measurement, and Control 112(1), 1990: for a mode of
 natural frequency ``omega`` and damping ``zeta``, with ``T = 2 pi / (omega sqrt(1 - zeta^2))`` and

@@ -1,7 +1,8 @@
 """Paper V's moving-surface sliding-mode attitude control (MTSMC) of a flexible satellite.
 
-Source: paper V (Persian journal, about 2023), eqs. 11-15: the surface ``sigma = w + alpha(t) q_v``
-whose slope ``alpha`` moves in time, a switching term ``W_s tanh(sigma/eps)`` and compensation of
+Source: paper V (in Persian; its authors and title are not known), eqs. 11-15: the surface
+``sigma = w + alpha(t) q_v`` whose slope ``alpha`` moves in time, a switching term
+``W_s tanh(sigma/eps)`` and compensation of
 the rigid-flexible coupling. The paper's equations and gain table were lost in extraction; this
 module is the toolkit's documented reconstruction
 (**assumed** as a whole)::

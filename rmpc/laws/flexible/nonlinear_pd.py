@@ -1,6 +1,7 @@
 """Nonlinear (saturated) PD attitude control (one of paper S's surveyed baselines).
 
-Paper S (Persian review, 2023-24) lists nonlinear PD among the industrial baselines without an
+Paper S (Fathi and Bolandi's survey of flexible satellites, in Persian) lists nonlinear PD among
+the industrial baselines without an
 equation. The toolkit's form (**assumed**) saturates the proportional term per axis::
 
     u = -K_d w - K_p sat(q_v, q_s),   sat(q_v, q_s)_i = min(max(q_v,i, -q_s), q_s)

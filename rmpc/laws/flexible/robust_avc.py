@@ -1,6 +1,7 @@
 """Robust active vibration control (AVC) of a flexible satellite's modes by PZT (paper V, theorem 2).
 
-Source: paper V (Persian journal, about 2023), theorem 2: a sliding variable on the modal error,
+Source: paper V (in Persian; its authors and title are not known), theorem 2: a sliding variable on
+the modal error,
 cancellation of the known ("nominal") part of the modal equation and a robust term against the
 bounded unknown part, with a Lyapunov function ``V = s' M s / 2``. Structure **likely**, details
 **assumed**::
