@@ -13,7 +13,7 @@ import pkgutil
 
 import pytest
 
-PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common")
+PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common", "dev")
 
 #: The modules whose docstrings hold examples (``>>>``), by their import name.
 MODULES_WITH_EXAMPLES = (
