@@ -17,6 +17,8 @@ this folder stays in the checkout. Run its tools from the repository root (the r
 - ``python -m dev.offline_timing --out DIR``: the off-line design's timing per back-end
   (:mod:`dev.offline_timing`).
 - ``python dev/blas_kernels.py --out DIR``: the test suite under several OpenBLAS kernel choices.
+- Mutation testing with mutmut, configured in ``pyproject.toml`` (``[tool.mutmut]``); the last
+  run's report is ``dev/reports/mutation/report.md``.
 
-The shipped packages never import this one.
+The shipped packages never import this one (``tests/test_distribution_contents.py``).
 """

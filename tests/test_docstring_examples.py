@@ -32,7 +32,6 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.families.mrp.family",
     "benchmarks.families.wheel.family",
     "benchmarks.families.wheel.plant",
-    "benchmarks.mutation.operators",
     "benchmarks.reports.figure_style",
     "benchmarks.reports.sections",
     "benchmarks.reports.tables",

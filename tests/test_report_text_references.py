@@ -25,7 +25,6 @@ ROOT = Path(__file__).resolve().parent.parent
 #: Modules whose only matches are random seeds in words ("with seed 0", "(seed {seed})").
 RANDOM_SEED_MODULES = {
     "dev/generic_stress.py",
-    "benchmarks/mutation/report.py",
     "dev/stress.py",
 }
 
