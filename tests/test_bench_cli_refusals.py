@@ -15,7 +15,7 @@ import pytest
 
 from benchmarks.cli import main
 from benchmarks.core.store import CaseStore
-from benchmarks.robustness.cli_cases import TINY_SWEEP
+from dev.robustness.cli_cases import TINY_SWEEP
 from toolkit_common.errors import ConfigError, StoreError
 
 TINY = TINY_SWEEP  # one short case of LQR on the linear plant

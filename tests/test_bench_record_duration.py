@@ -15,7 +15,7 @@ import pytest
 from benchmarks.cli import main
 from benchmarks.core.runner import simulate_scenario
 from benchmarks.core.scenario import Scenario
-from benchmarks.robustness.cli_cases import TINY_SWEEP
+from dev.robustness.cli_cases import TINY_SWEEP
 
 # family: (scenario, duration asked for, dt, samples that run = round(duration / dt))
 CASES = {

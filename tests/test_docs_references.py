@@ -43,7 +43,7 @@ _EXTENSIONS = "py|toml|md|rst|txt|json|csv|cfg|ini|yaml|yml|png|svg|npz|npy|sh|l
 _PATH = re.compile(
     rf"(?<![\w/:.@-])((?:\.\.?/)*(?:[\w.-]+/)*[\w.-]+\.(?:{_EXTENSIONS}))(?![\w/-])"
 )
-_TOP_DIRS = ("benchmarks", "docs", "lmi", "models", "rmpc", "tests", "toolkit_common")
+_TOP_DIRS = ("benchmarks", "dev", "docs", "lmi", "models", "rmpc", "tests", "toolkit_common")
 _DIR = re.compile(rf"(?<![\w/:.@-])((?:{'|'.join(_TOP_DIRS)})/[\w.-]+(?:/[\w.-]+)*)/?(?![\w-])")
 _URL = re.compile(r"\b(?:https?|ftp)://\S+")
 

@@ -13,7 +13,7 @@ import pkgutil
 
 import pytest
 
-PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common")
+PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common", "dev")
 
 #: The modules whose docstrings hold examples (``>>>``), by their import name.
 MODULES_WITH_EXAMPLES = (
@@ -32,7 +32,6 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.families.mrp.family",
     "benchmarks.families.wheel.family",
     "benchmarks.families.wheel.plant",
-    "benchmarks.mutation.operators",
     "benchmarks.reports.citations",
     "benchmarks.reports.figure_style",
     "benchmarks.reports.sections",

@@ -1,4 +1,4 @@
-"""States far outside the region (:mod:`benchmarks.far_states`): the IPM proves them infeasible by
+"""States far outside the region (:mod:`dev.far_states`): the IPM proves them infeasible by
 itself, with a certificate the independent check accepts, and the records say so.
 
 Two problems of the benchmark's set (2 and 5 states, 1e3 beyond the slab the input can hold),
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from benchmarks.far_states import far_problems, format_far, run_far
+from dev.far_states import far_problems, format_far, run_far
 from lmi.infeasibility import MIN_RADIUS
 
 

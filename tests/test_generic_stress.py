@@ -1,4 +1,4 @@
-"""The generic stress set (:mod:`benchmarks.generic_stress`): what each problem claims about itself
+"""The generic stress set (:mod:`dev.generic_stress`): what each problem claims about itself
 holds independently of any solver, and the IPM alone (no fallback) answers every problem of a fast
 subset "optimal" with a certified answer or "infeasible" with a checked proof.
 
@@ -23,7 +23,7 @@ import warnings
 import numpy as np
 import pytest
 
-from benchmarks.generic_stress import (
+from dev.generic_stress import (
     WITNESS_SHARE,
     format_generic,
     generic_problem,
@@ -33,7 +33,7 @@ from benchmarks.generic_stress import (
     slab_reach,
     unstable_mode,
 )
-from benchmarks.stress import witness_bound
+from dev.stress import witness_bound
 from lmi import KothareProblem, build_kothare_data, certify
 from lmi.infeasibility import MIN_RADIUS
 from toolkit_common.errors import InvalidArgumentError

@@ -9,7 +9,7 @@ certificate.
   infeasible too.
 * A certificate tampered with (sign flipped, a block made indefinite, checked against another
   state inside the region) fails the check.
-* Infeasible stress problems (infeasible by construction, :mod:`benchmarks.stress`) are proved
+* Infeasible stress problems (infeasible by construction, :mod:`dev.stress`) are proved
   infeasible; on feasible ones phase one finds a strictly feasible point, and a solve forced to
   fail (``max_iter = 2``) is never called infeasible.
 * Bad settings still raise naming the argument.
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.stress import make_problem
+from dev.stress import make_problem
 from lmi import KothareProblem
 from lmi.infeasibility import MIN_RADIUS, check_farkas
 from toolkit_common.errors import InvalidArgumentError

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from reference_checks import assert_gamma_in_reference_bracket
 
-from benchmarks.stress import make_problem
+from dev.stress import make_problem
 from lmi import KothareProblem
 from lmi.ipm import BlockLMISolver, kernels
 from models import FlexibleSatellite

@@ -1,4 +1,4 @@
-"""The public LMI benchmark (:mod:`benchmarks.public_lmi`): its records and its report.
+"""The public LMI benchmark (:mod:`dev.public_lmi`): its records and its report.
 
 No timing is asserted (times live in the benchmark's output); what is checked is what the
 records claim: both solvers' answers on control2 against SDPLIB's published optimum, and the
@@ -11,7 +11,7 @@ import json
 
 import pytest
 
-from benchmarks.public_lmi import PUBLISHED_OPTIMA, format_public, load_case, main, run_public
+from dev.public_lmi import PUBLISHED_OPTIMA, format_public, load_case, main, run_public
 from toolkit_common.errors import InvalidArgumentError
 
 

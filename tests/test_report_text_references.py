@@ -4,10 +4,10 @@ A reader of ``results.md`` or of the API reference built from the docstrings has
 the repository, not the specification (``SPEC``, ``API.md``) or the papers' source notes (once
 called "the seed": ``seed 6``, ``seed section 8``, ``(seed 8(c))``, ``the seed's choice``). Every
 module of the packages (``models``, ``rmpc``, ``lmi``, ``toolkit_common`` and ``benchmarks``, whose
-settings tables, notes and headings become report text) is scanned as source text (strings,
-comments and docstrings alike), but for the few whose "seed" is a random seed in words the
-patterns cannot tell apart. A random seed is fine: ``seed=``, ``--seed``, ``random seed 0``,
-``seeds``, ``seeded``. Nothing is run.
+settings tables, notes and headings become report text) and of the development tools (``dev``) is
+scanned as source text (strings, comments and docstrings alike), but for the few whose "seed" is
+a random seed in words the patterns cannot tell apart. A random seed is fine: ``seed=``,
+``--seed``, ``random seed 0``, ``seeds``, ``seeded``. Nothing is run.
 
 A string that ends up in a benchmark record keeps its wording (changing it would change the
 records); :data:`RECORD_STRINGS` lists those, and the scan passes over their lines only.
@@ -24,15 +24,14 @@ ROOT = Path(__file__).resolve().parent.parent
 
 #: Modules whose only matches are random seeds in words ("with seed 0", "(seed {seed})").
 RANDOM_SEED_MODULES = {
-    "benchmarks/generic_stress.py",
-    "benchmarks/mutation/report.py",
-    "benchmarks/stress.py",
+    "dev/generic_stress.py",
+    "dev/stress.py",
 }
 
 #: The scanned modules: every module of the packages but :data:`RANDOM_SEED_MODULES`.
 MODULES = sorted(
     path
-    for package in ("models", "rmpc", "lmi", "toolkit_common", "benchmarks")
+    for package in ("models", "rmpc", "lmi", "toolkit_common", "benchmarks", "dev")
     for path in (ROOT / package).rglob("*.py")
     if path.relative_to(ROOT).as_posix() not in RANDOM_SEED_MODULES
 )

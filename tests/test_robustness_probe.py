@@ -12,11 +12,11 @@ import time
 import numpy as np
 import pytest
 
-from benchmarks.robustness.api_cases import api_probes, targets
-from benchmarks.robustness.cli_cases import cli_probes
-from benchmarks.robustness.probe import Probe
-from benchmarks.robustness.runner import run_api_probe
-from benchmarks.robustness.verdicts import classify_cli, classify_exception
+from dev.robustness.api_cases import api_probes, targets
+from dev.robustness.cli_cases import cli_probes
+from dev.robustness.probe import Probe
+from dev.robustness.runner import run_api_probe
+from dev.robustness.verdicts import classify_cli, classify_exception
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_positive
 

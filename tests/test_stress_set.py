@@ -1,4 +1,4 @@
-"""The seeded stress set of Kothare problems (:mod:`benchmarks.stress`): what each problem claims
+"""The seeded stress set of Kothare problems (:mod:`dev.stress`): what each problem claims
 about itself holds, independently of any solver.
 
 * feasible problems: the witness ``(gamma, Q, Y)`` satisfies every LMI (:func:`lmi.certify`
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.stress import make_problem, stress_set
+from dev.stress import make_problem, stress_set
 from lmi import build_kothare_data, certify
 from toolkit_common.errors import InvalidArgumentError
 
@@ -83,7 +83,7 @@ def test_stress_benchmark_answers_never_contradict_the_construction():
     """The benchmark on one feasible and one infeasible 4-state problem (~1 s): no path says
     "optimal" on the infeasible one or "infeasible" on the feasible one, the IPM is optimal
     on the feasible one and agrees with cvxpy + Clarabel at 1e-9 within 1e-6."""
-    from benchmarks.stress import format_stress, run_stress
+    from dev.stress import format_stress, run_stress
 
     records = run_stress([make_problem(4, 2, 2, "feasible", 0), make_problem(4, 2, 2, "infeasible", 0)])
     for rec in records:

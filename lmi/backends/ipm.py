@@ -57,7 +57,7 @@ REBALANCE_MAX_RESIDUAL = 1e-3
 #: ``warm_max_iter`` a warm one.
 #: ``max_iter`` is 100, not 60: the main run's proof of infeasibility (its Farkas ray,
 #: :meth:`lmi.ipm.BlockLMISolver.solve`) took up to 57 iterations on the generic stress set's
-#: infeasible problems of 20-30 states (:mod:`benchmarks.generic_stress`), 61 and 66 on two of
+#: infeasible problems of 20-30 states (:mod:`dev.generic_stress`), 61 and 66 on two of
 #: them; at 60 those two ended ``"max_iterations"`` and went to phase one, which proved one
 #: (129 iterations in all, 71 s instead of 9 s) and not the other (its certificate's radius
 #: 7e7, below the 1e8 asked).
@@ -376,7 +376,7 @@ class IPMKothare(KothareBackend):
         :data:`lmi.scaling.MIN_SPREAD`.
 
         The full factor, not only the diagonal: on the generic stress set's
-        ``n30-v2-generic-none-s1`` (:mod:`benchmarks.generic_stress`) the run ended "inaccurate"
+        ``n30-v2-generic-none-s1`` (:mod:`dev.generic_stress`) the run ended "inaccurate"
         after 52 iterations, ``S`` and ``Z`` spanning 17 decades near the optimum (block
         eigenvalues from 3e-12 to 7e5 and from 3e-14 to 1e4) and the relative gap stuck at
         1.5e-8; its ``Q`` had eigenvalues from 0.035 to 7.9e4 but a diagonal within a factor 4,

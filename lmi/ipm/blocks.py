@@ -61,8 +61,8 @@ DIRECT_MIN_VARIABLES = 64
 #: any span (measured by forcing it), the effect was mixed and no status changed: paper P (span
 #: 2.1-2.3) 130 -> 126 cold and 125 -> 129 warm-started iterations over 8 random states at 2
 #: vertices, 157 -> 158 and 145 -> 144 at 8; the stress set of 6-14 states
-#: (:mod:`benchmarks.stress`, spans up to 40) 1092 -> 1175 in all, two infeasibility proofs
-#: moving from the main run to phase one; the far states (:mod:`benchmarks.far_states`) 1734 ->
+#: (:mod:`dev.stress`, spans up to 40) 1092 -> 1175 in all, two infeasibility proofs
+#: moving from the main run to phase one; the far states (:mod:`dev.far_states`) 1734 ->
 #: 1616; random 8-16-state problems 358 -> 363. A threshold of 20 changed records of the fault
 #: suite (``rmpc bench faults``, W1-W3, by up to 3e-6 relative through their closed loops). At
 #: 100 no suite record changed (W4's CRMPC problems, span 512, are weighted and kept their

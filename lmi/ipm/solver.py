@@ -139,7 +139,7 @@ STEP_ACCURACY = 1.0
 #: (That was measured with the test on the worst of the three.) The worst alone stopped runs that
 #: were converging: on open-loop-unstable problems the relative gap can rise for a while as the
 #: objective grows while both residuals fall by orders of magnitude; on the generic stress set's
-#: ``n16-v2-generic-peak-s0`` (:mod:`benchmarks.generic_stress`) the gap went from 0.80 to 0.42
+#: ``n16-v2-generic-peak-s0`` (:mod:`dev.generic_stress`) the gap went from 0.80 to 0.42
 #: relative over iterations 7-22 while the primal residual fell from 1e-2 to 4e-5, the run was
 #: stopped there, and it converges in 41 iterations when any measure halving counts as progress.
 #: SDPLIB's control3 without block weights stalled the same way under the worst-measure rule
@@ -160,7 +160,7 @@ INFEASIBILITY_RADIUS = MIN_RADIUS
 #: ... and only when the dual iterate is a ray: ``||G'z|| <= RAY_TOL ||z||`` (``G`` the
 #: equilibrated coefficients, unit columns). A bounded dual optimum of a feasible problem whose
 #: optimal value is large has a large radius too but ``G'z = -c``. Measured at the proof on the
-#: 60 far states of :mod:`benchmarks.far_states`: ``||G'z|| / ||z||`` of 2e-12..3e-10 (see
+#: 60 far states of :mod:`dev.far_states`: ``||G'z|| / ||z||`` of 2e-12..3e-10 (see
 #: :meth:`BlockLMISolver.solve`).
 RAY_TOL = 1e-6
 

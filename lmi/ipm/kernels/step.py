@@ -155,7 +155,7 @@ def _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale):
     :func:`_newton` does) it is of the order ``eps ||P||^2 ||dx||``, which refinement cannot
     reduce once ``eps cond(P)^2 > 1``: measured on a 12-state unstable Kothare problem, it grew
     to 40 times ``||r_d||`` over the last iterations and the dual residual with it, from 3e-8 to
-    1 (see :mod:`benchmarks.generic_stress`). One refinement step on ``P' dz~ = -r_d`` (with the
+    1 (see :mod:`dev.generic_stress`). One refinement step on ``P' dz~ = -r_d`` (with the
     formed ``P``) follows while it shrinks the residual.
     """
     n, m = qr_h.shape

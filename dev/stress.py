@@ -23,7 +23,7 @@ peak or ellipsoid input bound and a state ``x``. Two kinds:
     controller keeps the cost finite and the Kothare LMIs have no solution. Here ``A_0`` is
     the vertex-mean model itself (it is one of the vertices).
 
-:func:`run_stress` (``python -m benchmarks.stress``) solves the set with the IPM back-end (with
+:func:`run_stress` (``python -m dev.stress``) solves the set with the IPM back-end (with
 and without its Clarabel fallback) and with cvxpy + Clarabel at tight tolerances, and flags any
 answer that contradicts what is known by construction.
 
@@ -71,7 +71,7 @@ class StressProblem:
         Sample time (for the delta formulations).
     kind : {"feasible", "infeasible", "unknown"}
         Known by construction (see the module docstring); ``"unknown"`` only for the generic
-        problems of :mod:`benchmarks.generic_stress`.
+        problems of :mod:`dev.generic_stress`.
     seed : int
     witness : tuple or None
         For feasible problems ``(gamma, Q, Y)``, a point satisfying every LMI.
@@ -321,7 +321,7 @@ def format_stress(records: Sequence[dict]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m benchmarks.stress [--sizes 6 10 14] [--vertices 2 8] [--seeds 0 1 2] [--out FILE]``."""
+    """``python -m dev.stress [--sizes 6 10 14] [--vertices 2 8] [--seeds 0 1 2] [--out FILE]``."""
     import argparse
     import os
 

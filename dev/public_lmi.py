@@ -16,7 +16,7 @@ the iterations and the median times: ``solve`` (the IPM's :meth:`~lmi.ipm.BlockL
 Clarabel's own solve time as cvxpy reports it) and ``total`` (with building the solver; with
 building the cvxpy problem and its compilation).
 
-``python -m benchmarks.public_lmi [--cases control2 ...] [--repeats 3] [--out DIR]`` prints a
+``python -m dev.public_lmi [--cases control2 ...] [--repeats 3] [--out DIR]`` prints a
 Markdown table; with ``--out`` it also writes ``DIR/results.md`` and ``DIR/results.json``.
 """
 
@@ -132,7 +132,7 @@ def format_public(records: Sequence[dict]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m benchmarks.public_lmi [--cases control2 control3 control4] [--repeats 3] [--out DIR]``."""
+    """``python -m dev.public_lmi [--cases control2 control3 control4] [--repeats 3] [--out DIR]``."""
     import argparse
     import os
     import platform

@@ -6,7 +6,7 @@ eigenvalues in the right half-plane) and ``B_c`` standard normal with ``m = 3`` 
 (zero-order hold) at ``dt = 0.1`` s, ``Q1 = I``, ``R = I``. The polytope has ``n_vertices``
 vertices: ``(A, 0.8 B)`` and ``(A, 1.2 B)`` (an uncertain input gain), and for more than two,
 ``(A + 0.001 E_j / sqrt(n), B diag(g_j))`` with ``E_j`` standard normal and ``g_j`` uniform in
-``[0.8, 1.2]`` per input (about 1 % of ``A_c``; at 0.01, as in :mod:`benchmarks.stress`, no
+``[0.8, 1.2]`` per input (about 1 % of ``A_c``; at 0.01, as in :mod:`dev.stress`, no
 quadratic Lyapunov function held the 8 vertices of most plants of 16 states and more, with or
 without a bound: every such problem was infeasible). The input bound is none, a peak bound (1 per
 input) or an ellipsoid (1). Each plant gives up to three problems (``kind``):
@@ -16,7 +16,7 @@ input) or an ellipsoid (1). Each plant gives up to three problems (``kind``):
     LMIs have a solution is not decided by the construction; where the witness below exists and
     satisfies the bound at that state the problem is marked ``"feasible"`` instead.
 ``"feasible"``
-    (Bounded problems.) The witness of :func:`benchmarks.stress.lqr_contraction` (the LQR gain of
+    (Bounded problems.) The witness of :func:`dev.stress.lqr_contraction` (the LQR gain of
     the vertex-mean model, with its Riccati matrix scaled until every vertex's closed loop
     contracts it) at the generic problem's state shortened until the witness needs 0.9 of the
     bound: feasible by construction, with the bound close to active.
@@ -27,9 +27,9 @@ input) or an ellipsoid (1). Each plant gives up to three problems (``kind``):
     upper bound on ``|w^T B_0 u|`` over the admissible inputs (``sum_j |(w^T B_0)_j| u_j`` for the
     peak bound, ``||w^T B_0|| u`` for the ellipsoid). On the constant plant ``(A, 0.8 B)``
     ``|w^T x(k+1)| >= |lam| |w^T x(k)| - reach``, so ``|w^T x(k)|`` grows along every admissible
-    input sequence and the Kothare LMIs have no solution (as in :mod:`benchmarks.stress`).
+    input sequence and the Kothare LMIs have no solution (as in :mod:`dev.stress`).
 
-:func:`run_generic` (``python -m benchmarks.generic_stress``) solves each problem with the IPM
+:func:`run_generic` (``python -m dev.generic_stress``) solves each problem with the IPM
 back-end, its Clarabel fallback off (status, gamma, iterations, time, the worst recomputed LMI
 margin of :func:`lmi.certify` or the radius of the checked infeasibility certificate), and with
 cvxpy + Clarabel on the textbook LMIs (Kothare's eq. (14) as printed, ``formulation="standard"``;
@@ -46,7 +46,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from benchmarks.core.jsonable import write_json
-from benchmarks.stress import SAMPLE_TIME, StressProblem, lqr_contraction, lqr_witness, witness_bound
+from dev.stress import SAMPLE_TIME, StressProblem, lqr_contraction, lqr_witness, witness_bound
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = ["GENERIC_BOUNDS", "GENERIC_KINDS", "GENERIC_SIZES", "REFERENCES", "format_generic",
@@ -186,7 +186,7 @@ def generic_set(sizes: Sequence[int] = GENERIC_SIZES, vertex_counts: Sequence[in
 
 
 def has_witness(n: int, n_vertices: int, seed: int) -> bool:
-    """Whether the plant has the witness of :func:`benchmarks.stress.lqr_contraction`."""
+    """Whether the plant has the witness of :func:`dev.stress.lqr_contraction`."""
     a, b, _ = generic_plant(n, n_vertices, seed)
     return lqr_contraction(a, b, np.eye(n), np.eye(INPUTS)) is not None
 
@@ -300,7 +300,7 @@ def _warm_up(references: Sequence[str]) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m benchmarks.generic_stress [--sizes ...] [--vertices 2 8] [--seeds 0 1]
+    """``python -m dev.generic_stress [--sizes ...] [--vertices 2 8] [--seeds 0 1]
     [--references cvxpy cvxpy_shared | --references] [--no-ipm] [--merge FILE ...] [--out FILE]``.
 
     ``--references`` with no name runs the IPM only; ``--no-ipm`` the references only;

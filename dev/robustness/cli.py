@@ -9,11 +9,11 @@ from collections import Counter
 from collections.abc import Sequence
 
 from benchmarks.core.machine import machine_info
-from benchmarks.robustness.api_cases import api_probes
-from benchmarks.robustness.cli_cases import cli_probes
-from benchmarks.robustness.probe import Probe
-from benchmarks.robustness.runner import run_probes
-from benchmarks.robustness.verdicts import VERDICTS, Outcome
+from dev.robustness.api_cases import api_probes
+from dev.robustness.cli_cases import cli_probes
+from dev.robustness.probe import Probe
+from dev.robustness.runner import run_probes
+from dev.robustness.verdicts import VERDICTS, Outcome
 
 
 def markdown(results: list[tuple[Probe, Outcome]]) -> str:
@@ -48,7 +48,7 @@ def markdown(results: list[tuple[Probe, Outcome]]) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the probes; exit 0 when every input got a clear answer, 1 otherwise."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.robustness", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m dev.robustness", description=__doc__)
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.add_argument(
         "--timeout", type=float, default=30.0, help="seconds before an input counts as a hang"

@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from benchmarks.robustness.probe import Expect, Probe
+from dev.robustness.probe import Expect, Probe
 
 TINY_SWEEP = """name = "tiny"
 description = "one short case"

@@ -1,6 +1,6 @@
 """States far outside the region: does the IPM say "infeasible", with a checked proof, and how fast?
 
-The problems are the infeasible ones of :mod:`benchmarks.stress` (open-loop unstable: a real
+The problems are the infeasible ones of :mod:`dev.stress` (open-loop unstable: a real
 eigenvalue ``lam`` in ``[1.1, 1.5]`` with left eigenvector ``w``), with the state placed
 ``distance`` times beyond the slab ``|w'x| (lam - 1) <= max |w' B_0 u|`` that holds every state
 the input bound can keep from escaping (``distance`` of 10, 1e3 and 1e6 by default): infeasible by
@@ -13,7 +13,7 @@ Each record: the status, ``solver_status`` and iterations of the IPM (the defaul
 Clarabel fallback on: the fallback must not be needed) and whether its certificate passed the
 independent check (:func:`lmi.infeasibility.check_farkas`), the radius it proves, the feasible
 solve's status and iterations, the median times and their ratio. ``python -m
-benchmarks.far_states`` prints a Markdown table and the machine's load.
+dev.far_states`` prints a Markdown table and the machine's load.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from benchmarks.core.jsonable import write_json
-from benchmarks.stress import StressProblem, make_problem
+from dev.stress import StressProblem, make_problem
 
 __all__ = ["FAR_DISTANCES", "far_problems", "feasible_radius", "format_far", "run_far"]
 
@@ -135,7 +135,7 @@ def format_far(records: Sequence[dict]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m benchmarks.far_states [--sizes 2 3 4 5 6] [--seeds 0 1 2 3]
+    """``python -m dev.far_states [--sizes 2 3 4 5 6] [--seeds 0 1 2 3]
     [--distances 10 1e3 1e6] [--vertices 2] [--repeats 5] [--out FILE]``."""
     import argparse
     import os

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.robustness.probe import Probe
-from benchmarks.robustness.verdicts import Outcome, classify_cli, classify_exception
+from dev.robustness.probe import Probe
+from dev.robustness.verdicts import Outcome, classify_cli, classify_exception
 
 MEMORY_LIMIT_BYTES = 4 * 2**30
 """Address-space limit of an API probe's child (a size without a bound ends in MemoryError, not swap)."""

@@ -11,10 +11,10 @@ command (:mod:`.cli_cases`) and gives each one a verdict (:mod:`.verdicts`):
 - ``silent``: the input was accepted although it should have been refused;
 - ``hang``: no answer within the time limit.
 
-Run it with ``python -m benchmarks.robustness --out DIR``; it writes ``DIR/probe.json`` (one record
+Run it with ``python -m dev.robustness --out DIR``; it writes ``DIR/probe.json`` (one record
 per input) and ``DIR/probe.md`` (counts per verdict and the list of inputs that are not ``clear``).
 """
 
-from benchmarks.robustness.verdicts import VERDICTS, Outcome
+from dev.robustness.verdicts import VERDICTS, Outcome
 
 __all__ = ["VERDICTS", "Outcome"]

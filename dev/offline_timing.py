@@ -1,6 +1,6 @@
 """Design time of the off-line nested design (Wan & Kothare 2003) per back-end, and gamma agreement.
 
-Run as ``python -m benchmarks.offline_timing --out DIR [--repeats R] [--cases ...] [--backends ...]``.
+Run as ``python -m dev.offline_timing --out DIR [--repeats R] [--cases ...] [--backends ...]``.
 For each case the table of :class:`lmi.offline.NestedKothareProblem` is designed ``R`` times per
 back-end (``"ipm"``, the toolkit's interior-point method, and ``"cvxpy"``, cvxpy + Clarabel), a
 fresh problem each time (its construction counted: that is what a user pays once); reported per
@@ -181,8 +181,8 @@ def _markdown(res: dict[str, Any]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line: ``python -m benchmarks.offline_timing --out DIR``."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.offline_timing",
+    """Command line: ``python -m dev.offline_timing --out DIR``."""
+    parser = argparse.ArgumentParser(prog="python -m dev.offline_timing",
                                      description=(__doc__ or "").split("\n")[0])
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--repeats", type=int, default=3)

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.robustness.probe import Probe
+from dev.robustness.probe import Probe
 
 NAN = float("nan")
 INF = float("inf")

@@ -1,6 +1,0 @@
-"""``python -m benchmarks.robustness --out DIR [--timeout S] [--only api|cli] [--match TEXT]``."""
-
-from benchmarks.robustness.cli import main
-
-if __name__ == "__main__":
-    raise SystemExit(main())
