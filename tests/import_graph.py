@@ -9,7 +9,9 @@ is sorted by where it stands:
 - ``typing``: under ``if TYPE_CHECKING:``, never executed.
 
 ``from pkg import name`` points at ``pkg.name`` when that is a module, else at ``pkg`` (the
-package's ``__init__``, which may itself import the module that asks: a real cycle).
+package's ``__init__``, which may itself import the module that asks: a real cycle). A cycle is
+a cycle at any level, ``typing`` included: a type hint that names a module which imports back
+is a circle in the design even if it never runs (``farm-studio look`` counts it too).
 
 Run as ``python tests/import_graph.py`` for a report of the cycles at each level and the edges
 between packages.
@@ -206,14 +208,18 @@ def forbidden_edges(graph: ImportGraph) -> list[tuple[str, str, str]]:
 
 
 def report(graph: ImportGraph) -> str:
-    """The cycles at module level, the further ones that function-level imports add, and bad edges."""
+    """The cycles at module level, the further ones that function-level and then typing-only
+    imports add, and bad edges."""
     module_cycles = graph.cycles(["module"])
     runtime_cycles = [c for c in graph.cycles(["module", "function"]) if c not in module_cycles]
+    typing_cycles = [c for c in graph.cycles(LEVELS) if c not in module_cycles + runtime_cycles]
     lines = [f"{len(graph.files)} modules in {', '.join(PACKAGES)}"]
     lines.append(f"module-level cycles: {len(module_cycles)}")
     lines += ["  " + " <-> ".join(c) for c in module_cycles]
     lines.append(f"cycles closed by function-level imports: {len(runtime_cycles)}")
     lines += ["  " + " <-> ".join(c) for c in runtime_cycles]
+    lines.append(f"cycles closed by typing-only imports: {len(typing_cycles)}")
+    lines += ["  " + " <-> ".join(c) for c in typing_cycles]
     bad = forbidden_edges(graph)
     lines.append(f"imports against the dependency direction: {len(bad)}")
     lines += [f"  {m} -> {t} ({level})" for m, t, level in bad]

@@ -9,9 +9,10 @@ so a new family is a new sub-package of :mod:`benchmarks.families` listed in its
 ``SHIPPED_FAMILIES``, or a user's own object registered with
 :func:`benchmarks.core.registry.register_family`: nothing in the core is edited.
 
-This module is the bottom of the harness: it imports nothing of :mod:`benchmarks`, and the
-families import it (with :mod:`benchmarks.core.metrics`) and nothing else of the core. Looking a
-family up by name is :mod:`benchmarks.core.registry`'s job.
+This module is the bottom of the harness: it imports nothing of :mod:`benchmarks`, not even for
+type hints (a scenario is typed ``Any``), and the families import it (with
+:mod:`benchmarks.core.metrics`) and nothing else of the core. Looking a family up by name is
+:mod:`benchmarks.core.registry`'s job, and :mod:`benchmarks.core.scenario` uses both.
 
 Every family has at least the fields ``plant``, ``saturation``, ``duration`` and ``dt`` (the
 record of a case names its plant and saturation; a ``duration`` of ``None`` lets the family pick
@@ -30,14 +31,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from toolkit_common.errors import ConfigError
-
-if TYPE_CHECKING:  # benchmarks.core.scenario imports this module
-    from benchmarks.core.scenario import Scenario
 
 __all__ = [
     "REQUIRED_FIELDS",
@@ -300,8 +298,12 @@ class PlantFamily:
             return f"'none' or 'limiter' for {controller} (it has no constraint)"
         return None
 
-    def build_controller(self, model: Any, scenario: Scenario) -> BuiltController:
-        """Build the scenario's controller on ``model`` with its effective settings."""
+    def build_controller(self, model: Any, scenario: Any) -> BuiltController:
+        """Build the scenario's controller on ``model`` with its effective settings.
+
+        ``scenario`` is a :class:`benchmarks.core.scenario.Scenario` (typed ``Any`` here, like the
+        scenario every callable above receives: the scenario module imports this one).
+        """
         settings = self.effective_settings(scenario.controller, scenario.settings)
         return self.controllers[scenario.controller].build(model, scenario, settings)
 

@@ -7,7 +7,9 @@ auxiliary solver of the same blocks and one more variable (:func:`phase_one_solv
 every iterate (:class:`PhaseOneCheck`) for a strictly feasible ``x`` or a dual point that, moved
 onto ``sum_j <A_ij, Z_j> = 0`` (:func:`dual_correction`), is a Farkas certificate of
 infeasibility (:class:`PhaseOneResult`). It reads the solver's packed data
-(:class:`lmi.ipm.blocks.BlockData`) directly. The auxiliary solver takes the solver's weights,
+(:class:`lmi.ipm.blocks.BlockData`) directly and builds the auxiliary solver from the solver's
+own class (``type(slv)``): it imports no solver, the solver imports it (the solver is typed
+``Any`` where more than its data is used). The auxiliary solver takes the solver's weights,
 so its iterates are in the weighted units of that packed data (its ``t`` has the coefficient
 ``-I`` there: with ``-I`` in the original blocks, phase one of SDPLIB's control3 and control4
 took 5 and 6 iterations instead of 3 and 2); the certificate is returned, and its margins are
@@ -18,15 +20,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from lmi.ipm import kernels as _kernels
-from lmi.ipm.blocks import BlockFactor
-
-if TYPE_CHECKING:
-    from lmi.ipm.solver import BlockLMISolver
+from lmi.ipm.blocks import BlockData, BlockFactor
 
 __all__ = [
     "PHASE_ONE_MARGIN", "PHASE_ONE_MAX_ITER", "PHASE_ONE_RESIDUAL", "PHASE_ONE_TOL", "PhaseOneCheck",
@@ -77,8 +76,9 @@ class PhaseOneResult:
     solve_time: float
 
 
-def run_phase_one(slv: BlockLMISolver) -> PhaseOneResult:
-    """Phase one on the current data of ``slv`` (see :meth:`lmi.ipm.BlockLMISolver.phase_one`)."""
+def run_phase_one(slv: Any) -> PhaseOneResult:
+    """Phase one on the current data of ``slv``, a :class:`lmi.ipm.BlockLMISolver` (see
+    :meth:`lmi.ipm.BlockLMISolver.phase_one`)."""
     start = time.perf_counter()
     slv._refresh()
     aux = phase_one_solver(slv)
@@ -114,9 +114,9 @@ def run_phase_one(slv: BlockLMISolver) -> PhaseOneResult:
     )
 
 
-def phase_one_solver(slv: BlockLMISolver) -> BlockLMISolver:
-    """The phase-one solver of ``slv`` (built once, a solver of the same class), its blocks brought
-    up to date with those of ``slv``."""
+def phase_one_solver(slv: Any) -> Any:
+    """The phase-one solver of ``slv``, a :class:`lmi.ipm.BlockLMISolver` (built once, a solver of
+    the same class), its blocks brought up to date with those of ``slv``."""
     n = slv.n
     aux = slv._phase_one_solver
     fresh = aux is None
@@ -152,7 +152,7 @@ class PhaseOneCheck:
     corrected onto ``A'Z = 0``, prove infeasibility? (see :meth:`lmi.ipm.BlockLMISolver.phase_one`).
     What it found is left in ``found``."""
 
-    def __init__(self, solver: BlockLMISolver, aux_scale: np.ndarray) -> None:
+    def __init__(self, solver: BlockData, aux_scale: np.ndarray) -> None:
         self.solver = solver
         self.aux_scale = aux_scale
         self.found: dict[str, Any] = {}
@@ -208,7 +208,7 @@ class PhaseOneCheck:
         return "infeasible"
 
 
-def dual_correction(slv: BlockLMISolver, z: np.ndarray) -> list[np.ndarray] | None:
+def dual_correction(slv: BlockData, z: np.ndarray) -> list[np.ndarray] | None:
     """``Z`` (positive definite blocks, padded) moved onto ``sum_j <A_ij, Z_j> = 0`` by the
     correction of least norm in ``Z``'s own metric: with ``Z_j = L_j L_j'``, ``Z_j + dZ_j =
     L_j (I + F_j) L_j'`` with ``||F||_F`` least, i.e. ``F`` the least-norm solution of
