@@ -36,11 +36,6 @@ def test_the_graph_sees_every_module_and_sorts_imports_by_level(graph: ImportGra
     assert "benchmarks.timing.config" in graph.targets("benchmarks.timing.rmpc", ["typing"])
 
 
-#: Cycles that are leaving the packages by another change: benchmarks.mutation moves out to dev/
-#: (its report names the runner's types for hints only). Once it is gone this list is empty.
-LEAVING = [["benchmarks.mutation.report", "benchmarks.mutation.runner"]]
-
-
 def test_no_module_level_import_cycle(graph: ImportGraph) -> None:
     assert graph.cycles(["module"]) == [], report(graph)
 
@@ -49,8 +44,7 @@ def test_no_import_cycle_even_through_function_level_or_typing_imports(graph: Im
     # the plant-family protocol once named the scenario in a type hint (the scenario imports the
     # registry, which imports the families, which import the protocol), and the solver's phase
     # one named the solver (which imports it): cycles no import at run time closes
-    cycles = [c for c in graph.cycles(LEVELS) if c not in LEAVING]
-    assert cycles == [], report(graph)
+    assert graph.cycles(LEVELS) == [], report(graph)
 
 
 def test_dependencies_point_one_way(graph: ImportGraph) -> None:
