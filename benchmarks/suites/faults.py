@@ -42,6 +42,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.wheel import defaults
+from benchmarks.reports.measurement import records_reason, withhold
 from benchmarks.reports.sections import failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "fault_cases", "run_faults"]
@@ -267,8 +268,9 @@ def paper_w_results(records: list[dict[str, Any]]) -> list[str]:
     """
     from benchmarks.suites.faults_claims import assess_d_error, assess_hardware, assess_r1, claims_markdown
 
+    reason = _smoke(records)
     lines = ["## Paper W's reported results and what this toolkit measures", ""]
-    lines += claims_markdown([assess_r1(records), *assess_hardware(records)])
+    lines += claims_markdown(withhold([assess_r1(records), *assess_hardware(records)], reason))
     r4 = [r for exp in ("W2", "W3", "W4") for r in _find(records, exp, "ABFTC")]
     if r4:
         cmd = max(r["metrics"]["faults"]["max_abs_u_cmd"] for r in r4)
@@ -283,9 +285,14 @@ def paper_w_results(records: list[dict[str, Any]]) -> list[str]:
         )
     else:
         lines.append("- **R4**: W2-W4 were not run.")
-    lines += claims_markdown([assess_d_error(records)])
+    lines += claims_markdown(withhold([assess_d_error(records)], reason))
     lines.append("")
     return lines
+
+
+def _smoke(records: list[dict[str, Any]]) -> str | None:
+    """Why this run measures none of paper W's claims (a smoke run), read from the records; else None."""
+    return records_reason(records, "recovery after a fault or a steady state (the fault windows shrink too)")
 
 
 def _recovery_cell(rec: dict[str, Any] | None) -> str:
@@ -325,7 +332,8 @@ def w5_section(records: list[dict[str, Any]]) -> list[str]:
             name = ("limits on" if col[0] else "no limits") + (", freeze on" if col[1] else ", freeze off")
             row[name] = _recovery_cell(pick(g, col))
         rows.append(row)
-    r1 = assess_r1(records)
+    reason = _smoke(records)
+    r1 = withhold([assess_r1(records)], reason)[0]
     lines = [
         "### W5: recovery after the onset (2 deg) per adaptation gain",
         "",
@@ -336,8 +344,10 @@ def w5_section(records: list[dict[str, Any]]) -> list[str]:
         "",
         f"Measured: {r1.evidence}.",
     ]
-    if r1.why:
-        lines.append(f"The gap to paper W's 10 s: {r1.why}.")
+    if reason is not None:
+        lines.append(f"No measurement of the gap to paper W's R1: {reason}.")
+    elif r1.why:
+        lines.append(f"The gap to paper W's R1: {r1.why}.")
     return [*lines, ""]
 
 
@@ -524,5 +534,6 @@ def _markdown(
         "Every value paper W leaves out is the toolkit's choice "
         "(`benchmarks/families/wheel/defaults.py`; each is a scenario field or controller setting)."
     )
-    lines += settings_section(intro, defaults.settings_rows(), defaults.rationale())
+    rationale = None if _smoke(records) else defaults.rationale()
+    lines += settings_section(intro, defaults.settings_rows(), rationale)
     return "\n".join(lines)
