@@ -25,6 +25,7 @@ W7    S1: the plant's wheel axes tilted 5 deg (an error in D), the controllers o
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -42,7 +43,7 @@ from benchmarks.core.suite import (
     write_traces,
 )
 from benchmarks.families.wheel import defaults
-from benchmarks.reports.measurement import records_reason, withhold
+from benchmarks.reports.measurement import records_reason, run_durations, withhold
 from benchmarks.reports.sections import failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "fault_cases", "run_faults"]
@@ -494,6 +495,38 @@ def _write(
     return files
 
 
+_FAULT = re.compile(r"WheelFault\(wheel=(\d+), kind='(\w+)', t_on=([^,]+), t_off=([^,]+), value=([^)]+)\)")
+
+
+def _fault_words(text: str) -> str:
+    """A record's fault (``settings.faults_used``, the fault's repr) in words, with its window."""
+    m = _FAULT.fullmatch(text)
+    if m is None:
+        return text
+    wheel, kind, t_on, t_off, value = m.groups()
+    end = "the end" if t_off in ("inf", "math.inf") else f"{float(t_off):g} s"
+    size = "" if kind == "out" else f" ({value})"
+    return f"wheel {wheel} {kind}{size} from t = {float(t_on):g} s to {end}"
+
+
+def run_text(text: str, records: list[dict[str, Any]]) -> str:
+    """An experiment's description for the report: paper W's scenario as :data:`EXPERIMENTS`
+    words it for a full run; for a run at a time scale below 1 (whose times differ from paper
+    W's), that the scenario is scaled; then the faults, run lengths and time scale of ``records``."""
+    scales = sorted({float(r["settings"].get("time_scale", 1.0)) for r in records})
+    scaled = any(t < 1.0 for t in scales)
+    out = text
+    if scaled:
+        out = f"Paper W's scenario with its times scaled by {' / '.join(f'{t:g}' for t in scales)}."
+    faults = list(dict.fromkeys(f for r in records for f in r["settings"].get("faults_used", [])))
+    spans = sorted({round(d, 9) for d in run_durations(records)})
+    if faults:
+        out += " Faults in this run: " + "; ".join(_fault_words(f) for f in faults) + "."
+    if spans:
+        out += f" Runs of {' / '.join(f'{d:g}' for d in spans)} s."
+    return out
+
+
 def _markdown(
     records: list[dict],
     outcome: SuiteOutcome,
@@ -519,7 +552,7 @@ def _markdown(
         recs = [r for r in records if r["experiment"] == exp]
         if not recs and exp not in figures:
             continue
-        lines += [f"## {exp} (paper W's {scenario})", "", text, ""]
+        lines += [f"## {exp} (paper W's {scenario})", "", run_text(text, recs), ""]
         if recs:
             lines += [rows_table([case_row(r) for r in recs]), ""]
         for path in figures.get(exp, []):

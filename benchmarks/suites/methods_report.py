@@ -203,14 +203,21 @@ def least_conservative(records: list[dict[str, Any]]) -> list[str]:
         def ratio(r: dict[str, Any], b: dict[str, Any] | None = base) -> float | None:
             return region_ratio(r, b)
 
-        reg = _best([r for r in hard if not _capped(r) and not _capped(base)], ratio, largest=True)
-        if reg is None and any(_capped(r) for r in hard):
-            parts.append("largest region (hard bounds): not measured, a region reached the search cap")
-        elif reg is not None:
+        measured = [] if _capped(base) else [r for r in hard if not _capped(r)]
+        at_cap = [r["method"] for r in hard if _capped(r)]
+        reg = _best(measured, ratio, largest=True)
+        if reg is not None:
             parts.append(
                 f"largest region (hard bounds): {reg['method']} ({ratio(reg):.3f} x kothare's, "
                 "geometric mean)"
-                + _ties(hard, ratio, reg)
+                + _ties(measured, ratio, reg)
+                + (f" (at the search cap, not ranked: {', '.join(at_cap)})" if at_cap else "")
+            )
+        elif at_cap:
+            parts.append(
+                "largest region (hard bounds): not ranked, the search cap bounds "
+                + ("Kothare's region" if _capped(base) else "the regions")
+                + f" (at the cap: {', '.join(at_cap)})"
             )
         gained = [r for r in recs if certified(r)]
         cost = _best(gained, _cost, largest=False)
@@ -306,6 +313,15 @@ def write_methods_report(
         "",
         "## Which form is least conservative where",
         "",
+        *(
+            [
+                "No measurement: a smoke run's few directions and short horizons check the set-up; the "
+                "lines below are what it measured, not a ranking of the forms.",
+                "",
+            ]
+            if short
+            else []
+        ),
         *least_conservative(records),
         "",
     ]
