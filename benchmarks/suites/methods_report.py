@@ -27,6 +27,7 @@ if TYPE_CHECKING:  # the runner imports this module; the settings are only a typ
 __all__ = [
     "GAMMA_COMPARABLE",
     "NO_GAIN",
+    "SUMMARY_COLUMNS",
     "TIE_TOLERANCE",
     "certified",
     "least_conservative",
@@ -46,6 +47,16 @@ TIE_TOLERANCE: float = 0.001
 
 #: What the report shows in place of a cost for a form that never had a certified gain.
 NO_GAIN = "no certified gain"
+
+#: The columns of the compact table each problem's section shows first (all columns follow).
+SUMMARY_COLUMNS: tuple[str, ...] = (
+    "method",
+    "status at x0",
+    "gamma",
+    "region vs kothare",
+    "cost (nominal plant)",
+    "solve p50 / p95 (ms)",
+)
 
 #: Step statuses that mean the controller applied a certified gain.
 _CERTIFIED_STEPS = ("optimal", "reused")
@@ -336,7 +347,15 @@ def write_methods_report(
             "",
         ]
         prows = [table_row(r, _kothare(records, p)) for r in recs]
-        lines += [to_markdown(list(prows[0]), [list(row.values()) for row in prows]), ""]
+        short_cols = [c for c in SUMMARY_COLUMNS if c in prows[0]]
+        lines += [
+            to_markdown(short_cols, [[row[c] for c in short_cols] for row in prows]),
+            "",
+            "All columns:",
+            "",
+            to_markdown(list(prows[0]), [list(row.values()) for row in prows]),
+            "",
+        ]
         notes = [f"- {r['method']}: {r['skip_reason']}" for r in recs if r.get("skip_reason")] + [
             f"- {r['method']}: {n}" for r in recs for n in r.get("notes", [])
         ]
