@@ -244,7 +244,7 @@ def _add_methods(bsub: Any) -> None:
         "--methods", type=_names, default=None, metavar="kothare,vertex,...", help="run only these methods"
     )
     methods.add_argument("--fresh", action="store_true", help="ignore the cases stored by an earlier run")
-    methods.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    methods.add_argument("--no-progress", action="store_true", help="no progress output at all")
     methods.set_defaults(func=_cmd_bench_methods)
 
 
@@ -259,7 +259,7 @@ def _add_suite(bsub: Any, name: str, workers_help: str) -> None:
     parser.add_argument(
         "--experiments", type=_experiments, default=None, metavar=metavar, help="run only these experiments"
     )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    parser.add_argument("--no-progress", action="store_true", help="no progress output at all")
     parser.set_defaults(func=_cmd_bench_suite, suite_module=module, suite_runner=runner)
 
 
@@ -346,7 +346,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         metavar="E1,E2,...",
         help="run only these experiments",
     )
-    paper.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    paper.add_argument("--no-progress", action="store_true", help="no progress output at all")
     paper.set_defaults(func=_cmd_bench_paper)
 
     for name in _SUITES:
@@ -391,7 +391,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="replace what DIR holds when it belongs to another sweep or run (refused by default)",
     )
-    sweep.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    sweep.add_argument("--no-progress", action="store_true", help="no progress output at all")
     sweep.set_defaults(func=_cmd_bench_sweep)
 
 

@@ -11,12 +11,12 @@ import pytest
 from benchmarks.suites import methods as suite
 from benchmarks.suites.methods import (
     MethodsSettings,
-    least_conservative,
     method_options,
     region_along,
     run_methods,
 )
 from benchmarks.suites.methods_problems import build_problem
+from benchmarks.suites.methods_report import least_conservative
 
 API_FIELDS = (
     "problem",

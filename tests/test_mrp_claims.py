@@ -96,8 +96,9 @@ def test_verdicts_follow_the_short_runs_numbers(short_records):
                                     else "not reproduced")
     assert f"{ratio:.3g}" in claims["R4"].evidence
     text = "\n".join(paper_m_comparison(short_records))
-    for c in claims.values():
-        assert f"**{c.experiment}: {c.verdict}.**" in text
+    for c in claims.values():  # a smoke run's report judges none of them
+        assert f"**{c.experiment}: no measurement.**" in text
+    assert "reproduced" not in text
 
 
 def _rec(exp, ctrl, err=1e-9, t_peak=0.0, est=None, ratio=None, final=1e-9, initial=57.8):

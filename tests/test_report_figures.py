@@ -83,8 +83,8 @@ def test_responses_figure_draws_attitude_torques_and_the_limit_lines():
         assert ax.get_xlabel() == "time (s)"
     # the line style tells the plant apart, the colour the controller
     styles = [(line.get_label(), line.get_linestyle()) for line in curves(grid[0, 0])]
-    assert styles == [("RMPC limiter (linear)", "--"), ("RMPC limiter (nonlinear)", "-"),
-                      ("GIPC limiter (linear)", "--"), ("GIPC limiter (nonlinear)", "-")]
+    assert styles == [("RMPC, limiter (linear)", "--"), ("RMPC, limiter (nonlinear)", "-"),
+                      ("GIPC, limiter (linear)", "--"), ("GIPC, limiter (nonlinear)", "-")]
     colours = [line.get_color() for line in curves(grid[0, 0])]
     assert colours[0] == colours[1] != colours[2] == colours[3]
     assert len(fig.legends) == 1 and len(fig.legends[0].get_texts()) == len(runs)
@@ -118,7 +118,7 @@ def test_gamma_figure_one_log_panel_per_experiment_with_a_bound():
         # "gamma(k)" alone passes a unit check through "(k)": the label must say it has no unit
         assert ax.get_ylabel() == "cost bound gamma(k) (dimensionless)"
         labels = [line.get_label() for line in curves(ax)]
-        assert labels == ["RMPC limiter (linear)", "RMPC limiter (nonlinear)"]
+        assert labels == ["RMPC, limiter (linear)", "RMPC, limiter (nonlinear)"]
         np.testing.assert_allclose(curves(ax)[0].get_ydata(), runs[0][1]["gamma"])
     assert gamma_figure({"E5": runs[2:]}) is None
     assert plot_gamma({"E5": runs[2:]}, "unused.png") is None

@@ -16,9 +16,17 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from benchmarks.reports.figure_style import PALETTE
+from benchmarks.reports.figure_style import PALETTE, wrapped_title
 
-__all__ = ["GAMMA_LABEL", "gamma_figure", "plot_gamma", "plot_responses", "responses_figure"]
+__all__ = [
+    "GAMMA_LABEL",
+    "SATURATION_WORDS",
+    "gamma_figure",
+    "plot_gamma",
+    "plot_responses",
+    "responses_figure",
+    "run_label",
+]
 
 _AXIS_LABELS = ("roll $\\phi$", "pitch $\\theta$", "yaw $\\psi$")
 _TORQUE_LABELS = ("$M_x$", "$M_y$", "$M_z$")
@@ -28,8 +36,22 @@ _STYLES = {"nonlinear": "-", "linear": "--"}
 Run = tuple[Mapping[str, Any], Mapping[str, np.ndarray]]
 
 
+#: The scenario's ``saturation`` option in words, for legends.
+SATURATION_WORDS: dict[str, str] = {
+    "none": "no saturation",
+    "limiter": "limiter",
+    "constraint": "controller's constraint",
+}
+
+
 def _key(rec: Mapping[str, Any]) -> str:
-    return f"{rec['controller']} {rec['saturation']}"
+    sat = str(rec["saturation"])
+    return f"{rec['controller']}, {SATURATION_WORDS.get(sat, sat)}"
+
+
+def run_label(rec: Mapping[str, Any]) -> str:
+    """A run's legend entry in words: ``"RMPC, no saturation (linear)"``."""
+    return f"{_key(rec)} ({rec['plant']})"
 
 
 def _colors(runs: Sequence[Run]) -> dict[str, str]:
@@ -48,7 +70,7 @@ def responses_figure(runs: Sequence[Run], title: str, u_max: float) -> Figure:
     runs : sequence of (record, trace)
         ``trace`` has ``t``, ``x`` and ``u_applied`` (see :func:`benchmarks.core.runner.simulate_scenario`).
     title : str
-        Figure title.
+        Figure title, wrapped at word boundaries to the figure's width (never cut).
     u_max : float
         Torque limit drawn as dotted lines (N m).
 
@@ -67,7 +89,7 @@ def responses_figure(runs: Sequence[Run], title: str, u_max: float) -> Figure:
             color=colors[_key(rec)],
             linestyle=_STYLES.get(rec["plant"], "-"),
             linewidth=1.2,
-            label=f"{_key(rec)} ({rec['plant']})",
+            label=run_label(rec),
         )
         for i in range(3):
             axes[i, 0].plot(t, np.degrees(np.asarray(tr["x"])[:, i]), **style)
@@ -89,8 +111,8 @@ def responses_figure(runs: Sequence[Run], title: str, u_max: float) -> Figure:
     axes[0, 1].set_title(f"applied torque (limit +-{u_max:g} N m dotted)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)), fontsize="small")
-    fig.suptitle(title)
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(3, len(labels)), fontsize="small")
+    wrapped_title(fig, title, fontsize=11.0)
     return fig
 
 
@@ -155,7 +177,7 @@ def gamma_figure(groups: Mapping[str, Sequence[Run]]) -> Figure | None:
                 drawstyle="steps-post",
                 color=colors[_key(rec)],
                 linestyle=_STYLES.get(rec["plant"], "-"),
-                label=f"{_key(rec)} ({rec['plant']})",
+                label=run_label(rec),
             )
         ax.set_title(name)
         ax.set_xlabel("time (s)")

@@ -65,17 +65,25 @@ def failed_cases(failures: Sequence[Mapping[str, Any]]) -> list[str]:
     return ["## Failed cases", "", *(f"- {f['key']}: {f['error']}" for f in failures), ""]
 
 
-def settings_section(intro: str, rows: Sequence[Sequence[Any]], rationale: str) -> list[str]:
-    """The settings the toolkit chose: ``intro``, the table of ``(setting, value, source)`` rows, why."""
-    return [
+def settings_section(intro: str, rows: Sequence[Sequence[Any]], rationale: str | None) -> list[str]:
+    """The settings the toolkit chose: ``intro``, the table of ``(setting, value, source)`` rows, why.
+
+    ``rationale=None`` (a smoke run: the reasons speak of the full runs' lengths and results)
+    leaves the reasons out and says where they are.
+    """
+    lines = [
         "## Settings",
         "",
         intro,
         "",
         to_markdown(["setting", "value", "source"], [list(r) for r in rows]),
         "",
-        "Why these values:",
-        "",
-        rationale,
-        "",
     ]
+    if rationale is None:
+        return [
+            *lines,
+            "The reasons for these values speak of the full runs and are left out of a smoke run's "
+            "report; they are in the defaults module named above.",
+            "",
+        ]
+    return [*lines, "Why these values:", "", rationale, ""]

@@ -28,8 +28,11 @@ from benchmarks.core.metrics import AXES
 
 __all__ = [
     "METRIC_COLUMNS",
+    "SUMMARY_COLUMNS",
+    "drop_empty_columns",
     "format_value",
     "metric_table",
+    "select_columns",
     "to_csv",
     "to_json",
     "to_latex",
@@ -126,6 +129,41 @@ def metric_table(
         row += [_cell(get, rec["metrics"]) for _, get in METRIC_COLUMNS]
         rows.append(row)
     return header, rows
+
+
+#: The metric columns of the compact summary table a report shows first (the full table follows).
+SUMMARY_COLUMNS: tuple[str, ...] = (
+    *(f"sum|e| {ax} (rad)" for ax in AXES),
+    "max final |e| (rad)",
+    "max|u| (N m)",
+    "saturated",
+    "failures",
+)
+
+
+def select_columns(
+    header: Sequence[str], rows: Sequence[Row], names: Sequence[str]
+) -> tuple[list[str], list[Row]]:
+    """The columns of ``header`` named in ``names`` (in the table's order), with their cells."""
+    keep = [i for i, h in enumerate(header) if h in names]
+    return [header[i] for i in keep], [[row[i] for i in keep] for row in rows]
+
+
+def drop_empty_columns(
+    header: Sequence[str], rows: Sequence[Row]
+) -> tuple[list[str], list[Row], list[str]]:
+    """The table without the columns that are empty (``None``) in every row, and their names.
+
+    Examples
+    --------
+    >>> drop_empty_columns(["a", "b"], [[1, None], [2, None]])
+    (['a'], [[1], [2]], ['b'])
+    """
+    if not rows:
+        return list(header), [list(r) for r in rows], []
+    keep = [i for i in range(len(header)) if any(row[i] is not None for row in rows)]
+    dropped = [header[i] for i in range(len(header)) if i not in keep]
+    return [header[i] for i in keep], [[row[i] for i in keep] for row in rows], dropped
 
 
 def format_value(value: Any) -> str:

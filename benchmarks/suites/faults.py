@@ -25,6 +25,7 @@ W7    S1: the plant's wheel axes tilted 5 deg (an error in D), the controllers o
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -43,6 +44,7 @@ from benchmarks.core.suite import (
 )
 from benchmarks.families.wheel import defaults
 from benchmarks.reports.citations import citation_line
+from benchmarks.reports.measurement import records_reason, run_durations, withhold
 from benchmarks.reports.sections import failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "fault_cases", "run_faults"]
@@ -268,8 +270,9 @@ def paper_w_results(records: list[dict[str, Any]]) -> list[str]:
     """
     from benchmarks.suites.faults_claims import assess_d_error, assess_hardware, assess_r1, claims_markdown
 
+    reason = _smoke(records)
     lines = ["## Paper W's reported results and what this toolkit measures", ""]
-    lines += claims_markdown([assess_r1(records), *assess_hardware(records)])
+    lines += claims_markdown(withhold([assess_r1(records), *assess_hardware(records)], reason))
     r4 = [r for exp in ("W2", "W3", "W4") for r in _find(records, exp, "ABFTC")]
     if r4:
         cmd = max(r["metrics"]["faults"]["max_abs_u_cmd"] for r in r4)
@@ -284,9 +287,14 @@ def paper_w_results(records: list[dict[str, Any]]) -> list[str]:
         )
     else:
         lines.append("- **R4**: W2-W4 were not run.")
-    lines += claims_markdown([assess_d_error(records)])
+    lines += claims_markdown(withhold([assess_d_error(records)], reason))
     lines.append("")
     return lines
+
+
+def _smoke(records: list[dict[str, Any]]) -> str | None:
+    """Why this run measures none of paper W's claims (a smoke run), read from the records; else None."""
+    return records_reason(records, "recovery after a fault or a steady state (the fault windows shrink too)")
 
 
 def _recovery_cell(rec: dict[str, Any] | None) -> str:
@@ -326,7 +334,8 @@ def w5_section(records: list[dict[str, Any]]) -> list[str]:
             name = ("limits on" if col[0] else "no limits") + (", freeze on" if col[1] else ", freeze off")
             row[name] = _recovery_cell(pick(g, col))
         rows.append(row)
-    r1 = assess_r1(records)
+    reason = _smoke(records)
+    r1 = withhold([assess_r1(records)], reason)[0]
     lines = [
         "### W5: recovery after the onset (2 deg) per adaptation gain",
         "",
@@ -337,8 +346,10 @@ def w5_section(records: list[dict[str, Any]]) -> list[str]:
         "",
         f"Measured: {r1.evidence}.",
     ]
-    if r1.why:
-        lines.append(f"The gap to paper W's 10 s: {r1.why}.")
+    if reason is not None:
+        lines.append(f"No measurement of the gap to paper W's R1: {reason}.")
+    elif r1.why:
+        lines.append(f"The gap to paper W's R1: {r1.why}.")
     return [*lines, ""]
 
 
@@ -485,6 +496,38 @@ def _write(
     return files
 
 
+_FAULT = re.compile(r"WheelFault\(wheel=(\d+), kind='(\w+)', t_on=([^,]+), t_off=([^,]+), value=([^)]+)\)")
+
+
+def _fault_words(text: str) -> str:
+    """A record's fault (``settings.faults_used``, the fault's repr) in words, with its window."""
+    m = _FAULT.fullmatch(text)
+    if m is None:
+        return text
+    wheel, kind, t_on, t_off, value = m.groups()
+    end = "the end" if t_off in ("inf", "math.inf") else f"{float(t_off):g} s"
+    size = "" if kind == "out" else f" ({value})"
+    return f"wheel {wheel} {kind}{size} from t = {float(t_on):g} s to {end}"
+
+
+def run_text(text: str, records: list[dict[str, Any]]) -> str:
+    """An experiment's description for the report: paper W's scenario as :data:`EXPERIMENTS`
+    words it for a full run; for a run at a time scale below 1 (whose times differ from paper
+    W's), that the scenario is scaled; then the faults, run lengths and time scale of ``records``."""
+    scales = sorted({float(r["settings"].get("time_scale", 1.0)) for r in records})
+    scaled = any(t < 1.0 for t in scales)
+    out = text
+    if scaled:
+        out = f"Paper W's scenario with its times scaled by {' / '.join(f'{t:g}' for t in scales)}."
+    faults = list(dict.fromkeys(f for r in records for f in r["settings"].get("faults_used", [])))
+    spans = sorted({round(d, 9) for d in run_durations(records)})
+    if faults:
+        out += " Faults in this run: " + "; ".join(_fault_words(f) for f in faults) + "."
+    if spans:
+        out += f" Runs of {' / '.join(f'{d:g}' for d in spans)} s."
+    return out
+
+
 def _markdown(
     records: list[dict],
     outcome: SuiteOutcome,
@@ -511,7 +554,7 @@ def _markdown(
         recs = [r for r in records if r["experiment"] == exp]
         if not recs and exp not in figures:
             continue
-        lines += [f"## {exp} (paper W's {scenario})", "", text, ""]
+        lines += [f"## {exp} (paper W's {scenario})", "", run_text(text, recs), ""]
         if recs:
             lines += [rows_table([case_row(r) for r in recs]), ""]
         for path in figures.get(exp, []):
@@ -526,5 +569,6 @@ def _markdown(
         "Every value paper W leaves out is the toolkit's choice "
         "(`benchmarks/families/wheel/defaults.py`; each is a scenario field or controller setting)."
     )
-    lines += settings_section(intro, defaults.settings_rows(), defaults.rationale())
+    rationale = None if _smoke(records) else defaults.rationale()
+    lines += settings_section(intro, defaults.settings_rows(), rationale)
     return "\n".join(lines)

@@ -74,7 +74,7 @@ __all__ = [
 EXPERIMENTS: dict[str, str] = {
     "F1": "Paper V's 2x2 study on the 160 deg V-slew: {MTSMC, CSMC (tanh)} x {AVC off, on}, equal gains.",
     "F2": "The boundary layer eps of the tanh switching term: MTSMC and CSMC (tanh) per eps, CSMC (sign).",
-    "F3": "Steady error at the target under a constant 0.05 N m per axis (250 s): MTSMC with and "
+    "F3": "Steady error at the target under a constant 0.05 N m per axis: MTSMC with and "
     "without the integral term, CSMC.",
     "F4": "A 10 deg slew where the linear model holds: OfflineRMPC and RMPC on the 14-state model "
     "over the 8-vertex polytope (0.5 s period, per-axis peak bound) against MTSMC and the LQR "

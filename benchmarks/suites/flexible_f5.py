@@ -22,6 +22,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from benchmarks.reports.sections import rows_table
+from benchmarks.suites.flexible_claims import tail_words
 
 __all__ = ["F5_BASELINES", "F5_REFERENCES", "f5_lines", "f5_verdicts"]
 
@@ -128,7 +129,7 @@ def f5_lines(records: Sequence[dict[str, Any]], row: Callable[[dict[str, Any]], 
         settle,
         f"- Excites the first mode least over the slew (peak |eta_1|): {_names(peak_best)} at "
         f"{peak_best[0][0]:.3g} (largest: {peak_worst[1]} at {peak_worst[0]:.3g}).",
-        f"- Leaves the least modal energy over the run's last 10 s: {_names(res_best)} at "
+        f"- Leaves the least modal energy over {tail_words(recs)}: {_names(res_best)} at "
         f"{res_best[0][0]:.3g} "
         f"(largest: {res_worst[1]} at {res_worst[0]:.3g}).",
         "",

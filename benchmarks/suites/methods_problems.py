@@ -288,7 +288,7 @@ SUITE_CHOICES: tuple[tuple[str, str, str], ...] = (
     (
         "disturbance method",
         f"E = nominal B, w_max = {DISTURBANCE_FRACTION:g} u_max; the closed loop itself runs without it",
-        "an input-channel disturbance of a size every problem can carry",
+        "one size relative to each problem's own input bound (where no gain carries it, the report says so)",
     ),
     (
         "soft method",

@@ -36,6 +36,7 @@ from benchmarks.core.suite import (
 )
 from benchmarks.families.mrp import defaults
 from benchmarks.reports.citations import citation_line
+from benchmarks.reports.measurement import records_reason, withhold
 from benchmarks.reports.sections import dash, failed_cases, rows_table, run_lines, settings_section, statuses
 
 __all__ = ["CONTROLLERS", "EXPERIMENTS", "mrp_cases", "run_mrp"]
@@ -142,6 +143,11 @@ def _find(records: list[dict], exp: str, ctrl: str, scale: float = 1.0) -> dict 
     return None
 
 
+def _smoke(records: list[dict[str, Any]]) -> str | None:
+    """Why this run measures none of paper M's claims (a smoke run), read from the records; else None."""
+    return records_reason(records, "a steady window after the transient")
+
+
 def paper_m_comparison(records: list[dict[str, Any]]) -> list[str]:
     """Paper M's reported outcomes with this run's verdicts (:mod:`benchmarks.suites.mrp_claims`)."""
     from benchmarks.suites.mrp_claims import assess_paper_m, paper_m_claims_markdown
@@ -158,7 +164,7 @@ def paper_m_comparison(records: list[dict[str, Any]]) -> list[str]:
         rec = _find(records, exp, ctrl, scale)
         return None if rec is None else rec["metrics"]["err_angle_ss_max_deg"]
 
-    lines += paper_m_claims_markdown(assess_paper_m(records))
+    lines += paper_m_claims_markdown(withhold(assess_paper_m(records), _smoke(records)))
     robust = [
         f"{c} {dash(err('M2', c))} deg" for c in ("RMPC", "CRMPC") if _find(records, "M2", c) is not None
     ]
@@ -236,7 +242,8 @@ def _write(
     lines += paper_m_comparison(records)
     lines += failed_cases(outcome.failures)
     intro = "Every value paper M leaves out is the toolkit's choice (`benchmarks/families/mrp/defaults.py`)."
-    lines += settings_section(intro, defaults.settings_rows(), defaults.rationale())
+    rationale = None if _smoke(records) else defaults.rationale()
+    lines += settings_section(intro, defaults.settings_rows(), rationale)
     (out / "results.md").write_text("\n".join(lines), encoding="utf-8")
     files += [out / n for n in ("results.json", "run.json", "results.md")]
     return files

@@ -37,12 +37,20 @@ from benchmarks.core.suite import (
 )
 from benchmarks.families.rigid import defaults
 from benchmarks.reports.citations import citation_line
+from benchmarks.reports.measurement import run_durations, smoke_reason
 from benchmarks.reports.sections import failed_cases, run_lines, settings_section
-from benchmarks.reports.tables import metric_table, to_markdown, write_tables
+from benchmarks.reports.tables import (
+    SUMMARY_COLUMNS,
+    drop_empty_columns,
+    metric_table,
+    select_columns,
+    to_markdown,
+    write_tables,
+)
 from models import PAPER_P_INERTIA
 from toolkit_common.errors import ConfigError
 
-__all__ = ["EXPERIMENTS", "PaperCase", "PaperOutcome", "paper_cases", "run_paper"]
+__all__ = ["EXPERIMENTS", "PaperCase", "PaperOutcome", "experiment_text", "paper_cases", "run_paper"]
 
 #: Experiment name -> what it shows.
 EXPERIMENTS: dict[str, str] = {
@@ -51,7 +59,7 @@ EXPERIMENTS: dict[str, str] = {
     "+-u_max, versus the constraint inside the controller (RMPC ||u||_2 <= u_max; GIPC |u| <= u_max, "
     "|du| <= du_max). Paper P's metric: sum_k |e(k)| per axis.",
     "E3": "E2 on the nonlinear satellite; the figure overlays the linear responses of E2 (dashed).",
-    "E4": "Input disturbance: a step torque from t = 10 s on the nonlinear satellite: RMPC, GIPC, CRMPC.",
+    "E4": "Input disturbance: a step torque on the nonlinear satellite: RMPC, GIPC, CRMPC.",
     "E5": "Inertia uncertainty raised to +-70 % (true inertia at the heavy corner) with the E4 disturbance.",
     "E6": "Initial attitude raised by 30 %: linear vs nonlinear satellite, RMPC and GIPC.",
 }
@@ -61,6 +69,37 @@ EXPERIMENTS: dict[str, str] = {
 PaperCase = SuiteCase
 #: What :func:`run_paper` did: records, failures, files, wall time, interruption.
 PaperOutcome = SuiteOutcome
+
+
+def _values(records: Sequence[dict], key: str) -> list[Any]:
+    """The distinct values of ``settings[key]`` in ``records``, in order of appearance."""
+    out: list[Any] = []
+    for rec in records:
+        value = rec.get("settings", {}).get(key)
+        if value is not None and value not in out:
+            out.append(value)
+    return out
+
+
+def _seconds(values: Sequence[Any]) -> str:
+    return " / ".join(f"{float(v):g}" for v in values) + " s"
+
+
+def experiment_text(exp: str, records: Sequence[dict]) -> str:
+    """What ``exp`` shows (:data:`EXPERIMENTS`), then the run length and, for a disturbed experiment,
+    the step's size, axes and start, all read from ``records`` (the experiment's records)."""
+    text = EXPERIMENTS[exp]
+    durations = _values(records, "duration")
+    if durations:
+        text += f" Runs of {_seconds(durations)}."
+    disturbed = [r for r in records if r.get("settings", {}).get("disturbance")]
+    if disturbed:
+        sizes = " / ".join(f"{float(v):g}" for v in _values(disturbed, "disturbance"))
+        axes = " / ".join(", ".join(a) for a in _values(disturbed, "disturbance_axes"))
+        start = _values(disturbed, "disturbance_start")
+        text += f" The step: {sizes} N m" + (f" on {axes}" if axes else "")
+        text += (f" from t = {_seconds(start)}" if start else "") + "."
+    return text
 
 
 def paper_cases(duration_scale: float = 1.0, experiments: Sequence[str] | None = None) -> list[PaperCase]:
@@ -176,16 +215,16 @@ def _write(
         groups.setdefault(case.experiment, []).append((rec, trace))
     figures: dict[str, list[Path]] = {}
     for exp, items in groups.items():
-        path = plot_responses(
-            items, out / "figures" / f"{exp}.png", f"{exp}: {EXPERIMENTS[exp]}"[:110], defaults.U_MAX
-        )
+        recs = [rec for rec, _ in items]
+        title = f"{exp}: {experiment_text(exp, recs)}"
+        path = plot_responses(items, out / "figures" / f"{exp}.png", title, _u_max(recs))
         figures.setdefault(exp, []).append(path)
     if "E2" in groups and "E3" in groups:
         path = plot_responses(
             groups["E2"] + groups["E3"],
             out / "figures" / "E3_linear_vs_nonlinear.png",
             "E2 (linear, dashed) vs E3 (nonlinear, solid)",
-            defaults.U_MAX,
+            _u_max([rec for rec, _ in groups["E2"]]),
         )
         figures.setdefault("E3", []).append(path)
     gamma = plot_gamma(groups, out / "figures" / "gamma.png")
@@ -198,10 +237,47 @@ def _write(
     run_info = write_run_info(
         out, "rmpc bench paper", outcome, len(cases), workers, scheduler, ("duration_scale", duration_scale)
     )
-    md = _markdown(records, outcome, figures, gamma, run_info, out)
+    md = _markdown(records, outcome, figures, gamma, run_info, out, duration_scale)
     (out / "results.md").write_text(md, encoding="utf-8")
     files += [out / n for n in ("results.json", "run.json", "results.md")]
     return files
+
+
+def _u_max(records: Sequence[dict]) -> float:
+    """The torque limit the records ran with (the defaults' when they do not say)."""
+    values = _values(records, "u_max")
+    return float(values[0]) if values else defaults.U_MAX
+
+
+def _tables(recs: Sequence[dict]) -> list[str]:
+    """A compact summary table, then the full table without its empty columns (and why they are)."""
+    header, rows = metric_table(recs, lead=("controller", "plant", "saturation"))
+    lead = ["controller", "plant", "saturation"]
+    short_h, short_rows = select_columns(header, rows, [*lead, *SUMMARY_COLUMNS])
+    full_h, full_rows, dropped = drop_empty_columns(header, rows)
+    lines = [to_markdown(short_h, short_rows), "", "All metrics:", "", to_markdown(full_h, full_rows), ""]
+    if dropped:
+        why = {"max settling (s)": "no run settled within its run length"}
+        listed = "; ".join(f"{d} ({why.get(d, 'not measured in any run')})" for d in dropped)
+        lines += [f"Columns left out, empty in every run: {listed}.", ""]
+    return lines
+
+
+def _settings_rows(records: Sequence[dict]) -> list[tuple[str, str, str]]:
+    """The defaults' settings rows, with the run length and the disturbance start of this run's
+    records in place of the full runs' values."""
+    rows = []
+    durations = _values(records, "duration")
+    disturbed = [r for r in records if r.get("settings", {}).get("disturbance")]
+    starts = _values(disturbed, "disturbance_start")
+    sizes = _values(disturbed, "disturbance")
+    for name, value, source in defaults.settings_rows():
+        if name == "duration per run (s)" and durations:
+            value = " / ".join(f"{float(d):g}" for d in durations)
+        elif name == "disturbance (E4, E5)" and starts and sizes:
+            value = " / ".join(f"{float(m):g}" for m in sizes) + f" N m step from t = {_seconds(starts)}"
+        rows.append((name, value, source))
+    return rows
 
 
 def inconsistencies(inertia: np.ndarray) -> list[str]:
@@ -236,13 +312,23 @@ def _markdown(
     gamma: Path | None,
     info: dict[str, Any],
     out: Path,
+    duration_scale: float = 1.0,
 ) -> str:
-    from benchmarks.families.rigid.defaults import rationale, settings_rows
+    from benchmarks.families.rigid.defaults import rationale
+    from benchmarks.reports.measurement import withhold
     from benchmarks.suites.paper_claims import assess_claims, claims_markdown
 
+    reason = smoke_reason(
+        duration_scale, run_durations(records), "settling, rejection of the disturbance or steady behaviour"
+    )
     lines = ["# Benchmark suite `paper`: experiments E1-E6 of paper P", "", citation_line("P"), ""]
     lines += [
-        *run_lines(info, f"duration scale {info['duration_scale']:g}", versions_in_run_json=True),
+        *run_lines(
+            info,
+            f"duration scale {info['duration_scale']:g}"
+            + (" (a smoke run: run lengths shortened, no measurement)" if reason else ""),
+            versions_in_run_json=True,
+        ),
         "",
         "Errors are the attitude angles (rad); `sum|e|` is paper P's `sum_k |e(k)|` over all samples; "
         "settling and overshoot are the worst axis (`-`: not settled within the run); `per-solve` times are "
@@ -255,12 +341,12 @@ def _markdown(
         recs = [r for r in records if r["experiment"] == exp]
         if not recs and exp not in figures:
             continue
-        lines += [f"## {exp}", "", text, ""]
-        header, rows = metric_table(recs, lead=("controller", "plant", "saturation"))
-        lines += [to_markdown(header, rows), ""]
+        lines += [f"## {exp}", "", experiment_text(exp, recs) if recs else text, ""]
+        if recs:
+            lines += _tables(recs)
         for path in figures.get(exp, []):
             lines += [f"![{path.stem}]({path.relative_to(out).as_posix()})", ""]
-    lines += claims_markdown(assess_claims(records))
+    lines += claims_markdown(withhold(assess_claims(records), reason))
     if gamma is not None:
         lines += [
             "## gamma(k)",
@@ -276,5 +362,5 @@ def _markdown(
         "Every value paper P leaves out is the toolkit's choice "
         "(`benchmarks/families/rigid/defaults.py`; each is a scenario field or controller setting)."
     )
-    lines += settings_section(intro, settings_rows(), rationale())
+    lines += settings_section(intro, _settings_rows(records), None if reason else rationale())
     return "\n".join(lines)

@@ -304,8 +304,8 @@ def claims_markdown(claims: Sequence[Claim]) -> list[str]:
         "",
         "Each comparative claim of paper P, tested on this run's records "
         "(`benchmarks/suites/paper_claims.py` holds the thresholds). The sweep "
-        "`rmpc bench sweep --config paper_claims` repeats E4/E5 over the true inertia from 0.3 to "
-        "1.7 x paper P's and over the disturbance axes.",
+        "`rmpc bench sweep --config paper_claims` repeats E4/E5 over the true inertia and over the "
+        "disturbance axes.",
         "",
     ]
     lines += claim_lines(claims)
