@@ -27,6 +27,7 @@ _NUMBER = re.compile(r"(?<![\w.^])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.]*\w\()
 #: A time: a number followed by " s" (seconds) as a unit.
 SECONDS = re.compile(r"(?<![\w.^])(\d+(?:\.\d+)?)(?:-(\d+(?:\.\d+)?))? s\b")
 
+_CITATION = re.compile(r"^Paper [A-Z]: ")
 _CLAIM = re.compile(r"^(- \*\*[^*]+\*\*) .*? (Measured: .*)$")
 
 
@@ -38,6 +39,8 @@ def prose(markdown: str) -> str:
         if line.startswith("## "):
             skipping = line.startswith(("## Settings", "## Inconsistencies"))
         if skipping or line.startswith(("|", "![", "Machine: ")):  # the machine's platform string
+            continue
+        if _CITATION.match(line):  # the papers' bibliographic data (volume, year), not the run's
             continue
         if line.startswith("Inconsistencies of paper"):  # mrp: paper M's notes, quoted
             skipping = True

@@ -15,14 +15,11 @@ them). Two kinds of record are kept apart from the comparisons:
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from benchmarks.core.suite import SuiteOutcome, write_records, write_rows_csv, write_run_info
-
-if TYPE_CHECKING:  # the runner imports this module; the settings are only a type here
-    from benchmarks.suites.methods import MethodsSettings
 
 __all__ = [
     "GAMMA_COMPARABLE",
@@ -251,12 +248,16 @@ def write_methods_report(
     out: Path,
     outcome: SuiteOutcome,
     extras: dict[tuple[str, str], dict[str, Any]],
-    settings: MethodsSettings,
+    settings: Any,
     n_cases: int,
     resumed: int,
     short: bool,
 ) -> list[Path]:
-    """Write ``results.json``, ``results.csv``, ``run.json``, ``results.md`` and the figures."""
+    """Write ``results.json``, ``results.csv``, ``run.json``, ``results.md`` and the figures.
+
+    ``settings`` is the run's :class:`benchmarks.suites.methods.MethodsSettings` (not named in
+    the signature: the runner imports this module).
+    """
     from benchmarks.reports.methods_figures import plot_regions, plot_summary
     from benchmarks.reports.sections import failed_cases, run_lines, settings_section
     from benchmarks.reports.tables import to_markdown
