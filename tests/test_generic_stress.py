@@ -133,6 +133,8 @@ def _ipm_alone(prob):
     return KothareProblem(**prob.kothare_kwargs(), backend="ipm", solver_options=options).solve(prob.x)
 
 
+#: The words of an IPM run that did not conclude (before its retry or phase one concluded).
+IPM_WORDS = ("inaccurate", "numerical_error", "insufficient_progress", "max_iterations")
 #: Each with the status the IPM must give (its Clarabel fallback off), and what it gave before its
 #: QR-phase Newton solve, dual update, stall test and rebalanced retry were changed.
 FAST = [
@@ -155,8 +157,14 @@ def test_ipm_alone_is_optimal_or_certified_infeasible(spec, expected):
     assert prob.kind in (expected if expected == "infeasible" else "feasible", "unknown")
     sol = _ipm_alone(prob)
     assert sol.status == expected, sol.solver_status
-    # from the main run itself: no rebalanced retry, no phase one
-    assert sol.solver_status == ("optimal" if expected == "optimal" else "ipm infeasible")
+    # the toolkit's IPM answered: its main run, or its own rebalanced retry or phase one. Which
+    # of them depends on the CPU's rounding (n12-v2-generic-ellipsoid-s1: the main run with
+    # OpenBLAS's SkylakeX kernels, "inaccurate; rebalanced optimal" with its Katmai kernels), so
+    # the path is not the promise; the answer and its certificate below are.
+    if expected == "optimal":
+        assert sol.solver_status in ("optimal", *(f"{w}; rebalanced optimal" for w in IPM_WORDS))
+    else:
+        assert sol.solver_status in ("ipm infeasible", *(f"ipm {w}; phase one infeasible" for w in IPM_WORDS))
     if expected == "optimal":
         # the LMIs recomputed from the answer (worst margins measured -5.8e-16..+1.1e-15; the
         # solver's own certificate asks >= -1e-7)

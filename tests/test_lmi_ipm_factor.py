@@ -74,13 +74,23 @@ def test_a_singular_complement_goes_to_qr(row: int) -> None:
 
 def test_the_pivot_test_measures_relative_pivots() -> None:
     """Two nearly parallel rows of ``P'``: the second pivot relative to ``sqrt(H_22)`` is the
-    sine of their angle, so the test passes above the switch and fails below it."""
+    sine of their angle, so the test passes a decade above the switch (1e-6) and fails a decade
+    below it. Both sines keep the pivot far above rounding (its square, ``sine^2 H_22``, is
+    1e-14 of ``H_22`` or more, against errors of a few ``eps`` in forming ``H``), so Cholesky
+    succeeds on any CPU. Further below (1e-9: the squared pivot under ``eps``) rounding decides
+    whether Cholesky stops (``info > 0``, as with OpenBLAS's Katmai kernels) or leaves a pivot
+    the test refuses (SkylakeX): either way the solve goes to QR."""
     p = P_GOOD[:2].copy()
-    for sine, ok in ((1e-3, True), (1e-9, False)):
-        p[1] = p[0] + sine * np.linalg.norm(p[0]) * P_GOOD[2] / np.linalg.norm(P_GOOD[2])
+    direction = P_GOOD[2] / np.linalg.norm(P_GOOD[2])
+    for sine, ok in ((10 * QR_SWITCH, True), (0.1 * QR_SWITCH, False)):
+        p[1] = p[0] + sine * np.linalg.norm(p[0]) * direction
         h = p @ p.T
         info, r_fac = _cholesky(h)
         assert info == 0 and bool(_factor_ok(h, r_fac, QR_SWITCH)) is ok
+    p[1] = p[0] + 1e-9 * np.linalg.norm(p[0]) * direction
+    h = p @ p.T
+    info, r_fac = _cholesky(h)
+    assert info != 0 or not _factor_ok(h, r_fac, QR_SWITCH)
     h = P_GOOD @ P_GOOD.T
     _, r_fac = _cholesky(h)
     r_fac[1, 3] = np.nan  # a non-finite factor is never accepted
