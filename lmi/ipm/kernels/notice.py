@@ -1,7 +1,7 @@
 """The lines printed while the kernels compile on first use (:func:`compile_notice`).
 
-The first solver built after an install compiles the kernels (30-70 s at a light load; over
-two minutes with the machine's two cores shared by ten jobs) and numba prints nothing meanwhile;
+The first solver built after an install compiles the kernels (30-50 s at a light load; over
+two minutes at a load average of 11-15 on two cores) and numba prints nothing meanwhile;
 later processes load them from numba's on-disk cache in well under a second. Whether the cache
 is cold is read, before anything compiles, from the cache index of each kernel that the first
 solve calls (:data:`FIRST_SOLVE_KERNELS`): numba keeps one index per kernel, next to its file or
