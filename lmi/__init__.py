@@ -7,11 +7,26 @@ interior-point method for ``min c'x`` subject to ``C_j - sum_i x_i A_ij >= 0`` (
 :class:`IPMResult`).
 """
 
-from lmi.certificate import Certificate, certify
-from lmi.data import KothareData, build_kothare_data
-from lmi.ipm import BlockLMISolver, IPMResult
-from lmi.kothare import KothareProblem, LMISolution
-from lmi.status import FAILURE_STATUSES, OPTIMAL, STATUSES
+from typing import TYPE_CHECKING
+
+from toolkit_common.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from lmi.certificate import Certificate, certify
+    from lmi.data import KothareData, build_kothare_data
+    from lmi.ipm import BlockLMISolver, IPMResult
+    from lmi.kothare import KothareProblem, LMISolution
+    from lmi.status import FAILURE_STATUSES, OPTIMAL, STATUSES
+
+
+# the module defining each public name, imported when the name is first looked up
+_EXPORTS = {
+    "lmi.certificate": ("Certificate", "certify"),
+    "lmi.data": ("KothareData", "build_kothare_data"),
+    "lmi.ipm": ("BlockLMISolver", "IPMResult"),
+    "lmi.kothare": ("KothareProblem", "LMISolution"),
+    "lmi.status": ("FAILURE_STATUSES", "OPTIMAL", "STATUSES"),
+}
 
 __all__ = [
     "FAILURE_STATUSES",
@@ -26,3 +41,4 @@ __all__ = [
     "build_kothare_data",
     "certify",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -50,6 +50,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.timing.config",
     "lmi.data",
     "lmi.forms.problem",
+    "lmi.ipm.kernels.notice",
     "lmi.ipm.solver",
     "lmi.kothare",
     "lmi.offline",

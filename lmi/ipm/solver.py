@@ -643,7 +643,8 @@ def _load_kernels() -> None:
     if _KERNELS_LOADED.is_set():
         return
     _KERNELS_LOADED.set()
-    BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
+    with _kernels.compile_notice():  # a line on stderr when they compile (lmi.ipm.kernels.notice)
+        BlockLMISolver([1.0], [(-np.eye(2), -np.eye(2)[None])]).solve()
 
 
 def _constant_blocks(consts: list[np.ndarray]) -> IPMResult:

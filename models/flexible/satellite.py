@@ -29,7 +29,8 @@ public face.)
 
 from __future__ import annotations
 
-import control
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -60,6 +61,9 @@ from models.linear import PolytopicModel, sample_time, zoh
 from models.protocols import map_states
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_positive_values, as_vector, check_bool, renamed_arguments
+
+if TYPE_CHECKING:  # python-control (with matplotlib, ~2 s) is imported where it is used
+    import control
 
 __all__ = ["FlexibleSatellite"]
 

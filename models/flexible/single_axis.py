@@ -18,13 +18,17 @@ appendage frequency (:func:`regime`).
 
 from __future__ import annotations
 
-import control
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from models.flexible.parameters import HybridParameters
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
+
+if TYPE_CHECKING:  # python-control (with matplotlib, ~2 s) is imported where it is used
+    import control
 
 __all__ = [
     "REGIME_LABELS",
@@ -114,6 +118,8 @@ def flexible_factor(
     for wc, zc, wu, zu in zip(w_c, z_c, w_u, z_u, strict=True):
         num = np.polymul(num, [1.0 / wc**2, 2.0 * zc / wc, 1.0])
         den = np.polymul(den, [1.0 / wu**2, 2.0 * zu / wu, 1.0])
+    import control
+
     return control.tf(num, den)
 
 
@@ -152,6 +158,8 @@ def single_axis_tf(
         float(p.inertia[axis, axis]), p.coupling[:, axis], masses, p.stiffness, p.viscous_damping,
         cancel_uncoupled=cancel_uncoupled,
     )
+    import control
+
     return control.tf(num, den)
 
 

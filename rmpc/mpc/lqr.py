@@ -5,7 +5,6 @@ from __future__ import annotations
 import time
 from typing import ClassVar
 
-import control
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -80,6 +79,8 @@ class LQR:
                 "vertex", f"None or an integer in [0, {plant.n_vertices - 1}]", repr(vertex)
             )
         a, b = plant.nominal if vertex is None else plant.vertex(vertex)
+        import control  # with matplotlib, ~2 s: imported on first use
+
         try:
             k, s, _ = control.dlqr(a, b, self.Q, self.R)
         except (ValueError, np.linalg.LinAlgError) as err:

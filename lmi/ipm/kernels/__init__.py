@@ -31,26 +31,51 @@ forms (:mod:`lmi.ipm.kernels.schur`), the factorisations by BLAS/LAPACK
 (:mod:`lmi.ipm.kernels.step`) and the whole iteration (:mod:`lmi.ipm.kernels.iteration`); this
 package re-exports the public ones. Compiled on first use and
 cached next to their files (``cache=True``): the first process after an install pays the
-compilation (about 30 s here at load 2), later ones load it (well under 1 s).
+compilation (about 30 s here at load 2), later ones load it (well under 1 s); a line on
+stderr says so while they compile (:mod:`lmi.ipm.kernels.notice`). The names above are imported
+on first use (:mod:`toolkit_common.lazy`), numba with them: importing :mod:`lmi.ipm` does not
+import numba, building the first :class:`lmi.ipm.BlockLMISolver` does.
 """
 
-from lmi.ipm.kernels.iteration import (
-    STEP_LOST_DEFINITENESS,
-    STEP_OK,
-    STEP_SINGULAR,
-    grouped_iteration,
-    rows_iteration,
-)
-from lmi.ipm.kernels.packed import blocks_within, cholesky_blocks, pack, residuals, unpack
-from lmi.ipm.kernels.schur import (
-    scaling_and_schur_direct,
-    scaling_and_schur_grouped,
-    scaling_and_schur_rows,
-)
-from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
+from typing import TYPE_CHECKING
+
+from toolkit_common.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from lmi.ipm.kernels.iteration import (
+        STEP_LOST_DEFINITENESS,
+        STEP_OK,
+        STEP_SINGULAR,
+        grouped_iteration,
+        rows_iteration,
+    )
+    from lmi.ipm.kernels.notice import compile_notice
+    from lmi.ipm.kernels.packed import blocks_within, cholesky_blocks, pack, residuals, unpack
+    from lmi.ipm.kernels.schur import (
+        scaling_and_schur_direct,
+        scaling_and_schur_grouped,
+        scaling_and_schur_rows,
+    )
+    from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
+
+
+# the module defining each public name, imported when the name is first looked up
+_EXPORTS = {
+    "lmi.ipm.kernels.iteration": (
+        "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "grouped_iteration", "rows_iteration",
+    ),
+    "lmi.ipm.kernels.packed": ("blocks_within", "cholesky_blocks", "pack", "residuals", "unpack"),
+    "lmi.ipm.kernels.schur": (
+        "scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows",
+    ),
+    "lmi.ipm.kernels.notice": ("compile_notice",),
+    "lmi.ipm.kernels.step": ("REFINE_STEPS", "newton_step", "smallest_eigenvalue"),
+}
 
 __all__ = [
     "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blocks_within", "cholesky_blocks",
-    "grouped_iteration", "newton_step", "pack", "residuals", "rows_iteration", "scaling_and_schur_direct",
-    "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
+    "compile_notice", "grouped_iteration", "newton_step", "pack", "residuals", "rows_iteration",
+    "scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue",
+    "unpack",
 ]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
