@@ -15,6 +15,7 @@ from lmi import KothareProblem, LMISolution
 from lmi.forms import FormProblem, form_options
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.mpc.diagnosis import FailureDiagnosis, diagnose
 from rmpc.mpc.fallback import CertifiedGain
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
@@ -81,7 +82,11 @@ class RMPC:
     on_failure : {"fallback", "raise"}
         What to do when a solve gives no usable (certified) answer: keep the last certified
         gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`
-        (:class:`~rmpc.mpc.fallback.CertifiedGain`).
+        (:class:`~rmpc.mpc.fallback.CertifiedGain`). Before any certified gain the fallback is
+        ``u = 0``, which no certificate stands behind: the first such step warns
+        (:class:`~rmpc.errors.NoCertifiedGainWarning`) with the status and the
+        :meth:`diagnose` of the state (which bound blocks, what to try); a raised failure
+        carries the same diagnosis.
     hold_radius : float
         Below this norm of ``x - x_ref`` the problem degenerates (``gamma -> 0``); the last
         certified gain is kept without re-solving (its invariant ellipsoid contains the state).
@@ -227,6 +232,20 @@ class RMPC:
         x = as_vector(x, "x", self.plant.n_states)
         return self.problem.solve(x - self.x_ref, u_max=u_max)
 
+    def diagnose(self, x: ArrayLike, status: str | None = None) -> FailureDiagnosis:
+        """Why there is no certified gain at ``x``, and what to try (:mod:`rmpc.mpc.diagnosis`).
+
+        ``status`` is the failed solve's (solved here when not given). A few more solves at
+        ``x``: without bounds, with Kothare's plain problem (for another form), with softened
+        bounds.
+        """
+        x = as_vector(x, "x", self.plant.n_states)
+        z = x - self.x_ref
+        if status is None:
+            status = self.problem.solve(z).status
+        return diagnose(self.problem.data, z, status, has_addition=not self.form.is_kothare,
+                        backend="clarabel" if self.problem.backend == "clarabel" else "ipm")
+
     def in_ellipsoid(self, x: ArrayLike) -> bool:
         """Whether ``x - x_ref`` lies in the invariant ellipsoid of the current gain."""
         if self.certified.solution is None:
@@ -270,6 +289,7 @@ class RMPC:
         u, self.last = kept.take(
             sol, z, shape, x=x, bound=self.problem.data.u_max if bound is None else bound,
             failure_extra={"inside_ellipsoid": kept.contains(z)},
+            diagnose=lambda: self.diagnose(x, sol.status),
         )
         if sol.u0 is not None and not self.last.fallback:
             u = sol.u0.copy()  # the free first move
