@@ -17,6 +17,7 @@ from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
 from rmpc.mpc.diagnosis import FailureDiagnosis, diagnose
 from rmpc.mpc.fallback import CertifiedGain
+from rmpc.mpc.methods import method_options
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
@@ -155,7 +156,11 @@ class RMPC:
         disturbance: Any = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
-            raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
+            hint = ""
+            if type(plant).__name__ in ("StateSpace", "TransferFunction"):
+                hint = (" (a python-control system: build the polytope with models.PolytopicModel."
+                        "from_statespace([sys_1, ..., sys_k]) from discrete-time vertices)")
+            raise ArgumentTypeError("plant", "a models.PolytopicModel" + hint, type(plant).__name__)
         input_constraint = input_constraint_kind(input_constraint, u_max)
         self.plant = plant
         self.form = form_options(
@@ -196,6 +201,29 @@ class RMPC:
             )
         self.dt = plant.dt
         self.last: StepInfo | None = None
+
+    @classmethod
+    def from_method(cls, key: str, plant: PolytopicModel, **options: Any) -> RMPC:
+        """The robust MPC of the literature's method ``key`` (MUP's method keys).
+
+        ``key`` is one of :data:`rmpc.mpc.methods.METHODS` (``"kothare"``, ``"cuzzola"``,
+        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``), which sets the form's
+        options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other arguments of
+        :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per component
+        (``input_constraint="peak"``) unless ``input_constraint`` is given.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import PolytopicModel
+        >>> from rmpc import RMPC
+        >>> plant = PolytopicModel([(np.array([[1.1]]), np.array([[1.0]])),
+        ...                         (np.array([[1.1]]), np.array([[0.5]]))], dt=1.0)
+        >>> ctrl = RMPC.from_method("cuzzola", plant, Q=np.eye(1), R=np.eye(1), u_max=1.0)
+        >>> ctrl.form.lyapunov, ctrl.input_constraint
+        ('vertex', 'peak')
+        """
+        return cls(plant, **method_options(key, options))
 
     @property
     def input_constraint(self) -> str | None:
