@@ -18,6 +18,7 @@ from rmpc.controller import StepInfo, StepInputs, check_step_inputs
 from rmpc.mpc.diagnosis import FailureDiagnosis, diagnose
 from rmpc.mpc.fallback import CertifiedGain
 from rmpc.mpc.methods import method_options
+from rmpc.mpc.setpoint import SteadyTarget, steady_target
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
@@ -80,6 +81,12 @@ class RMPC:
         it (``lam``, the S-procedure's contraction factor, searched when not given).
         The LMIs of every form and the combinations that exist: the page "The field's robust MPC
         forms" of the docs (:mod:`lmi.forms`). The defaults give Kothare's problem.
+    offset_free : bool
+        Offset-free action on a constant input disturbance: every :meth:`step` takes the
+        disturbance estimate ``StepInputs(d_hat=...)`` (from an estimator with
+        ``disturbance_model="input"``; :func:`rmpc.simulate` passes it) and applies
+        ``u = u_s - d_hat + F (x - x_s)``, so an unmeasured constant load leaves no offset
+        once the estimate has converged (see :meth:`set_reference`).
     on_failure : {"fallback", "raise"}
         What to do when a solve gives no usable (certified) answer: keep the last certified
         gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`
@@ -154,6 +161,7 @@ class RMPC:
         saturation: Literal["auxiliary"] | None = None,
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
+        offset_free: bool = False,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             hint = ""
@@ -199,8 +207,30 @@ class RMPC:
                 "x_ref", "an equilibrium of every vertex with zero input (A_j x_ref = x_ref)",
                 f"max |A_j x_ref - x_ref| = {drift:.3g}",
             )
+        self.u_ref = np.zeros(plant.n_inputs)
+        self.target: SteadyTarget | None = None
+        if not isinstance(offset_free, bool | np.bool_):
+            raise ArgumentTypeError("offset_free", "a bool", type(offset_free).__name__)
+        self.offset_free = bool(offset_free)
+        if self.offset_free:
+            self.accepts = frozenset({"u_max", "d_hat"})
         self.dt = plant.dt
         self.last: StepInfo | None = None
+
+    def set_reference(self, reference: ArrayLike, outputs: ArrayLike) -> SteadyTarget:
+        """Hold the outputs ``C_r x`` (``outputs``) at ``reference`` from the next step on.
+
+        The target ``(x_s, u_s)`` is a steady state of every vertex with ``C_r x_s = r``
+        (:func:`rmpc.mpc.setpoint.steady_target`; refused with the reason when there is none);
+        the controller then regulates ``x - x_s`` with ``u = u_s + F (x - x_s)``, the input bound
+        tightened by ``u_s`` (``|v_i| <= u_max_i - |u_s,i|``, or ``||v|| <= u_max - ||u_s||``) so
+        the total input keeps it. With ``offset_free=True`` the step's disturbance estimate
+        ``d_hat`` moves the target input to ``u_s - d_hat``.
+        """
+        target = steady_target(self.plant.A, self.plant.B, reference, outputs)
+        self.target = target
+        self.x_ref, self.u_ref = target.x.copy(), target.u.copy()
+        return target
 
     @classmethod
     def from_method(cls, key: str, plant: PolytopicModel, **options: Any) -> RMPC:
@@ -295,14 +325,18 @@ class RMPC:
             disturbance correction leaves of the torque limit. Other fields are errors.
         """
         x = as_vector(x, "x", self.plant.n_states)
-        u_max = check_step_inputs(inputs, self.accepts, "RMPC").u_max
+        given = check_step_inputs(inputs, self.accepts, "RMPC")
+        u_max = given.u_max
         bound = None if u_max is None else self.problem.input_bound(u_max)
+        u_s = self._target_input(given.d_hat)
+        if np.any(u_s != 0.0):
+            bound = self._tightened(self.problem.data.u_max if bound is None else bound, u_s)
         z = x - self.x_ref
         shape = (self.plant.n_inputs, self.plant.n_states)
         kept = self.certified
         if kept.near_origin(z):
             u, self.last = kept.reuse(z, shape, "near origin")
-            return self._saturate(u, bound)
+            return u_s + self._saturate(u, bound)
         tighter = (
             bound is not None and kept.bound is not None
             and bool(np.any(bound < kept.bound * (1.0 - 1e-12)))
@@ -312,7 +346,7 @@ class RMPC:
             level = float(z @ q_inv @ z)
             if self.resolve_threshold < level <= 1.0:
                 u, self.last = kept.reuse(z, shape, "inside ellipsoid", level=level)
-                return self._saturate(u, bound)
+                return u_s + self._saturate(u, bound)
         sol = self.problem.solve(z, u_max=bound)
         u, self.last = kept.take(
             sol, z, shape, x=x, bound=self.problem.data.u_max if bound is None else bound,
@@ -321,7 +355,30 @@ class RMPC:
         )
         if sol.u0 is not None and not self.last.fallback:
             u = sol.u0.copy()  # the free first move
-        return self._saturate(u, bound)
+        return u_s + self._saturate(u, bound)
+
+    def _target_input(self, d_hat: Any) -> np.ndarray:
+        """``u_s`` of the target, less the disturbance estimate with ``offset_free=True``."""
+        if not self.offset_free:
+            return self.u_ref
+        if d_hat is None:
+            raise InvalidArgumentError(
+                "inputs.d_hat", "the input-disturbance estimate (offset_free=True: give the step "
+                "StepInputs(d_hat=est.d_hat), as simulate does with an estimator that has a "
+                "disturbance model)", "None",
+            )
+        return self.u_ref - as_vector(d_hat, "inputs.d_hat", self.plant.n_inputs)
+
+    def _tightened(self, bound: np.ndarray | None, u_s: np.ndarray) -> np.ndarray | None:
+        """The bound left to ``u - u_s`` so that ``u`` keeps ``bound`` (``None``: no bound)."""
+        kind = self.problem.data.input_constraint
+        if kind is None or bound is None:
+            return bound
+        if kind == "peak":
+            left = bound - np.abs(u_s)
+        else:
+            left = bound - float(np.linalg.norm(u_s))
+        return np.maximum(left, 1e-12 * np.maximum(bound, 1.0))  # none left: the solve says infeasible
 
     def _saturate(self, u: np.ndarray, bound: np.ndarray | None) -> np.ndarray:
         """The componentwise saturation of the auxiliary-gain form (other forms: ``u`` as it is)."""

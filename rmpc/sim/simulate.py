@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from models import PolytopicModel, ReactionWheelActuator, TorqueLimiter
 from models.protocols import Plant
-from rmpc.controller import Controller
+from rmpc.controller import Controller, StepInputs
 from rmpc.sim.disturbances import as_disturbance, disturbance_at
 from rmpc.sim.plants import SampledPlant, as_sampled_plant
 from rmpc.sim.trajectory import Trajectory
@@ -203,7 +203,11 @@ def simulate(
             measured = (x if sensor is None
                         else _finite_output(sensor(t, x), "sensor", "sensor(t, x)", t, None))
         start = time.perf_counter()
-        u = np.asarray(controller.step(measured), dtype=float).reshape(-1)
+        step_inputs = read.step_inputs(controller) if read is not None else None
+        u = np.asarray(
+            controller.step(measured) if step_inputs is None else controller.step(measured, step_inputs),
+            dtype=float,
+        ).reshape(-1)
         step_time[k] = time.perf_counter() - start
         if u.shape != (m,) or not np.all(np.isfinite(u)):
             raise InvalidArgumentError(
@@ -287,6 +291,12 @@ class _MeasurementChain:
         if d_hat is not None and np.size(d_hat):
             self.d_hat.append(np.asarray(d_hat, dtype=float).copy())
         return x_hat
+
+    def step_inputs(self, controller: Any) -> StepInputs | None:
+        """``StepInputs(d_hat=...)`` for a controller that takes the disturbance estimate."""
+        if self.d_hat and "d_hat" in getattr(controller, "accepts", ()):
+            return StepInputs(d_hat=self.d_hat[-1])
+        return None
 
     def log(self) -> dict[str, np.ndarray]:
         out = {}
