@@ -385,7 +385,9 @@ class PolytopicModel:
         ----------
         systems : StateSpace or sequence of StateSpace
             Discrete-time systems with a common, positive ``dt`` and equal sizes. Only ``A``
-            and ``B`` are used (the polytope is in the state equation).
+            and ``B`` are used (the polytope is in the state equation); the state and input
+            names are the first system's signal labels (python-control's ``x[0]``, ``u[0]``,
+            ... unless the system was built with its own ``states=`` / ``inputs=``).
         nominal : StateSpace, optional
             The nominal system; defaults to the mean of the vertices.
         attitude : {"euler321", "quaternion_vector"} or None
@@ -411,7 +413,12 @@ class PolytopicModel:
         if max(dts) - min(dts) > 1e-12 * max(dts):
             raise InvalidArgumentError("systems", "a common dt", f"dt values {dts}")
         nom = None if nominal is None else (nominal.A, nominal.B)
-        return cls([(s.A, s.B) for s in systems], dt=dts[0], nominal=nom, attitude=attitude)
+        first = systems[0]
+        return cls(
+            [(s.A, s.B) for s in systems], dt=dts[0], nominal=nom, attitude=attitude,
+            state_names=list(getattr(first, "state_labels", None) or []) or None,
+            input_names=list(getattr(first, "input_labels", None) or []) or None,
+        )
 
     def __repr__(self) -> str:
         return (

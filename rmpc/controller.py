@@ -73,10 +73,14 @@ class StepInputs:
     u_max : float, array_like or None
         The input bound for this step instead of the controller's own (same kind), e.g. what
         CRMPC's disturbance correction leaves of the torque limit.
+    d_hat : (m,) array_like or None
+        The estimate of a constant input disturbance (an estimator's ``d_hat``), for a
+        controller with offset-free action (:class:`~rmpc.RMPC` with ``offset_free=True``).
     """
 
     pzt: Any = None
     u_max: Any = None
+    d_hat: Any = None
 
     def given(self) -> tuple[str, ...]:
         """The names of the fields set to a value (not ``None``)."""

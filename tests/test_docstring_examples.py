@@ -82,6 +82,7 @@ MODULES_WITH_EXAMPLES = (
     "models.wheels.stage",
     "rmpc.controller",
     "rmpc.errors",
+    "rmpc.estimators.linear",
     "rmpc.laws.flexible.adaptive_pd",
     "rmpc.laws.flexible.adaptive_smc",
     "rmpc.laws.flexible.attitude_pd",

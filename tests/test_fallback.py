@@ -17,7 +17,7 @@ from models import PolytopicModel, RigidSatellite
 from rmpc import RMPC, ScheduledRMPC
 from rmpc.mpc import fallback
 from rmpc.mpc.fallback import CertifiedGain, is_certified
-from toolkit_common.errors import InvalidArgumentError, SolverError
+from toolkit_common.errors import InvalidArgumentError, NoCertifiedGainWarning, SolverError
 from toolkit_common.status import Status
 
 PLANT = PolytopicModel([(np.array([[2.0]]), np.array([[1.0]]))], dt=1.0)
@@ -31,7 +31,8 @@ def _problem() -> KothareProblem:
 def test_a_certified_solve_replaces_the_gain_and_a_failed_one_keeps_it() -> None:
     prob = _problem()
     kept = CertifiedGain("test")
-    u0, info0 = kept.take(prob.solve(FAR), FAR, (1, 1))  # before any gain: zero
+    with pytest.warns(NoCertifiedGainWarning, match="no certified gain"):
+        u0, info0 = kept.take(prob.solve(FAR), FAR, (1, 1))  # before any gain: zero
     assert info0.fallback and info0.status == Status.INFEASIBLE and info0.extra["had_gain"] is False
     assert u0.tolist() == [0.0] and kept.gain is None and not kept.contains(NEAR)
     good = prob.solve(NEAR)

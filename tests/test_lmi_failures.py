@@ -21,7 +21,7 @@ import pytest
 from lmi import FAILURE_STATUSES, KothareProblem, certify
 from models import PolytopicModel
 from rmpc import RMPC
-from toolkit_common.errors import SolverError, ToolkitError
+from toolkit_common.errors import NoCertifiedGainWarning, SolverError, ToolkitError
 
 A = np.diag([1.5, 0.9])
 B = np.array([[1.0], [1.0]])
@@ -81,7 +81,8 @@ def test_step_keeps_the_last_certified_gain_on_failure():
 
 def test_failure_without_a_previous_gain_applies_zero():
     ctrl = _controller()
-    u = ctrl.step(FAR)
+    with pytest.warns(NoCertifiedGainWarning, match="'infeasible'.*input bound"):
+        u = ctrl.step(FAR)
     assert ctrl.last.fallback and ctrl.last.extra["had_gain"] is False
     np.testing.assert_array_equal(u, np.zeros(1))
     assert ctrl.gain is None
@@ -100,7 +101,8 @@ def test_solver_stopped_early_is_a_fallback():
     """``max_iter = 2`` (no Clarabel fallback): the IPM stops early; RMPC records it and falls back."""
     options = {"max_iter": 2, "fallback": False}
     ctrl = _controller(solver_options=options)
-    u = ctrl.step(NEAR)
+    with pytest.warns(NoCertifiedGainWarning, match="'max_iterations'.*max_iter"):
+        u = ctrl.step(NEAR)
     assert ctrl.last.status == "max_iterations" and ctrl.last.fallback
     np.testing.assert_array_equal(u, np.zeros(1))
     with pytest.raises(SolverError):

@@ -8,7 +8,7 @@ import pytest
 from lmi import KothareProblem
 from models import RigidSatellite
 from rmpc import RMPC, ScheduledRMPC, simulate
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, SolverError
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError, NoCertifiedGainWarning, SolverError
 
 Q = np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1])
 R = 0.01 * np.eye(3)
@@ -89,7 +89,8 @@ def test_failure_is_a_status_or_raises_on_request():
     sat = RigidSatellite.paper_p()
     # An input bound far too small for this state: infeasible.
     ctrl = ScheduledRMPC.for_satellite(sat, 0.01, 0.3, Q, R, u_max=1e-9)
-    u = ctrl.step(np.array([1.0, 1.0, 1.0, 0.5, 0.5, 0.5]))
+    with pytest.warns(NoCertifiedGainWarning, match="input bound u_max = 1e-09"):
+        u = ctrl.step(np.array([1.0, 1.0, 1.0, 0.5, 0.5, 0.5]))
     assert ctrl.last.fallback
     assert ctrl.last.status != "optimal"
     np.testing.assert_array_equal(u, np.zeros(3))

@@ -74,3 +74,13 @@ class SingularityError(ToolkitError, ArithmeticError):
 
 class SolverError(ToolkitError, RuntimeError):
     """A numerical solver failed and the caller asked for failures to raise."""
+
+
+class NoCertifiedGainWarning(UserWarning):
+    """A controller applies an input no certified gain stands behind (zero before the first one).
+
+    Issued once per run (until ``reset()`` or the next certified gain) with the step's status and
+    a diagnosis: what blocks a certified gain and what to try. Filter it like any warning::
+
+        warnings.filterwarnings("ignore", category=NoCertifiedGainWarning)
+    """

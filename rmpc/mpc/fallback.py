@@ -8,7 +8,11 @@ what to apply at a step, the same way for :class:`~rmpc.RMPC` and :class:`~rmpc.
   reported);
 - a solve without one keeps the last certified gain (zero before the first one) and reports the
   solver's status with ``fallback=True``, or raises :class:`~toolkit_common.errors.SolverError`
-  with ``on_failure="raise"``;
+  with ``on_failure="raise"``. Zero is no certified input: the first step that applies it warns
+  (:class:`~toolkit_common.errors.NoCertifiedGainWarning`, once until :meth:`CertifiedGain.reset`
+  or the next certified gain) with the status and a diagnosis (:mod:`rmpc.mpc.diagnosis`: which
+  bound blocks and what to try), kept in the step's ``extra["diagnosis"]``; a raised failure
+  carries the same diagnosis in its message;
 - near the origin (``||z|| <= hold_radius``, where the problem degenerates) no solve is made and
   the last gain is applied, status ``"reused"``; so is a gain kept on purpose (RMPC's
   ``resolve_threshold``).
@@ -16,13 +20,16 @@ what to apply at a step, the same way for :class:`~rmpc.RMPC` and :class:`~rmpc.
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Callable
 from typing import Any, Literal
 
 import numpy as np
 
 from lmi import LMISolution
 from rmpc.controller import StepInfo
-from toolkit_common.errors import SolverError
+from rmpc.mpc.diagnosis import FailureDiagnosis
+from toolkit_common.errors import NoCertifiedGainWarning, SolverError
 from toolkit_common.status import Status, is_usable
 from toolkit_common.validation import check_choice, check_positive
 
@@ -80,12 +87,14 @@ class CertifiedGain:
         self.solution: LMISolution | None = None
         self.bound: np.ndarray | None = None
         self._q_inv: np.ndarray | None = None
+        self._warned = False
 
     def reset(self) -> None:
-        """Forget the gain."""
+        """Forget the gain (and that the missing gain was warned about)."""
         self.solution = None
         self.bound = None
         self._q_inv = None
+        self._warned = False
 
     @property
     def gain(self) -> np.ndarray | None:
@@ -126,6 +135,7 @@ class CertifiedGain:
         self, sol: LMISolution, z: np.ndarray, shape: tuple[int, int], *, x: np.ndarray | None = None,
         bound: np.ndarray | None = None, extra: dict[str, Any] | None = None,
         failure_extra: dict[str, Any] | None = None,
+        diagnose: Callable[[], FailureDiagnosis] | None = None,
     ) -> tuple[np.ndarray, StepInfo]:
         """``u = F z`` after the solve ``sol`` and the step's :class:`~rmpc.StepInfo`.
 
@@ -144,27 +154,50 @@ class CertifiedGain:
         extra, failure_extra : dict, optional
             Added to ``extra`` after ``"solution"``: ``extra`` for a certified solve,
             ``failure_extra`` (then ``"had_gain"``) for a fallback.
+        diagnose : callable, optional
+            Called (with no argument) when ``sol`` is not certified and the failure is raised or
+            zero is applied: returns the :class:`~rmpc.mpc.diagnosis.FailureDiagnosis` that the
+            message and ``extra["diagnosis"]`` carry.
 
         Raises
         ------
         SolverError
             With ``on_failure="raise"``, when ``sol`` is not certified.
+
+        Warns
+        -----
+        NoCertifiedGainWarning
+            When zero is applied for want of any certified gain (once until :meth:`reset` or
+            the next certified gain).
         """
         if is_certified(sol):
             assert sol.F is not None and sol.Q is not None
             self.solution, self.bound, self._q_inv = sol, bound, None
+            self._warned = False
             info = StepInfo(
                 status=sol.status, solve_time=sol.solve_time, gamma=sol.gamma, iterations=sol.iterations,
                 extra={"solution": sol, **(extra or {})},
             )
             return sol.F @ z, info
+        where = z if x is None else x
         if self.on_failure == "raise":
-            where = z if x is None else x
+            why = "" if diagnose is None else " " + diagnose().message()
             raise SolverError(
                 f"{self.owner}.step: the LMI solve at x = {where.tolist()} returned status {sol.status!r} "
-                f"(solver: {sol.solver_status!r}) and on_failure='raise'"
+                f"(solver: {sol.solver_status!r}) and on_failure='raise'.{why}"
             )
         details = {"solution": sol, **(failure_extra or {}), "had_gain": self.solution is not None}
+        if self.solution is None and not self._warned:
+            self._warned = True
+            diagnosis = None if diagnose is None else diagnose()
+            details["diagnosis"] = diagnosis
+            why = "" if diagnosis is None else " " + diagnosis.message()
+            warnings.warn(
+                f"{self.owner}.step: no certified gain at x = {where.tolist()} (status {sol.status!r}); "
+                f"applying u = 0, which no certificate stands behind, until a solve certifies a gain "
+                f"(on_failure='raise' stops instead).{why}",
+                NoCertifiedGainWarning, stacklevel=3,
+            )
         info = StepInfo(
             status=sol.status, solve_time=sol.solve_time, gamma=None, iterations=sol.iterations,
             fallback=True, extra=details,

@@ -15,7 +15,10 @@ from lmi import KothareProblem, LMISolution
 from lmi.forms import FormProblem, form_options
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.mpc.diagnosis import FailureDiagnosis, diagnose
 from rmpc.mpc.fallback import CertifiedGain
+from rmpc.mpc.methods import method_options
+from rmpc.mpc.setpoint import SteadyTarget, steady_target
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
@@ -78,10 +81,20 @@ class RMPC:
         it (``lam``, the S-procedure's contraction factor, searched when not given).
         The LMIs of every form and the combinations that exist: the page "The field's robust MPC
         forms" of the docs (:mod:`lmi.forms`). The defaults give Kothare's problem.
+    offset_free : bool
+        Offset-free action on a constant input disturbance: every :meth:`step` takes the
+        disturbance estimate ``StepInputs(d_hat=...)`` (from an estimator with
+        ``disturbance_model="input"``; :func:`rmpc.simulate` passes it) and applies
+        ``u = u_s - d_hat + F (x - x_s)``, so an unmeasured constant load leaves no offset
+        once the estimate has converged (see :meth:`set_reference`).
     on_failure : {"fallback", "raise"}
         What to do when a solve gives no usable (certified) answer: keep the last certified
         gain and record the fallback, or raise :class:`~toolkit_common.errors.SolverError`
-        (:class:`~rmpc.mpc.fallback.CertifiedGain`).
+        (:class:`~rmpc.mpc.fallback.CertifiedGain`). Before any certified gain the fallback is
+        ``u = 0``, which no certificate stands behind: the first such step warns
+        (:class:`~rmpc.errors.NoCertifiedGainWarning`) with the status and the
+        :meth:`diagnose` of the state (which bound blocks, what to try); a raised failure
+        carries the same diagnosis.
     hold_radius : float
         Below this norm of ``x - x_ref`` the problem degenerates (``gamma -> 0``); the last
         certified gain is kept without re-solving (its invariant ellipsoid contains the state).
@@ -148,9 +161,14 @@ class RMPC:
         saturation: Literal["auxiliary"] | None = None,
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
+        offset_free: bool = False,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
-            raise ArgumentTypeError("plant", "a models.PolytopicModel", type(plant).__name__)
+            hint = ""
+            if type(plant).__name__ in ("StateSpace", "TransferFunction"):
+                hint = (" (a python-control system: build the polytope with models.PolytopicModel."
+                        "from_statespace([sys_1, ..., sys_k]) from discrete-time vertices)")
+            raise ArgumentTypeError("plant", "a models.PolytopicModel" + hint, type(plant).__name__)
         input_constraint = input_constraint_kind(input_constraint, u_max)
         self.plant = plant
         self.form = form_options(
@@ -189,8 +207,53 @@ class RMPC:
                 "x_ref", "an equilibrium of every vertex with zero input (A_j x_ref = x_ref)",
                 f"max |A_j x_ref - x_ref| = {drift:.3g}",
             )
+        self.u_ref = np.zeros(plant.n_inputs)
+        self.target: SteadyTarget | None = None
+        if not isinstance(offset_free, bool | np.bool_):
+            raise ArgumentTypeError("offset_free", "a bool", type(offset_free).__name__)
+        self.offset_free = bool(offset_free)
+        if self.offset_free:
+            self.accepts = frozenset({"u_max", "d_hat"})
         self.dt = plant.dt
         self.last: StepInfo | None = None
+
+    def set_reference(self, reference: ArrayLike, outputs: ArrayLike) -> SteadyTarget:
+        """Hold the outputs ``C_r x`` (``outputs``) at ``reference`` from the next step on.
+
+        The target ``(x_s, u_s)`` is a steady state of every vertex with ``C_r x_s = r``
+        (:func:`rmpc.mpc.setpoint.steady_target`; refused with the reason when there is none);
+        the controller then regulates ``x - x_s`` with ``u = u_s + F (x - x_s)``, the input bound
+        tightened by ``u_s`` (``|v_i| <= u_max_i - |u_s,i|``, or ``||v|| <= u_max - ||u_s||``) so
+        the total input keeps it. With ``offset_free=True`` the step's disturbance estimate
+        ``d_hat`` moves the target input to ``u_s - d_hat``.
+        """
+        target = steady_target(self.plant.A, self.plant.B, reference, outputs)
+        self.target = target
+        self.x_ref, self.u_ref = target.x.copy(), target.u.copy()
+        return target
+
+    @classmethod
+    def from_method(cls, key: str, plant: PolytopicModel, **options: Any) -> RMPC:
+        """The robust MPC of the literature's method ``key`` (MUP's method keys).
+
+        ``key`` is one of :data:`rmpc.mpc.methods.METHODS` (``"kothare"``, ``"cuzzola"``,
+        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``), which sets the form's
+        options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other arguments of
+        :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per component
+        (``input_constraint="peak"``) unless ``input_constraint`` is given.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import PolytopicModel
+        >>> from rmpc import RMPC
+        >>> plant = PolytopicModel([(np.array([[1.1]]), np.array([[1.0]])),
+        ...                         (np.array([[1.1]]), np.array([[0.5]]))], dt=1.0)
+        >>> ctrl = RMPC.from_method("cuzzola", plant, Q=np.eye(1), R=np.eye(1), u_max=1.0)
+        >>> ctrl.form.lyapunov, ctrl.input_constraint
+        ('vertex', 'peak')
+        """
+        return cls(plant, **method_options(key, options))
 
     @property
     def input_constraint(self) -> str | None:
@@ -227,6 +290,20 @@ class RMPC:
         x = as_vector(x, "x", self.plant.n_states)
         return self.problem.solve(x - self.x_ref, u_max=u_max)
 
+    def diagnose(self, x: ArrayLike, status: str | None = None) -> FailureDiagnosis:
+        """Why there is no certified gain at ``x``, and what to try (:mod:`rmpc.mpc.diagnosis`).
+
+        ``status`` is the failed solve's (solved here when not given). A few more solves at
+        ``x``: without bounds, with Kothare's plain problem (for another form), with softened
+        bounds.
+        """
+        x = as_vector(x, "x", self.plant.n_states)
+        z = x - self.x_ref
+        if status is None:
+            status = self.problem.solve(z).status
+        return diagnose(self.problem.data, z, status, has_addition=not self.form.is_kothare,
+                        backend="clarabel" if self.problem.backend == "clarabel" else "ipm")
+
     def in_ellipsoid(self, x: ArrayLike) -> bool:
         """Whether ``x - x_ref`` lies in the invariant ellipsoid of the current gain."""
         if self.certified.solution is None:
@@ -248,14 +325,18 @@ class RMPC:
             disturbance correction leaves of the torque limit. Other fields are errors.
         """
         x = as_vector(x, "x", self.plant.n_states)
-        u_max = check_step_inputs(inputs, self.accepts, "RMPC").u_max
+        given = check_step_inputs(inputs, self.accepts, "RMPC")
+        u_max = given.u_max
         bound = None if u_max is None else self.problem.input_bound(u_max)
+        u_s = self._target_input(given.d_hat)
+        if np.any(u_s != 0.0):
+            bound = self._tightened(self.problem.data.u_max if bound is None else bound, u_s)
         z = x - self.x_ref
         shape = (self.plant.n_inputs, self.plant.n_states)
         kept = self.certified
         if kept.near_origin(z):
             u, self.last = kept.reuse(z, shape, "near origin")
-            return self._saturate(u, bound)
+            return u_s + self._saturate(u, bound)
         tighter = (
             bound is not None and kept.bound is not None
             and bool(np.any(bound < kept.bound * (1.0 - 1e-12)))
@@ -265,15 +346,39 @@ class RMPC:
             level = float(z @ q_inv @ z)
             if self.resolve_threshold < level <= 1.0:
                 u, self.last = kept.reuse(z, shape, "inside ellipsoid", level=level)
-                return self._saturate(u, bound)
+                return u_s + self._saturate(u, bound)
         sol = self.problem.solve(z, u_max=bound)
         u, self.last = kept.take(
             sol, z, shape, x=x, bound=self.problem.data.u_max if bound is None else bound,
             failure_extra={"inside_ellipsoid": kept.contains(z)},
+            diagnose=lambda: self.diagnose(x, sol.status),
         )
         if sol.u0 is not None and not self.last.fallback:
             u = sol.u0.copy()  # the free first move
-        return self._saturate(u, bound)
+        return u_s + self._saturate(u, bound)
+
+    def _target_input(self, d_hat: Any) -> np.ndarray:
+        """``u_s`` of the target, less the disturbance estimate with ``offset_free=True``."""
+        if not self.offset_free:
+            return self.u_ref
+        if d_hat is None:
+            raise InvalidArgumentError(
+                "inputs.d_hat", "the input-disturbance estimate (offset_free=True: give the step "
+                "StepInputs(d_hat=est.d_hat), as simulate does with an estimator that has a "
+                "disturbance model)", "None",
+            )
+        return self.u_ref - as_vector(d_hat, "inputs.d_hat", self.plant.n_inputs)
+
+    def _tightened(self, bound: np.ndarray | None, u_s: np.ndarray) -> np.ndarray | None:
+        """The bound left to ``u - u_s`` so that ``u`` keeps ``bound`` (``None``: no bound)."""
+        kind = self.problem.data.input_constraint
+        if kind is None or bound is None:
+            return bound
+        if kind == "peak":
+            left = bound - np.abs(u_s)
+        else:
+            left = bound - float(np.linalg.norm(u_s))
+        return np.maximum(left, 1e-12 * np.maximum(bound, 1.0))  # none left: the solve says infeasible
 
     def _saturate(self, u: np.ndarray, bound: np.ndarray | None) -> np.ndarray:
         """The componentwise saturation of the auxiliary-gain form (other forms: ``u`` as it is)."""

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 from lmi import KothareProblem, LMISolution
 from models import PolytopicModel, RigidSatellite
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.mpc.diagnosis import diagnose
 from rmpc.mpc.fallback import CertifiedGain
 from rmpc.mpc.robust_mpc import input_constraint_kind
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
@@ -192,7 +193,9 @@ class ScheduledRMPC:
         build = time.perf_counter() - start
         sol = problem.solve(x)
         u, self.last = kept.take(
-            sol, x, self._gain_shape(x), extra={"build_time": build}, failure_extra={"build_time": build}
+            sol, x, self._gain_shape(x), extra={"build_time": build}, failure_extra={"build_time": build},
+            diagnose=lambda: diagnose(problem.data, x, sol.status,
+                                      backend="clarabel" if problem.backend == "clarabel" else "ipm"),
         )
         return u
 

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from models import PolytopicModel, ReactionWheelActuator, TorqueLimiter
 from models.protocols import Plant
-from rmpc.controller import Controller
+from rmpc.controller import Controller, StepInputs
 from rmpc.sim.disturbances import as_disturbance, disturbance_at
 from rmpc.sim.plants import SampledPlant, as_sampled_plant
 from rmpc.sim.trajectory import Trajectory
@@ -43,6 +43,10 @@ def simulate(
     progress: Callable[[int, int], object] | None = None,
     sensor: Callable[[float, np.ndarray], ArrayLike] | None = None,
     max_steps: int = MAX_STEPS,
+    measurement: ArrayLike | None = None,
+    noise: float | ArrayLike | None = None,
+    estimator: Any = None,
+    noise_seed: int = 0,
 ) -> Trajectory:
     """Run ``controller`` in closed loop on ``plant`` from ``x0``.
 
@@ -92,6 +96,20 @@ def simulate(
         ``sensor(t, x) -> y``: what the controller measures (sensor noise, say); the
         trajectory keeps the true state. Its ``reset()`` is called before the run when present.
         Default: the controller sees the true state.
+    measurement : (p, n) array_like, optional
+        ``C`` of the sensor ``y = C x + v``: the controller then sees ``y`` (with an
+        ``estimator``: the estimate from it) instead of the state. Not with ``sensor``.
+    noise : float or (p,) array_like, optional
+        The standard deviation of the white Gaussian measurement noise ``v`` per output (with
+        ``measurement``), drawn from ``numpy.random.default_rng(noise_seed)``.
+    estimator : object with ``update(y, u_prev)`` and ``reset()``, optional
+        Turns each measurement into the state estimate the controller steps on
+        (:mod:`rmpc.estimators`); it gets the input applied at the previous sample (after the
+        limiter and actuator). Reset at the start; the estimates are kept in
+        ``Trajectory.stage_log["x_hat"]`` (and ``"d_hat"`` where it estimates a disturbance).
+        Needs ``measurement``.
+    noise_seed : int
+        Seed of the measurement noise.
     max_steps : int
         The largest number of samples a run may have (default :data:`MAX_STEPS`, 10 million:
         the trajectory's arrays are allocated up front); a longer run is refused with an error
@@ -160,6 +178,7 @@ def simulate(
         raise ArgumentTypeError("limiter", "a TorqueLimiter or callable", type(limiter).__name__)
     if reset and callable(getattr(controller, "reset", None)):
         controller.reset()
+    read = _measurement_chain(measurement, noise, estimator, noise_seed, sensor, n)
     if sensor is not None:
         if not callable(sensor):
             raise ArgumentTypeError("sensor", "None or a callable sensor(t, x)", type(sensor).__name__)
@@ -178,9 +197,17 @@ def simulate(
     xs[0] = x
     for k in range(n_steps):
         t = k * step_dt
-        measured = x if sensor is None else _finite_output(sensor(t, x), "sensor", "sensor(t, x)", t, None)
+        if read is not None:
+            measured = read(x, u_app[k - 1] if k else None)
+        else:
+            measured = (x if sensor is None
+                        else _finite_output(sensor(t, x), "sensor", "sensor(t, x)", t, None))
         start = time.perf_counter()
-        u = np.asarray(controller.step(measured), dtype=float).reshape(-1)
+        step_inputs = read.step_inputs(controller) if read is not None else None
+        u = np.asarray(
+            controller.step(measured) if step_inputs is None else controller.step(measured, step_inputs),
+            dtype=float,
+        ).reshape(-1)
         step_time[k] = time.perf_counter() - start
         if u.shape != (m,) or not np.all(np.isfinite(u)):
             raise InvalidArgumentError(
@@ -213,7 +240,9 @@ def simulate(
     return Trajectory(
         t=np.arange(n_steps + 1) * step_dt, x=xs, u_cmd=u_cmd, u_applied=u_app, d=d_log,
         status=status, solve_time=solve_time, step_time=step_time, gamma=gamma, info=info,
-        plant=sim_plant.kind, dt=step_dt, stage_log=_stack_rows(stage_rows), attitude_euler=attitude,
+        plant=sim_plant.kind, dt=step_dt,
+        stage_log={**_stack_rows(stage_rows), **({} if read is None else read.log())},
+        attitude_euler=attitude,
     )
 
 
@@ -239,3 +268,73 @@ def _stack_rows(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:
         if all(name in row for row in rows):
             out[name] = np.asarray([row[name] for row in rows])
     return out
+
+
+class _MeasurementChain:
+    """Sensor ``y = C x + v`` and, optionally, an estimator: what the controller steps on."""
+
+    def __init__(self, c: np.ndarray, sigma: np.ndarray, estimator: Any, seed: int) -> None:
+        self.c, self.sigma, self.estimator = c, sigma, estimator
+        self.rng = np.random.default_rng(seed)
+        self.x_hat: list[np.ndarray] = []
+        self.d_hat: list[np.ndarray] = []
+        if estimator is not None and callable(getattr(estimator, "reset", None)):
+            estimator.reset()
+
+    def __call__(self, x: np.ndarray, u_prev: np.ndarray | None) -> np.ndarray:
+        y = self.c @ x + self.sigma * self.rng.standard_normal(self.c.shape[0])
+        if self.estimator is None:
+            return y
+        x_hat = np.asarray(self.estimator.update(y, u_prev), dtype=float)
+        self.x_hat.append(x_hat.copy())
+        d_hat = getattr(self.estimator, "d_hat", None)
+        if d_hat is not None and np.size(d_hat):
+            self.d_hat.append(np.asarray(d_hat, dtype=float).copy())
+        return x_hat
+
+    def step_inputs(self, controller: Any) -> StepInputs | None:
+        """``StepInputs(d_hat=...)`` for a controller that takes the disturbance estimate."""
+        if self.d_hat and "d_hat" in getattr(controller, "accepts", ()):
+            return StepInputs(d_hat=self.d_hat[-1])
+        return None
+
+    def log(self) -> dict[str, np.ndarray]:
+        out = {}
+        if self.x_hat:
+            out["x_hat"] = np.asarray(self.x_hat)
+        if self.d_hat:
+            out["d_hat"] = np.asarray(self.d_hat)
+        return out
+
+
+def _measurement_chain(
+    measurement: ArrayLike | None, noise: float | ArrayLike | None, estimator: Any, seed: int,
+    sensor: Any, n: int,
+) -> _MeasurementChain | None:
+    """The checked sensor-estimator chain of :func:`simulate`, or ``None`` without ``measurement``."""
+    if measurement is None:
+        for name, value in (("noise", noise), ("estimator", estimator)):
+            if value is not None:
+                raise InvalidArgumentError(name, "measurement=C with it (what is measured)", "no measurement")
+        return None
+    if sensor is not None:
+        raise InvalidArgumentError("sensor", "None with measurement= (one sensor)", "both given")
+    try:
+        c = np.atleast_2d(np.asarray(measurement, dtype=float))
+    except (TypeError, ValueError) as err:
+        raise InvalidArgumentError("measurement", f"a real p x {n} matrix", str(err)) from None
+    if c.ndim != 2 or c.shape[1] != n or not np.all(np.isfinite(c)):
+        raise InvalidArgumentError("measurement", f"a finite p x {n} matrix", f"shape {c.shape}")
+    p = c.shape[0]
+    sigma = np.zeros(p) if noise is None else np.broadcast_to(np.asarray(noise, dtype=float), (p,)).copy()
+    if not np.all(np.isfinite(sigma)) or np.any(sigma < 0.0):
+        raise InvalidArgumentError("noise", "standard deviations >= 0 (a float or one per output)",
+                                   repr(np.asarray(noise).tolist()))
+    if estimator is not None:
+        if not callable(getattr(estimator, "update", None)):
+            raise ArgumentTypeError("estimator", "an object with update(y, u_prev)", type(estimator).__name__)
+        c_est = getattr(estimator, "C", None)
+        if c_est is not None and np.shape(c_est) != c.shape:
+            raise InvalidArgumentError("estimator", f"an estimator of {p} outputs (measurement's)",
+                                       f"one built for C of shape {np.shape(c_est)}")
+    return _MeasurementChain(c, sigma, estimator, int(seed))

@@ -1,0 +1,67 @@
+"""MUP's method keys by name: each builds the form its table names (the same answer as the
+options written out), MUP's per-component input bound by default, and clear refusals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.suites.methods_problems import build_problem
+from rmpc import RMPC
+from rmpc.mpc.methods import METHODS, NOT_YET
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+
+#: The options each key stands for, written out here independently of the module's table.
+EXPECTED = {
+    "kothare": {},
+    "cuzzola": {"lyapunov": "vertex"},
+    "mao": {"lyapunov": "vertex_pairs"},
+    "wan": {"cost": "nominal"},
+    "cao": {"saturation": "auxiliary"},
+    "mao_cao": {"lyapunov": "vertex_pairs", "saturation": "auxiliary"},
+    "wan_cao": {"cost": "nominal", "saturation": "auxiliary"},
+}
+#: MUP's 19 keys (rmpc_methods/feas_<key>.m).
+MUP_KEYS = {
+    "kothare", "kothare_soft_con", "cuzzola", "mao", "wan", "wan_soft_con", "cao", "cao_soft_con",
+    "mao_cao", "wan_cao", "wan_cao_soft_con", "ding", "li", "huang", "shi", "zhang", "wan_huang",
+    "mao_huang", "wan_zhang",
+}
+
+
+def test_every_mup_key_is_either_carried_or_refused_by_name() -> None:
+    assert set(METHODS) == set(EXPECTED)
+    assert set(METHODS) | set(NOT_YET) == MUP_KEYS and not set(METHODS) & set(NOT_YET)
+
+
+@pytest.mark.parametrize("key", list(EXPECTED))
+def test_a_key_gives_the_answer_of_its_options_written_out(key: str) -> None:
+    p = build_problem("mup_demo")
+    common = {"Q": p.Q, "R": p.R, "u_max": p.u_max}
+    by_key = RMPC.from_method(key, p.plant, **common)
+    by_hand = RMPC(p.plant, input_constraint="peak", **common, **EXPECTED[key])
+    assert by_key.input_constraint == "peak"
+    got, want = by_key.solve(p.x0), by_hand.solve(p.x0)
+    assert got.status == want.status == "optimal"
+    assert got.gamma == pytest.approx(want.gamma, rel=1e-6)
+    np.testing.assert_allclose(got.F, want.F, rtol=1e-4, atol=1e-6 * np.abs(want.F).max())
+
+
+def test_the_caller_may_choose_the_input_bound_kind() -> None:
+    p = build_problem("mup_demo")
+    ctrl = RMPC.from_method("wan", p.plant, Q=p.Q, R=p.R, u_max=float(np.min(p.u_max)),
+                            input_constraint="ellipsoid")
+    assert ctrl.input_constraint == "ellipsoid" and ctrl.form.cost == "nominal"
+
+
+def test_refusals_name_the_argument() -> None:
+    p = build_problem("mup_demo")
+    kw = {"Q": p.Q, "R": p.R}
+    with pytest.raises(InvalidArgumentError, match=r"key: .*'kothare'.*found 'kotare'"):
+        RMPC.from_method("kotare", p.plant, **kw)
+    with pytest.raises(InvalidArgumentError, match=r"key: .*found 'ding'.*nearest"):
+        RMPC.from_method("ding", p.plant, **kw)
+    with pytest.raises(ArgumentTypeError, match="key"):
+        RMPC.from_method(1, p.plant, **kw)
+    with pytest.raises(InvalidArgumentError, match=r"lyapunov: expected 'vertex'.*found 'common'"):
+        RMPC.from_method("cuzzola", p.plant, lyapunov="common", **kw)
