@@ -54,12 +54,13 @@ def cold_kernels(names: tuple[str, ...] = FIRST_SOLVE_KERNELS) -> list[str]:
     list of str
         Those whose cache index is missing, stale or unreadable: their first call compiles.
     """
-    from lmi.ipm import kernels
+    from lmi.ipm.kernels import iteration, packed, schur, step  # the modules, not the package
 
+    defined = {**vars(step), **vars(schur), **vars(iteration), **vars(packed)}
     cold = []
     for name in names:
         try:
-            index = getattr(kernels, name)._cache._cache_file._load_index()
+            index = defined[name]._cache._cache_file._load_index()
         except Exception:  # an unreadable index is rewritten by the compile that follows
             index = {}
         if not index:
