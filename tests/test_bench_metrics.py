@@ -94,6 +94,7 @@ def _trajectory() -> Trajectory:
         t=t, x=x, u_cmd=u_cmd, u_applied=u_app, d=np.zeros((4, 3)), status=status,
         solve_time=np.array([0.04, 0.0, 0.08, 0.02]), step_time=np.array([0.05, 0.001, 0.09, 0.03]),
         gamma=np.array([10.0, np.nan, np.nan, 2.0]), info=info, plant="linear", dt=0.1,
+        attitude_euler=x[:, :3],  # a satellite's run: its metrics are per attitude axis
     )
 
 

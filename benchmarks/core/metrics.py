@@ -1,7 +1,8 @@
 """Metrics of one closed-loop run: attitude error, torque use, saturation, solver effort.
 
 The attitude error is the attitude itself (every experiment regulates it to zero), per axis
-``roll, pitch, yaw`` = ``phi, theta, psi`` in rad. Definitions (``e_k = e(t_k)``,
+``roll, pitch, yaw`` = ``phi, theta, psi`` in rad; for a plant without an attitude the errors
+are its states, keyed by the plant's own state names (:func:`error_signals`). Definitions (``e_k = e(t_k)``,
 ``k = 0 .. N`` the recorded samples):
 
 - ``sum_abs_err``: ``sum_k |e_k|`` over all ``N + 1`` samples (paper P's table metric).
@@ -44,6 +45,7 @@ __all__ = [
     "FAILURE_FREE_STATUSES",
     "check_trajectory",
     "compute_metrics",
+    "error_signals",
     "iae",
     "ise",
     "last_time_above",
@@ -323,8 +325,25 @@ def _pcts(values: np.ndarray, prefix: str) -> dict[str, float | None]:
     }
 
 
-def _per_axis(values: list[Any]) -> dict[str, Any]:
-    return dict(zip(AXES, values, strict=True))
+def _per_axis(values: list[Any], names: tuple[str, ...] = AXES) -> dict[str, Any]:
+    return dict(zip(names, values, strict=True))
+
+
+def error_signals(traj: Any) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The regulated errors of a run and their names.
+
+    For a plant with an attitude (``traj.attitude_euler`` not ``None``: the satellites) the
+    first three states, named ``roll, pitch, yaw``; for any other plant every state, by the
+    plant's own names (``Trajectory.names()``: python-control's signal names for a polytope
+    from :meth:`models.PolytopicModel.from_statespace`, ``x[i]`` where it gives none).
+    """
+    x = np.asarray(traj.x, dtype=float)
+    if getattr(traj, "attitude_euler", None) is not None and x.shape[1] >= 3:
+        return x[:, :3], AXES
+    names = traj.names("state") if callable(getattr(traj, "names", None)) else ()
+    if len(names) != x.shape[1]:
+        names = tuple(f"x[{i}]" for i in range(x.shape[1]))
+    return x, tuple(names)
 
 
 def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, Any]:
@@ -333,7 +352,8 @@ def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, An
     Parameters
     ----------
     traj : rmpc.Trajectory
-        The run; ``x[:, :3]`` is the attitude error.
+        The run; the errors are :func:`error_signals` (the attitude of a satellite, every state
+        by its name for any other plant).
     u_max : float
         Per-axis torque limit (N m) that saturation and violation are measured against.
     band : float
@@ -345,7 +365,8 @@ def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, An
         JSON-ready values; ``None`` where a value does not exist.
     """
     t = np.asarray(traj.t, dtype=float)
-    err = np.asarray(traj.x, dtype=float)[:, :3]
+    err, names = error_signals(traj)
+    k = err.shape[1]
     u_app = np.abs(np.asarray(traj.u_applied, dtype=float))
     u_cmd = np.abs(np.asarray(traj.u_cmd, dtype=float))
     status = list(traj.status)
@@ -362,12 +383,12 @@ def compute_metrics(traj: Any, u_max: float, band: float = 0.02) -> dict[str, An
     for s in status:
         counts[s] = counts.get(s, 0) + 1
     metrics: dict[str, Any] = {
-        "sum_abs_err": _per_axis([float(v) for v in np.sum(np.abs(err), axis=0)]),
-        "final_abs_err": _per_axis([float(v) for v in np.abs(err[-1])]),
-        "iae": _per_axis([iae(t, err[:, i]) for i in range(3)]),
-        "ise": _per_axis([ise(t, err[:, i]) for i in range(3)]),
-        "settling_time": _per_axis([settling_time(t, err[:, i], band) for i in range(3)]),
-        "overshoot": _per_axis([overshoot(err[:, i]) for i in range(3)]),
+        "sum_abs_err": _per_axis([float(v) for v in np.sum(np.abs(err), axis=0)], names),
+        "final_abs_err": _per_axis([float(v) for v in np.abs(err[-1])], names),
+        "iae": _per_axis([iae(t, err[:, i]) for i in range(k)], names),
+        "ise": _per_axis([ise(t, err[:, i]) for i in range(k)], names),
+        "settling_time": _per_axis([settling_time(t, err[:, i], band) for i in range(k)], names),
+        "overshoot": _per_axis([overshoot(err[:, i]) for i in range(k)], names),
         "max_abs_u": float(np.max(u_app)) if u_app.size else 0.0,
         "max_abs_u_cmd": float(np.max(u_cmd)) if u_cmd.size else 0.0,
         "saturated_fraction": float(np.mean(np.any(u_cmd >= u_max * (1.0 - 1e-6), axis=1)))

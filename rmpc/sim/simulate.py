@@ -243,6 +243,7 @@ def simulate(
         plant=sim_plant.kind, dt=step_dt,
         stage_log={**_stack_rows(stage_rows), **({} if read is None else read.log())},
         attitude_euler=attitude,
+        state_names=_plant_names(plant, "state_names", n), input_names=_plant_names(plant, "input_names", m),
     )
 
 
@@ -338,3 +339,15 @@ def _measurement_chain(
             raise InvalidArgumentError("estimator", f"an estimator of {p} outputs (measurement's)",
                                        f"one built for C of shape {np.shape(c_est)}")
     return _MeasurementChain(c, sigma, estimator, int(seed))
+
+
+def _plant_names(plant: Any, attribute: str, size: int) -> tuple[str, ...]:
+    """The plant's (or its model's) names of one kind when it gives ``size`` of them, else ``()``."""
+    names = getattr(plant, attribute, None)
+    if names is None:
+        names = getattr(getattr(plant, "model", None), attribute, None)
+    try:
+        names = tuple(str(name) for name in names)
+    except TypeError:
+        return ()
+    return names if len(names) == size else ()

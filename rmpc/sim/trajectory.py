@@ -53,6 +53,10 @@ class Trajectory:
         ``attitude_euler(x)`` whatever its attitude representation; ``None`` for a plant
         without attitude (a user's model without ``attitude_euler``, a polytope built with
         ``attitude=None``).
+    state_names, input_names : tuple of str
+        The plant's names of its states and inputs (python-control's signal names for a
+        polytope built by :meth:`models.PolytopicModel.from_statespace`); empty when the plant
+        gives none.
     """
 
     t: np.ndarray
@@ -69,6 +73,8 @@ class Trajectory:
     dt: float
     stage_log: dict[str, np.ndarray] = field(default_factory=dict)
     attitude_euler: np.ndarray | None = None
+    state_names: tuple[str, ...] = ()
+    input_names: tuple[str, ...] = ()
 
     @property
     def n_steps(self) -> int:
@@ -90,6 +96,69 @@ class Trajectory:
                 "a run whose plant has no attitude (Trajectory.attitude_euler is None)",
             )
         return np.degrees(self.attitude_euler)
+
+    def names(self, kind: str = "state") -> tuple[str, ...]:
+        """The plant's state (``kind="state"``) or input names, ``x[i]`` / ``u[i]`` where it gave none."""
+        if kind not in ("state", "input"):
+            raise InvalidArgumentError("kind", "'state' or 'input'", repr(kind))
+        given, size, letter = ((self.state_names, self.x.shape[1], "x") if kind == "state"
+                               else (self.input_names, self.u_cmd.shape[1], "u"))
+        return tuple(given) if len(given) == size else tuple(f"{letter}[{i}]" for i in range(size))
+
+    def plot(self, u_max: Any = None, states: Any = None) -> Any:
+        """The run as a matplotlib figure: states, inputs (with the bounds), solve time, status.
+
+        Parameters
+        ----------
+        u_max : float or (m,) array_like, optional
+            Input bounds to draw as dashed lines (``+-u_max``).
+        states : sequence of int, optional
+            Which states to draw (default all), labelled with the plant's names.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Four panels: the states, the applied inputs (and commands where they differ), each
+            step's solve time (ms, log scale), and each step's status (a row per status word).
+        """
+        import matplotlib.pyplot as plt
+
+        state_names, input_names = self.names("state"), self.names("input")
+        picks = list(range(self.x.shape[1])) if states is None else [int(i) for i in states]
+        for i in picks:
+            if not 0 <= i < self.x.shape[1]:
+                raise InvalidArgumentError("states", f"indices in [0, {self.x.shape[1]})", repr(list(states)))
+        fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True,
+                                 gridspec_kw={"height_ratios": [3, 3, 1.5, 1.2]})
+        for i in picks:
+            axes[0].plot(self.t, self.x[:, i], label=state_names[i])
+        axes[0].set_ylabel("state")
+        axes[0].legend(loc="best", fontsize="small", ncol=min(3, max(1, len(picks))))
+        t_u = self.t[:-1]
+        for j, name in enumerate(input_names):
+            line, = axes[1].step(t_u, self.u_applied[:, j], where="post", label=f"{name} applied")
+            if not np.allclose(self.u_applied[:, j], self.u_cmd[:, j]):
+                axes[1].step(t_u, self.u_cmd[:, j], where="post", linestyle=":", color=line.get_color(),
+                             label=f"{name} commanded")
+        if u_max is not None:
+            bound = np.broadcast_to(np.asarray(u_max, dtype=float), (len(input_names),))
+            for level in np.unique(bound):
+                for sign in (1.0, -1.0):
+                    axes[1].axhline(sign * level, color="grey", linestyle="--", linewidth=0.8)
+        axes[1].set_ylabel("input")
+        axes[1].legend(loc="best", fontsize="small")
+        positive = self.solve_time > 0
+        axes[2].semilogy(t_u[positive], 1e3 * self.solve_time[positive], ".", markersize=2)
+        axes[2].set_ylabel("solve (ms)")
+        words = sorted(set(self.status))
+        axes[3].plot(t_u, [words.index(s) for s in self.status], "|", markersize=6)
+        axes[3].set_yticks(range(len(words)), words, fontsize="small")
+        axes[3].set_ylim(-0.5, len(words) - 0.5)
+        axes[3].set_ylabel("status")
+        axes[3].set_xlabel("time (s)")
+        fig.suptitle(f"Closed loop on the {self.plant} plant: {self.n_steps} steps of {self.dt:g} s")
+        fig.tight_layout()
+        return fig
 
     def status_counts(self) -> dict[str, int]:
         """How many steps ended with each status."""
