@@ -82,6 +82,8 @@ MODULES_WITH_EXAMPLES = (
     "models.wheels.satellite",
     "models.wheels.scenarios",
     "models.wheels.stage",
+    "rmpc.analysis",
+    "rmpc.analysis.region",
     "rmpc.controller",
     "rmpc.errors",
     "rmpc.estimators.linear",

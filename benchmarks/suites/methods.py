@@ -40,6 +40,7 @@ from benchmarks.core.progress import CaseProgress
 from benchmarks.core.suite import SuiteOutcome
 from benchmarks.suites.methods_problems import PROBLEMS, SHORT_PROBLEMS, MethodsProblem, build_problem
 from benchmarks.suites.methods_report import write_methods_report
+from rmpc.analysis import TimeBudgetExceeded, boundary_along
 from toolkit_common.errors import ConfigError
 
 __all__ = ["METHODS", "MethodsSettings", "evaluate", "method_options", "run_methods"]
@@ -188,58 +189,17 @@ def _directions(problem: MethodsProblem, settings: MethodsSettings) -> np.ndarra
     return size * v * scale
 
 
-class _OverBudget(Exception):
-    """A phase of a case ran past its time budget."""
-
-
-def _feasible(ctrl: Any, x: np.ndarray, counts: dict[str, int], deadline: float, last: list[str]) -> bool:
-    if time.perf_counter() > deadline:
-        raise _OverBudget
-    sol = ctrl.solve(x)
-    counts[sol.status] = counts.get(sol.status, 0) + 1
-    if sol.status != "optimal":
-        last[0] = sol.status
-    return sol.status == "optimal"
+_OverBudget = TimeBudgetExceeded
 
 
 def region_along(
     ctrl: Any, d: np.ndarray, settings: MethodsSettings, counts: dict[str, int], deadline: float = np.inf
 ) -> tuple[float, str]:
-    """The largest multiple ``t`` (to ``rel_tol``) with ``t d`` certified feasible, and what stopped it.
-
-    Feasibility is star-shaped (the LMIs at ``t x`` with ``t < 1`` are met by the same variables),
-    so bracketing by doubling or halving from ``t = 1`` and bisecting finds the boundary. The
-    second value is the status of the last solve that failed above ``t`` (``"infeasible"``, a
-    solver failure word) or ``"cap"`` when ``t`` reached ``t_max``. Raises ``_OverBudget`` past
-    ``deadline`` (a ``time.perf_counter`` value).
-    """
-    last = ["cap"]
-    lo, hi = 0.0, 1.0
-    if _feasible(ctrl, d, counts, deadline, last):
-        lo = 1.0
-        while True:
-            hi = 2.0 * lo
-            if hi > settings.t_max:
-                return settings.t_max, "cap"
-            if not _feasible(ctrl, hi * d, counts, deadline, last):
-                break
-            lo = hi
-    else:
-        t = 1.0
-        while True:
-            t /= 2.0
-            if t < 1.0 / settings.t_max:
-                return 0.0, last[0]
-            if _feasible(ctrl, t * d, counts, deadline, last):
-                lo, hi = t, 2.0 * t
-                break
-    while hi - lo > settings.rel_tol * lo:
-        mid = 0.5 * (lo + hi)
-        if _feasible(ctrl, mid * d, counts, deadline, last):
-            lo = mid
-        else:
-            hi = mid
-    return lo, last[0]
+    """:func:`rmpc.analysis.boundary_along` with the settings' cap and tolerance: the largest
+    certified multiple of ``d`` and what stopped it (``"cap"`` at ``t_max``). Raises
+    ``_OverBudget`` (:class:`rmpc.analysis.TimeBudgetExceeded`) past ``deadline``."""
+    return boundary_along(ctrl, d, t_max=settings.t_max, rel_tol=settings.rel_tol, counts=counts,
+                          deadline=deadline)
 
 
 def _closed_loop(
