@@ -161,3 +161,14 @@ def test_a_ray_that_fails_the_independent_check_is_not_called_infeasible(monkeyp
     sol = prob.solve(FAR)
     assert sol.solver_status.startswith("ipm infeasible (unchecked); clarabel"), sol.solver_status
     assert sol.infeasibility is None
+
+
+def test_a_weak_ray_is_refused_with_its_radius() -> None:
+    """``b'y = -1`` and ``||A'y|| = 1e-3``: no solution of norm below ``1 / 1e-3 = 1e3`` only,
+    far below :data:`MIN_RADIUS`; the certificate says so and is refused (a residual below 1 is
+    no exemption; the mutation test found that gap)."""
+    got = check_farkas(np.array([[1e-3]]), np.array([-1.0]), [("nonneg", 1)], np.array([1.0]))
+    assert got.radius == pytest.approx(1e3)
+    assert not got.ok
+    strong = check_farkas(np.array([[1e-12]]), np.array([-1.0]), [("nonneg", 1)], np.array([1.0]))
+    assert strong.radius == pytest.approx(1e12) and strong.ok
