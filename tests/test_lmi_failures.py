@@ -198,3 +198,15 @@ def test_uncertified_answer_is_never_applied(monkeypatch):
     u = ctrl.step(NEAR / 2)
     assert ctrl.last.fallback and ctrl.last.status == "uncertified"
     np.testing.assert_allclose(u, gain @ (NEAR / 2), rtol=1e-12)
+
+
+def test_a_singular_q_is_never_certified() -> None:
+    """At ``x = 0`` with ``Q = 0, Y = 0`` every LMI holds with margin 0 (within the tolerance):
+    only the invertibility of ``Q`` (the gain is ``Y Q^-1``) refuses it (mutmut's survivor
+    x_certify__mutmut_114 flipped that margin's sign)."""
+    from lmi import build_kothare_data
+
+    data = build_kothare_data([[[1.1]]], [[[1.0]]], [[1.0]], [[1.0]], input_constraint="peak", u_max=1.0)
+    cert = certify(data, np.zeros(1), 1.0, np.zeros((1, 1)), np.zeros((1, 1)))
+    assert cert.margins["Q_invertible"] == -np.inf and not cert.ok
+    assert all(v >= -cert.tol for k, v in cert.margins.items() if k != "Q_invertible")
