@@ -30,6 +30,7 @@ __all__ = [
     "operating_point",
     "relative_spread",
     "sample_time",
+    "unreachable_modes",
     "zoh",
 ]
 
@@ -438,3 +439,22 @@ def _quaternion_vector_to_euler(state: np.ndarray) -> np.ndarray:
         )
     q0 = np.sqrt(max(0.0, 1.0 - norm2))
     return quat_to_euler321(np.concatenate(([q0], qv)) / np.sqrt(q0 * q0 + norm2))
+
+
+def unreachable_modes(a: np.ndarray, b: np.ndarray, *, only_unstable: bool = False,
+                      tol: float = 1e-9) -> list[complex]:
+    """The eigenvalues of ``a`` that the input matrix ``b`` cannot move (the PBH test).
+
+    ``rank [a - lambda I, b] < n``, the rank read from the singular values relative to the
+    largest; with ``only_unstable`` only modes with ``|lambda| >= 1 - tol`` are tested. By
+    duality, ``unreachable_modes(a.T, c.T)`` are the modes of ``a`` that ``c`` does not see.
+    """
+    n = a.shape[0]
+    found = []
+    for lam in np.linalg.eigvals(a):
+        if only_unstable and abs(lam) < 1.0 - tol:
+            continue
+        sv = np.linalg.svd(np.hstack([a - lam * np.eye(n), b]), compute_uv=False)
+        if sv[-1] <= 1e-9 * max(1.0, sv[0]):
+            found.append(complex(lam))
+    return found

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from models import PolytopicModel
+from models.linear import unreachable_modes
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector
 
@@ -67,16 +68,8 @@ def _output_matrix(C: ArrayLike, n: int) -> np.ndarray:
 
 
 def _unobservable_modes(a: np.ndarray, c: np.ndarray, only_unstable: bool) -> list[complex]:
-    """The eigenvalues of ``a`` that ``c`` does not see (PBH: ``rank [a - lambda I; c] < n``)."""
-    n = a.shape[0]
-    found = []
-    for lam in np.linalg.eigvals(a):
-        if only_unstable and abs(lam) < 1.0 - 1e-9:
-            continue
-        sv = np.linalg.svd(np.vstack([a - lam * np.eye(n), c]), compute_uv=False)
-        if sv[-1] <= 1e-9 * max(1.0, sv[0]):
-            found.append(complex(lam))
-    return found
+    """The eigenvalues of ``a`` that ``c`` does not see (PBH by duality: ``rank [a - lambda I; c] < n``)."""
+    return unreachable_modes(a.T, c.T, only_unstable=only_unstable)
 
 
 class LinearEstimator:

@@ -31,7 +31,8 @@ import numpy as np
 from lmi import KothareProblem
 from lmi.data import KothareData
 from lmi.forms import FormProblem
-from toolkit_common.status import is_usable
+from models.linear import unreachable_modes
+from rmpc.mpc.fallback import is_certified
 
 __all__ = ["FailureDiagnosis", "diagnose", "uncontrollable_unstable_modes"]
 
@@ -75,21 +76,10 @@ class FailureDiagnosis:
 def uncontrollable_unstable_modes(
     A: np.ndarray, B: np.ndarray, tol: float = 1e-9
 ) -> list[tuple[int, complex]]:
-    """``(vertex, eigenvalue)`` of every mode with ``|lambda| >= 1`` that ``B_j`` cannot move.
-
-    The PBH test: ``rank [A_j - lambda I, B_j] < n``, the rank read from the singular values
-    relative to the largest.
-    """
-    found = []
-    for j, (a, b) in enumerate(zip(A, B, strict=True)):
-        n = a.shape[0]
-        for lam in np.linalg.eigvals(a):
-            if abs(lam) < 1.0 - tol:
-                continue
-            sv = np.linalg.svd(np.hstack([a - lam * np.eye(n), b]), compute_uv=False)
-            if sv[-1] <= 1e-9 * max(1.0, sv[0]):
-                found.append((j, complex(lam)))
-    return found
+    """``(vertex, eigenvalue)`` of every mode with ``|lambda| >= 1`` that ``B_j`` cannot move
+    (:func:`models.linear.unreachable_modes` per vertex)."""
+    return [(j, lam) for j, (a, b) in enumerate(zip(A, B, strict=True))
+            for lam in unreachable_modes(a, b, only_unstable=True, tol=tol)]
 
 
 def _u_max(data: KothareData) -> Any:
@@ -97,10 +87,6 @@ def _u_max(data: KothareData) -> Any:
     if data.input_constraint is None:
         return None
     return float(data.u_max[0]) if data.input_constraint == "ellipsoid" else data.u_max
-
-
-def _certified(sol: Any) -> bool:
-    return is_usable(sol.status) and sol.certificate is not None and sol.certificate.ok
 
 
 def _unbounded(data: KothareData, z: np.ndarray, backend: str) -> Any:
@@ -126,7 +112,7 @@ def diagnose(data: KothareData, z: np.ndarray, status: str, *, has_addition: boo
     backend : str
         The back-end of the diagnosis' solves.
     """
-    if not _certified(_unbounded(data, z, backend)):
+    if not is_certified(_unbounded(data, z, backend)):
         modes = uncontrollable_unstable_modes(data.A, data.B)
         if modes:
             listed = ", ".join(
@@ -150,7 +136,7 @@ def diagnose(data: KothareData, z: np.ndarray, status: str, *, has_addition: boo
             u_max=_u_max(data), output_matrix=data.C_out,
             y_max=data.y_max if data.C_out is not None else None, backend=backend,
         ).solve(z)
-        if _certified(plain):
+        if is_certified(plain):
             return FailureDiagnosis(
                 status, "form",
                 "Kothare's problem with the same bounds has a certified gain here; the form's addition "
@@ -169,7 +155,7 @@ def diagnose(data: KothareData, z: np.ndarray, status: str, *, has_addition: boo
         u_max=_u_max(data), output_matrix=data.C_out,
         y_max=data.y_max if data.C_out is not None else None, soft=soft, backend=backend,
     ).solve(z)
-    if not _certified(relaxed) or relaxed.slack is None:
+    if not is_certified(relaxed) or relaxed.slack is None:
         return FailureDiagnosis(
             status, "unknown",
             f"The solve ended {status!r}, and a solve with softened bounds found no answer either "

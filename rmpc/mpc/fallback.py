@@ -28,7 +28,6 @@ import numpy as np
 
 from lmi import LMISolution
 from rmpc.controller import StepInfo
-from rmpc.mpc.diagnosis import FailureDiagnosis
 from toolkit_common.errors import NoCertifiedGainWarning, SolverError
 from toolkit_common.status import Status, is_usable
 from toolkit_common.validation import check_choice, check_positive
@@ -135,7 +134,7 @@ class CertifiedGain:
         self, sol: LMISolution, z: np.ndarray, shape: tuple[int, int], *, x: np.ndarray | None = None,
         bound: np.ndarray | None = None, extra: dict[str, Any] | None = None,
         failure_extra: dict[str, Any] | None = None,
-        diagnose: Callable[[], FailureDiagnosis] | None = None,
+        diagnose: Callable[[], Any] | None = None,
     ) -> tuple[np.ndarray, StepInfo]:
         """``u = F z`` after the solve ``sol`` and the step's :class:`~rmpc.StepInfo`.
 
