@@ -124,3 +124,13 @@ def test_offset_free_step_needs_the_estimate() -> None:
         ctrl.step([0.1, 0.0])
     u = ctrl.step([0.0, 0.0], StepInputs(d_hat=[0.5]))
     assert u[0] == pytest.approx(-0.5)  # at the target, u = u_s - d_hat
+
+
+def test_a_set_point_without_an_input_bound_needs_no_tightening() -> None:
+    """Without an input constraint the target input is applied as it is (before: the step
+    passed an empty bound to a problem that has none)."""
+    ctrl = RMPC(motor_polytope(0.05), Q=np.eye(2), R=np.eye(1))
+    target = ctrl.set_reference([1.0], outputs=[[1.0, 0.0]])
+    u = ctrl.step(target.x)
+    assert ctrl.last.status in ("reused", "optimal")
+    np.testing.assert_allclose(u, target.u, atol=1e-12)

@@ -329,7 +329,7 @@ class RMPC:
         u_max = given.u_max
         bound = None if u_max is None else self.problem.input_bound(u_max)
         u_s = self._target_input(given.d_hat)
-        if np.any(u_s != 0.0):
+        if np.any(u_s != 0.0) and self.input_constraint is not None:
             bound = self._tightened(self.problem.data.u_max if bound is None else bound, u_s)
         z = x - self.x_ref
         shape = (self.plant.n_inputs, self.plant.n_states)
