@@ -68,6 +68,9 @@ def test_bad_input_names_the_argument() -> None:
         feasible_region(ctrl, [[1.0, 2.0]])
     with pytest.raises(InvalidArgumentError, match="t_max: expected a cap > 1"):
         feasible_region(ctrl, [[1.0]], t_max=0.5)
+    with pytest.raises(InvalidArgumentError, match="budget_s: expected seconds > 0"):
+        feasible_region(ctrl, [[1.0]], budget_s="soon")
+    assert feasible_region(ctrl, [[1.0]], budget_s=np.int64(60)).t.shape == (1,)
     with pytest.raises(ArgumentTypeError, match="ctrl"):
         feasible_region(object(), [[1.0]])
     with pytest.raises(InvalidArgumentError, match="Q: expected a positive definite"):

@@ -175,9 +175,13 @@ def feasible_region(
     if t_max <= 1.0:
         raise InvalidArgumentError("t_max", "a cap > 1", repr(t_max))
     rel_tol = check_positive(rel_tol, "rel_tol")
-    if not (isinstance(budget_s, int | float) and budget_s > 0):  # inf: no budget
+    try:
+        budget = float(budget_s)
+    except (TypeError, ValueError):
+        budget = float("nan")
+    if isinstance(budget_s, bool) or not budget > 0:  # inf: no budget
         raise InvalidArgumentError("budget_s", "seconds > 0 (inf for no budget)", repr(budget_s))
-    deadline = time.perf_counter() + float(budget_s)
+    deadline = time.perf_counter() + budget
     counts: dict[str, int] = {}
     ts, limits = [], []
     for d in dirs:
