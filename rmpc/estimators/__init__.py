@@ -5,5 +5,6 @@
 """
 
 from rmpc.estimators.linear import DISTURBANCE_MODELS, KalmanFilter, LinearEstimator, Luenberger
+from rmpc.estimators.robust import RobustObserver
 
-__all__ = ["DISTURBANCE_MODELS", "KalmanFilter", "LinearEstimator", "Luenberger"]
+__all__ = ["DISTURBANCE_MODELS", "KalmanFilter", "LinearEstimator", "Luenberger", "RobustObserver"]
