@@ -134,3 +134,51 @@ def test_a_set_point_without_an_input_bound_needs_no_tightening() -> None:
     u = ctrl.step(target.x)
     assert ctrl.last.status in ("reused", "optimal")
     np.testing.assert_allclose(u, target.u, atol=1e-12)
+
+
+class _RandomPlant:
+    """``x' = A x + B_true (u + d)``, a seeded plant no test was tuned to."""
+
+    n_disturbances = 1
+
+    def __init__(self, a: np.ndarray, b: np.ndarray) -> None:
+        self.a, self.b = a, b
+        self.n_states, self.n_inputs = a.shape[0], b.shape[1]
+
+    def dynamics(self, x, u=None, d=None):
+        u = np.zeros(self.n_inputs) if u is None else np.asarray(u, float)
+        load = np.zeros(self.n_inputs) if d is None else np.asarray(d, float).reshape(-1)
+        return self.a @ np.asarray(x, float) + self.b @ (u + load)
+
+
+def _random_loop(seed: int):
+    import scipy.linalg as sla
+
+    rng = np.random.default_rng(seed)
+    n, dt = 3, 0.1
+    a = rng.normal(size=(n, n))
+    a -= (np.max(np.linalg.eigvals(a).real) - rng.uniform(-0.5, 0.1)) * np.eye(n)
+    b = rng.normal(size=(n, 1))
+    c = rng.normal(size=(1, n))
+    vertices = []
+    for scale in (0.8, 1.2):
+        big = sla.expm(np.block([[a, scale * b], [np.zeros((1, n + 1))]]) * dt)
+        vertices.append((big[:n, :n], big[:n, n:]))
+    plant = PolytopicModel(vertices, dt=dt)
+    return plant, _RandomPlant(a, 1.1 * b), c, dt, float(rng.uniform(-0.4, 0.4))
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_offset_free_on_random_plants_leaves_no_offset_in_the_measured_output(seed: int) -> None:
+    """The standard result of offset-free estimation: once the estimator settles, the measured
+    output is at its target whatever the true vertex, on plants drawn at random."""
+    plant, truth, c, dt, load = _random_loop(seed)
+    kf = KalmanFilter(plant, c, process_noise=1e-6, measurement_noise=1e-8, disturbance_model="input",
+                      disturbance_noise=1e-4)
+    ctrl = RMPC(plant, Q=np.eye(3), R=0.1 * np.eye(1), u_max=1.0, offset_free=True)
+    traj = simulate(ctrl, truth, np.zeros(3), duration=40.0, dt=dt, measurement=c, noise=1e-6, estimator=kf,
+                    disturbance=StepDisturbance([load], 2.0))
+    y = traj.x @ c.T
+    assert np.abs(y).max() > 10 * abs(y[-1, 0])  # the load moved the output and it came back
+    assert abs(y[-1, 0]) < 1e-3 * max(1.0, np.abs(y).max())
+    assert np.abs(traj.u_applied).max() <= 1.0 + 1e-9
