@@ -18,11 +18,14 @@ from rmpc.sim.trajectory import Trajectory
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["MAX_STEPS", "simulate"]
+__all__ = ["MAX_STEPS", "NOISE_KINDS", "simulate"]
 
 
 MAX_STEPS = 10_000_000
 """Default bound on a run's samples (10 million samples of 14 states: about 1.1 GB of states)."""
+
+#: The distributions of :func:`simulate`'s measurement noise.
+NOISE_KINDS = ("gaussian", "uniform")
 
 
 def simulate(
@@ -47,6 +50,7 @@ def simulate(
     noise: float | ArrayLike | None = None,
     estimator: Any = None,
     noise_seed: int = 0,
+    noise_kind: str = "gaussian",
 ) -> Trajectory:
     """Run ``controller`` in closed loop on ``plant`` from ``x0``.
 
@@ -100,8 +104,10 @@ def simulate(
         ``C`` of the sensor ``y = C x + v``: the controller then sees ``y`` (with an
         ``estimator``: the estimate from it) instead of the state. Not with ``sensor``.
     noise : float or (p,) array_like, optional
-        The standard deviation of the white Gaussian measurement noise ``v`` per output (with
-        ``measurement``), drawn from ``numpy.random.default_rng(noise_seed)``.
+        The measurement noise ``v`` per output (with ``measurement``), drawn from
+        ``numpy.random.default_rng(noise_seed)``: the standard deviation of white Gaussian noise,
+        or with ``noise_kind="uniform"`` the bound of noise uniform in ``[-noise_i, noise_i]``
+        (the bounded noise :class:`rmpc.estimators.RobustObserver` certifies its bound for).
     estimator : object with ``update(y, u_prev)`` and ``reset()``, optional
         Turns each measurement into the state estimate the controller steps on
         (:mod:`rmpc.estimators`); it gets the input applied at the previous sample (after the
@@ -110,6 +116,8 @@ def simulate(
         Needs ``measurement``.
     noise_seed : int
         Seed of the measurement noise.
+    noise_kind : {"gaussian", "uniform"}
+        The distribution of the measurement noise (see ``noise``).
     max_steps : int
         The largest number of samples a run may have (default :data:`MAX_STEPS`, 10 million:
         the trajectory's arrays are allocated up front); a longer run is refused with an error
@@ -178,7 +186,7 @@ def simulate(
         raise ArgumentTypeError("limiter", "a TorqueLimiter or callable", type(limiter).__name__)
     if reset and callable(getattr(controller, "reset", None)):
         controller.reset()
-    read = _measurement_chain(measurement, noise, estimator, noise_seed, sensor, n)
+    read = _measurement_chain(measurement, noise, estimator, noise_seed, sensor, n, noise_kind)
     if sensor is not None:
         if not callable(sensor):
             raise ArgumentTypeError("sensor", "None or a callable sensor(t, x)", type(sensor).__name__)
@@ -274,8 +282,10 @@ def _stack_rows(rows: list[dict[str, Any]]) -> dict[str, np.ndarray]:
 class _MeasurementChain:
     """Sensor ``y = C x + v`` and, optionally, an estimator: what the controller steps on."""
 
-    def __init__(self, c: np.ndarray, sigma: np.ndarray, estimator: Any, seed: int) -> None:
+    def __init__(self, c: np.ndarray, sigma: np.ndarray, estimator: Any, seed: int,
+                 noise_kind: str = "gaussian") -> None:
         self.c, self.sigma, self.estimator = c, sigma, estimator
+        self.uniform = noise_kind == "uniform"
         self.rng = np.random.default_rng(seed)
         self.x_hat: list[np.ndarray] = []
         self.d_hat: list[np.ndarray] = []
@@ -283,7 +293,9 @@ class _MeasurementChain:
             estimator.reset()
 
     def __call__(self, x: np.ndarray, u_prev: np.ndarray | None) -> np.ndarray:
-        y = self.c @ x + self.sigma * self.rng.standard_normal(self.c.shape[0])
+        p = self.c.shape[0]
+        draw = self.rng.uniform(-1.0, 1.0, p) if self.uniform else self.rng.standard_normal(p)
+        y = self.c @ x + self.sigma * draw
         if self.estimator is None:
             return y
         x_hat = np.asarray(self.estimator.update(y, u_prev), dtype=float)
@@ -310,9 +322,11 @@ class _MeasurementChain:
 
 def _measurement_chain(
     measurement: ArrayLike | None, noise: float | ArrayLike | None, estimator: Any, seed: int,
-    sensor: Any, n: int,
+    sensor: Any, n: int, noise_kind: str = "gaussian",
 ) -> _MeasurementChain | None:
     """The checked sensor-estimator chain of :func:`simulate`, or ``None`` without ``measurement``."""
+    if noise_kind not in NOISE_KINDS:
+        raise InvalidArgumentError("noise_kind", f"one of {NOISE_KINDS}", repr(noise_kind))
     if measurement is None:
         for name, value in (("noise", noise), ("estimator", estimator)):
             if value is not None:
@@ -338,7 +352,7 @@ def _measurement_chain(
         if c_est is not None and np.shape(c_est) != c.shape:
             raise InvalidArgumentError("estimator", f"an estimator of {p} outputs (measurement's)",
                                        f"one built for C of shape {np.shape(c_est)}")
-    return _MeasurementChain(c, sigma, estimator, int(seed))
+    return _MeasurementChain(c, sigma, estimator, int(seed), noise_kind)
 
 
 def _plant_names(plant: Any, attribute: str, size: int) -> tuple[str, ...]:
