@@ -534,3 +534,18 @@ def test_bad_output_folders_are_named(controllers, tmp_path) -> None:
     with pytest.raises(ArgumentTypeError, match="out_dir: expected a path"):
         export_c(ctrl, 3)
     assert issubclass(InvalidArgumentError, ToolkitError)
+
+
+# -- the timing script ---------------------------------------------------------------------------
+def test_timing_section_times_both_and_agrees(controllers) -> None:
+    """benchmarks.timing.c_export on Kothare's table: both timed, same statuses, sizes reported."""
+    from benchmarks.timing.c_export import time_c_export
+
+    ctrl = controllers["kothare"]
+    states = general_states(ctrl, 300, seed=7)
+    rec = time_c_export(ctrl, states, batches=5, calls=200)
+    assert rec["same_statuses"] and rec["states"] == 300 and rec["n_ellipsoids"] == 10
+    assert 0.0 < rec["c_p50_s"] <= rec["c_p95_s"] and rec["python_p50_s"] > 0.0
+    assert rec["max_abs_diff_u"] <= 1e-12 * rec["max_u"]
+    assert rec["static_bytes"] == rec["table_bytes"] + rec["workspace_bytes"] > 0
+    assert rec["object_file_bytes"] > 0
