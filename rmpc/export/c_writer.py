@@ -32,7 +32,7 @@ import math
 import os
 import textwrap
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -215,7 +215,7 @@ class CProgram:
     defines: tuple[tuple[str, str, str], ...] = ()
     fields: tuple[WorkspaceField, ...] = ()
     helpers: str = ""
-    accessors: tuple[tuple[str, str, str], ...] = field(default_factory=tuple)
+    accessors: tuple[tuple[str, str, str], ...] = ()
 
     def __post_init__(self) -> None:
         for name, value, most in (("RMPC_NX", self.nx, MAX_NX), ("RMPC_NU", self.nu, MAX_NU)):
@@ -288,8 +288,10 @@ def render_header(program: CProgram) -> str:
         "Status codes (every export defines them all); this controller returns:",
         "    " + ", ".join(program.returns) + ".",
         "",
-        "The arithmetic is that of the Python step, one rounding per operation: do not compile",
-        "with -ffast-math or -ffp-contract=fast if the commands must agree with Python's.",
+        "The arithmetic is the Python step's, one rounding per operation, dot products summed",
+        "in index order (numpy's BLAS may sum them in another order: the commands then agree to",
+        "the rounding of a dot product). Do not compile with -ffast-math or -ffp-contract=fast",
+        "if the commands must agree with Python's.",
     ]
     guard = "RMPC_CONTROLLER_H"
     out = [_comment_block(lines), f"#ifndef {guard}", f"#define {guard}", ""]
