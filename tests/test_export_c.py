@@ -467,6 +467,17 @@ def test_result_reports_files_and_static_memory(compiled) -> None:
     assert res.static_bytes == res.table_bytes + res.workspace_bytes
 
 
+@pytest.mark.parametrize("which", ["chain9", "lqr"])
+def test_stricter_warnings_are_clean(which, compiled) -> None:
+    """The warnings flight-software rules often add (conversions, shadowing, float equality...)."""
+    extra = ["-Wconversion", "-Wshadow", "-Wcast-qual", "-Wstrict-prototypes", "-Wmissing-prototypes",
+             "-Wdouble-promotion", "-Wfloat-equal", "-Wundef", "-Wvla"]
+    source = compiled[which].result.source
+    command = [CC, *STRICT, *extra, "-c", "-o", os.devnull, str(source)]
+    run = subprocess.run(command, capture_output=True, text=True)
+    assert run.returncode == 0 and run.stderr == "", run.stderr
+
+
 def test_constants_round_trip_bit_for_bit(controllers, compiled) -> None:
     """Every table entry of the C source reads back as the Python double."""
     ctrl = controllers["satellite"]

@@ -78,7 +78,7 @@ static double rmpc_level(int i, const double *x)
 /* numpy's order for searchsorted: a < b, NaN after every number */
 static int rmpc_less(double a, double b)
 {
-    return a < b || (b != b && a == a);
+    return a < b || (isnan(b) && !isnan(a));
 }
 
 /* v = F_i x */
