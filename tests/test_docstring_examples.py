@@ -89,6 +89,8 @@ MODULES_WITH_EXAMPLES = (
     "rmpc.errors",
     "rmpc.estimators.linear",
     "rmpc.estimators.robust",
+    "rmpc.export",
+    "rmpc.export.c_writer",
     "rmpc.laws.flexible.adaptive_pd",
     "rmpc.laws.flexible.adaptive_smc",
     "rmpc.laws.flexible.attitude_pd",
