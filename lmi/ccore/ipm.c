@@ -26,8 +26,10 @@
 #define KM RMPC_KMAX
 #define KK (RMPC_KMAX * RMPC_KMAX)
 #define NV RMPC_NV
+#define NVP (((RMPC_NV + 4) / 4) * 4) /* rows of P' padded with zero rows (at least one) to a multiple of 4 */
 #define NB RMPC_NB
 #define SZ RMPC_SIZE
+#define SZP (((RMPC_SIZE + 3) / 4) * 4) /* row stride of P' (zero-padded to a multiple of 4) */
 #define CK RMPC_CERT_K
 #define MAXIT (RMPC_MAX_ITER > RMPC_WARM_MAX_ITER ? RMPC_MAX_ITER : RMPC_WARM_MAX_ITER)
 #define STALL_WINDOW 15
@@ -61,12 +63,13 @@ static struct workspace {
     point_t cur, nxt, warm, warm_next, best, stall;
     double s_chol[NB * KK], chol_new[NB * KK];
     double kk[NB * KK], lam[NB * KM];
-    double pt[NV * SZ], qrh[NV * SZ], tau[NV];
+    double pt[NVP * SZP], qrh[NVP * SZP], tau[NV];
     double h[NV * NV], l[NV * NV];
     double basis[RMPC_BASIS];
-    double r0[SZ], rd[NV], rp[SZ], sp[SZ], zp[SZ], gx[SZ], gtz[NV];
-    double u[SZ], ucor[SZ], rpt[SZ], v[SZ], dsa[SZ], dza[SZ], dst[SZ], dzt[SZ], dzt2[SZ],
-        tv[SZ], yv[SZ], err[NV], err2[NV], dx[NV], ddx[NV], wv[NV], vn[NV];
+    /* packed vectors: SZP entries, the padding past SZ always zero (read by dotv) */
+    double r0[SZP], rd[NV], rp[SZP], sp[SZP], zp[SZP], gx[SZP], gtz[NV];
+    double u[SZP], ucor[SZP], rpt[SZP], v[SZP], dsa[SZP], dza[SZP], dst[SZP], dzt[SZP], dzt2[SZP],
+        tv[SZP], yv[SZP], err[NV], err2[NV], dx[NV], ddx[NV], wv[NV], vn[NV];
     double m1[KK], m2[KK], m3[KK], m4[KK];
     double ev[KM], ee[KM], e1[KM], e2[KM];
     double merits[MAXIT + 1][3], ray[MAXIT + 1];
@@ -141,20 +144,31 @@ static double norm2(const double *v, int n)
     return sqrt(s);
 }
 
-static double dot(const double *a, const double *b, int n)
+/* sum of a[t] b[t] over t < n (n a multiple of 4) in four lanes by t mod 4: independent
+ * accumulators that a compiler can keep in one vector register without reordering a sum */
+static double dotv(const double *a, const double *b, int n)
 {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int i = 0;
-    for (; i + 4 <= n; i += 4) {
-        s0 += a[i] * b[i];
-        s1 += a[i + 1] * b[i + 1];
-        s2 += a[i + 2] * b[i + 2];
-        s3 += a[i + 3] * b[i + 3];
+    double c[4] = {0.0, 0.0, 0.0, 0.0};
+    int t;
+    for (t = 0; t < n; t += 4) {
+        c[0] += a[t] * b[t];
+        c[1] += a[t + 1] * b[t + 1];
+        c[2] += a[t + 2] * b[t + 2];
+        c[3] += a[t + 3] * b[t + 3];
     }
-    for (; i < n; ++i) {
-        s0 += a[i] * b[i];
+    return (c[0] + c[1]) + (c[2] + c[3]);
+}
+
+/* sum of a[t] b[t] over from <= t < SZP (zero padding past SZ): a scalar head to a multiple of 4,
+ * then dotv */
+static double dot_from(const double *a, const double *b, int from)
+{
+    double s = 0.0;
+    int t = from;
+    for (; t % 4 != 0; ++t) {
+        s += a[t] * b[t];
     }
-    return (s0 + s1) + (s2 + s3);
+    return s + dotv(a + t, b + t, SZP - t);
 }
 
 static double maxd(double a, double b) { return a > b ? a : b; }
@@ -496,11 +510,11 @@ static int scaling_and_p(void)
             pair_basis(ws.kk + j * KK, k, rmpc_pos_row[q], rmpc_pos_col[q], ws.basis + (q - first) * size);
         }
         for (i = 0; i < NV; ++i) {
-            memset(ws.pt + i * SZ + lo, 0, (size_t)size * sizeof(double));
+            memset(ws.pt + i * SZP + lo, 0, (size_t)size * sizeof(double));
         }
         for (e = rmpc_ent_off[j]; e < rmpc_ent_off[j + 1]; ++e) {
             double v = ws.spv[e];
-            double *row = ws.pt + rmpc_ent_var[e] * SZ + lo;
+            double *row = ws.pt + rmpc_ent_var[e] * SZP + lo;
             const double *src = ws.basis + (rmpc_ent_pos[e] - first) * size;
             for (t = 0; t < size; ++t) {
                 row[t] += v * src[t];
@@ -510,14 +524,48 @@ static int scaling_and_p(void)
     return 1;
 }
 
+/* the dot products of rows i0..i0+3 of P' with rows k0..k0+3 into acc (a 4 x 4 tile: each
+ * loaded entry serves four products), each sum split in four by t mod 4 (independent
+ * accumulators, so that a compiler can use vector registers without reordering a sum) */
+static void tile(const double *pa, const double *pb, double acc[16])
+{
+    int t, r, q, w;
+    double c[16][4];
+    for (r = 0; r < 16; ++r) {
+        for (w = 0; w < 4; ++w) {
+            c[r][w] = 0.0;
+        }
+    }
+    for (t = 0; t < SZP; t += 4) {
+        for (r = 0; r < 4; ++r) {
+            const double *a = pa + r * SZP + t;
+            for (q = 0; q < 4; ++q) {
+                const double *b = pb + q * SZP + t;
+                c[r * 4 + q][0] += a[0] * b[0];
+                c[r * 4 + q][1] += a[1] * b[1];
+                c[r * 4 + q][2] += a[2] * b[2];
+                c[r * 4 + q][3] += a[3] * b[3];
+            }
+        }
+    }
+    for (r = 0; r < 16; ++r) {
+        acc[r] = (c[r][0] + c[r][1]) + (c[r][2] + c[r][3]);
+    }
+}
+
 static void schur_complement(void)
 {
-    int i, k;
-    for (i = 0; i < NV; ++i) {
-        for (k = i; k < NV; ++k) {
-            double s = dot(ws.pt + i * SZ, ws.pt + k * SZ, SZ);
-            ws.h[i * NV + k] = s;
-            ws.h[k * NV + i] = s;
+    int i0, k0, r, q;
+    double acc[16];
+    for (i0 = 0; i0 < NV; i0 += 4) {
+        for (k0 = i0; k0 < NV; k0 += 4) {
+            tile(ws.pt + i0 * SZP, ws.pt + k0 * SZP, acc);
+            for (r = 0; r < 4 && i0 + r < NV; ++r) {
+                for (q = 0; q < 4 && k0 + q < NV; ++q) {
+                    ws.h[(i0 + r) * NV + k0 + q] = acc[r * 4 + q];
+                    ws.h[(k0 + q) * NV + i0 + r] = acc[r * 4 + q];
+                }
+            }
         }
     }
 }
@@ -547,7 +595,7 @@ static void pt_times(const double *v, double *out)
 {
     int i;
     for (i = 0; i < NV; ++i) {
-        out[i] = dot(ws.pt + i * SZ, v, SZ);
+        out[i] = dotv(ws.pt + i * SZP, v, SZP);
     }
 }
 
@@ -558,7 +606,7 @@ static void p_times(const double *dx, double *out)
         out[t] = 0.0;
     }
     for (i = 0; i < NV; ++i) {
-        const double *row = ws.pt + i * SZ;
+        const double *row = ws.pt + i * SZP;
         double a = dx[i];
         for (t = 0; t < SZ; ++t) {
             out[t] += row[t] * a;
@@ -634,8 +682,8 @@ static void householder_apply(double *y, int transpose)
     int step, t;
     for (step = 0; step < NV; ++step) {
         int k = transpose ? step : NV - 1 - step;
-        const double *hk = ws.qrh + k * SZ;
-        double s = y[k] + dot(hk + k + 1, y + k + 1, SZ - k - 1);
+        const double *hk = ws.qrh + k * SZP;
+        double s = y[k] + dot_from(hk, y, k + 1);
         s *= ws.tau[k];
         y[k] -= s;
         for (t = k + 1; t < SZ; ++t) {
@@ -651,8 +699,8 @@ static int householder_qr(void)
     int k, i, t;
     memcpy(ws.qrh, ws.pt, sizeof ws.qrh);
     for (k = 0; k < NV; ++k) {
-        double *hk = ws.qrh + k * SZ;
-        double alpha = hk[k], xnorm = sqrt(dot(hk + k + 1, hk + k + 1, SZ - k - 1)), beta, tau, sc;
+        double *hk = ws.qrh + k * SZP;
+        double alpha = hk[k], xnorm = sqrt(dot_from(hk, hk, k + 1)), beta, tau, sc;
         if (xnorm == 0.0) {
             ws.tau[k] = 0.0;
         } else {
@@ -664,20 +712,23 @@ static int householder_qr(void)
             }
             hk[k] = beta;
             ws.tau[k] = tau;
-            for (i = k + 1; i < NV; ++i) {
-                double *hi = ws.qrh + i * SZ;
-                double s = hi[k] + dot(hk + k + 1, hi + k + 1, SZ - k - 1);
-                s *= tau;
-                hi[k] -= s;
+            for (i = k + 1; i < NV; i += 2) { /* two columns at a time */
+                double *h0 = ws.qrh + i * SZP, *h1 = h0 + SZP;
+                double s0 = h0[k] + dot_from(hk, h0, k + 1), s1 = h1[k] + dot_from(hk, h1, k + 1);
+                s0 *= tau;
+                s1 *= tau;
+                h0[k] -= s0;
+                h1[k] -= s1;
                 for (t = k + 1; t < SZ; ++t) {
-                    hi[t] -= s * hk[t];
+                    h0[t] -= s0 * hk[t];
+                    h1[t] -= s1 * hk[t];
                 }
             }
         }
     }
     for (i = 0; i < NV; ++i) { /* L = R': L[i][t] = R[t][i] = qrh[i][t], t <= i */
         for (t = 0; t < NV; ++t) {
-            double v = t <= i ? ws.qrh[i * SZ + t] : 0.0;
+            double v = t <= i ? ws.qrh[i * SZP + t] : 0.0;
             if (!(v - v == 0.0)) {
                 return 0;
             }
