@@ -120,7 +120,9 @@ def test_kothare_examples_agree(tmp_path: Path, name: str) -> None:
     ctrl = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint)
     csolver = _compile(ctrl, tmp_path)
     a, b = pb.true_plant
-    worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, pb.x0, 15, float(pb.u_max))
+    # 30 of the suite's 40 steps: on example 2 the warm-start chains part by one iteration at
+    # step 32 (rounding), after which u differs by up to 1.7e-6 u_max (gamma by 4e-9)
+    worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, pb.x0, 30, float(pb.u_max))
     assert worst_gamma <= 1e-6
     assert worst_u <= 1e-6
 
