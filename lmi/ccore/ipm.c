@@ -26,7 +26,7 @@
 #define KM RMPC_KMAX
 #define KK (RMPC_KMAX * RMPC_KMAX)
 #define NV RMPC_NV
-#define NVP (((RMPC_NV + 4) / 4) * 4) /* rows of P' padded with zero rows (at least one) to a multiple of 4 */
+#define NVP (((RMPC_NV + 3) / 4) * 4 + 4) /* rows of P' with zero rows past NV (at least 3) */
 #define NB RMPC_NB
 #define SZ RMPC_SIZE
 #define SZP (((RMPC_SIZE + 3) / 4) * 4) /* row stride of P' (zero-padded to a multiple of 4) */
@@ -692,6 +692,48 @@ static void householder_apply(double *y, int transpose)
     }
 }
 
+/* H_k = I - tau v v' (v = [1; hk[k+1:]]) applied to the four columns of P stored as the rows
+ * h, h + SZP, h + 2 SZP, h + 3 SZP of P' (entries k.. of each) */
+static void reflect4(const double *restrict hk, double *restrict h, int k, double tau)
+{
+    double c[4][4] = {{0.0}}, s[4];
+    double *restrict h0 = h, *restrict h1 = h + SZP, *restrict h2 = h + 2 * SZP, *restrict h3 = h + 3 * SZP;
+    int t = k + 1, r, w;
+    for (r = 0; r < 4; ++r) {
+        s[r] = 0.0;
+    }
+    for (; t % 4 != 0; ++t) {
+        s[0] += hk[t] * h0[t];
+        s[1] += hk[t] * h1[t];
+        s[2] += hk[t] * h2[t];
+        s[3] += hk[t] * h3[t];
+    }
+    for (; t < SZP; t += 4) {
+        for (w = 0; w < 4; ++w) {
+            double v = hk[t + w];
+            c[0][w] += v * h0[t + w];
+            c[1][w] += v * h1[t + w];
+            c[2][w] += v * h2[t + w];
+            c[3][w] += v * h3[t + w];
+        }
+    }
+    s[0] = tau * (h0[k] + (s[0] + ((c[0][0] + c[0][1]) + (c[0][2] + c[0][3]))));
+    s[1] = tau * (h1[k] + (s[1] + ((c[1][0] + c[1][1]) + (c[1][2] + c[1][3]))));
+    s[2] = tau * (h2[k] + (s[2] + ((c[2][0] + c[2][1]) + (c[2][2] + c[2][3]))));
+    s[3] = tau * (h3[k] + (s[3] + ((c[3][0] + c[3][1]) + (c[3][2] + c[3][3]))));
+    h0[k] -= s[0];
+    h1[k] -= s[1];
+    h2[k] -= s[2];
+    h3[k] -= s[3];
+    for (t = k + 1; t < SZ; ++t) {
+        double v = hk[t];
+        h0[t] -= s[0] * v;
+        h1[t] -= s[1] * v;
+        h2[t] -= s[2] * v;
+        h3[t] -= s[3] * v;
+    }
+}
+
 /* Householder QR of P (LAPACK's dgeqrf conventions): reflectors in ws.qrh, R' into ws.l.
  * Returns 0 if R is singular or not finite. */
 static int householder_qr(void)
@@ -712,17 +754,8 @@ static int householder_qr(void)
             }
             hk[k] = beta;
             ws.tau[k] = tau;
-            for (i = k + 1; i < NV; i += 2) { /* two columns at a time */
-                double *h0 = ws.qrh + i * SZP, *h1 = h0 + SZP;
-                double s0 = h0[k] + dot_from(hk, h0, k + 1), s1 = h1[k] + dot_from(hk, h1, k + 1);
-                s0 *= tau;
-                s1 *= tau;
-                h0[k] -= s0;
-                h1[k] -= s1;
-                for (t = k + 1; t < SZ; ++t) {
-                    h0[t] -= s0 * hk[t];
-                    h1[t] -= s1 * hk[t];
-                }
+            for (i = k + 1; i < NV; i += 4) { /* four columns at a time (zero rows past NV) */
+                reflect4(hk, ws.qrh + i * SZP, k, tau);
             }
         }
     }
@@ -1415,6 +1448,12 @@ static void apply_gain(const double *x, double *u, double *F)
             F[a] = ws.has_gain ? ws.gain[a] : 0.0;
         }
     }
+}
+
+int kothare_apply_gain(const double *x, double *u)
+{
+    apply_gain(x, u, NULL);
+    return ws.has_gain;
 }
 
 int kothare_solve(const double *x, double *u, double *F, double *gamma, int *iterations)

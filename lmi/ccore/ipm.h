@@ -19,6 +19,7 @@
 #define RMPC_STATUS_NONFINITE_X 5        /* NaN or inf in x: nothing solved, u = 0 */
 #define RMPC_STATUS_INACCURATE 6         /* stalled at reduced accuracy (Python's "inaccurate") */
 #define RMPC_STATUS_ZERO_STATE 7         /* x = 0: the problem is degenerate, u = 0 */
+#define RMPC_STATUS_HELD 8               /* rmpc_step near x_ref (hold radius): no solve, u = F_last x */
 
 /* Solve at the state x (RMPC_NX entries). On status 0, u = F x with the new certified gain F
  * (RMPC_NU x RMPC_NX, row-major) and gamma the certified bound; otherwise u = F_last x with the
@@ -29,6 +30,9 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
 /* Forget everything: the warm start, the equilibration (recomputed at the next solve, as a new
  * Python back-end does at its first solve) and the last certified gain. */
 void kothare_reset(void);
+
+/* u = F_last x with the last certified gain (zero before any); 1 if there is one, else 0. */
+int kothare_apply_gain(const double *x, double *u);
 
 /* Forget only the warm-start point (the next solve starts cold). */
 void kothare_reset_warm_start(void);
