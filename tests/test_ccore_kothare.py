@@ -128,6 +128,25 @@ def test_kothare_examples_agree(tmp_path: Path, name: str) -> None:
 
 
 @pytest.mark.parametrize("kind", ["peak", "ellipsoid"])
+def test_output_bounds_agree(tmp_path: Path, kind: str) -> None:
+    """Paper P with an input bound and rate bounds (``|omega_i| <= 0.05, 0.06, 0.08`` over every vertex)."""
+    from models import RigidSatellite
+    from rmpc import RMPC
+
+    sat = RigidSatellite.paper_p()
+    x0 = sat.initial_state()
+    plant = sat.polytope(x0, 0.1, 0.3, "scalar")
+    ctrl = RMPC(plant, np.diag([1.0, 1.0, 1.0, 0.1, 0.1, 0.1]), np.diag([0.01] * 3), u_max=1.0,
+                input_constraint=kind, output_matrix=np.hstack([np.zeros((3, 3)), np.eye(3)]),
+                y_max=[0.05, 0.06, 0.08])
+    csolver = _compile(ctrl, tmp_path)
+    a, b = plant.nominal
+    worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, x0, 8, 1.0)
+    assert worst_gamma <= 1e-6
+    assert worst_u <= 1e-6
+
+
+@pytest.mark.parametrize("kind", ["peak", "ellipsoid"])
 def test_far_state_proved_infeasible(tmp_path: Path, kind: str) -> None:
     ctrl = _unstable(kind)
     csolver = _compile(ctrl, tmp_path)
