@@ -151,6 +151,14 @@ def test_far_state_proved_infeasible(tmp_path: Path, kind: str) -> None:
     ctrl = _unstable(kind)
     csolver = _compile(ctrl, tmp_path)
     near, far = np.array([0.1, 0.05]), np.array([100.0, 50.0])
+    # first far out, where the first solve weights the blocks
+    fresh = _unstable(kind)
+    csolver_far = _compile(fresh, tmp_path / "fresh")
+    sol = fresh.solve(far * 100.0)
+    status, _, u, _, info = csolver_far.solve(far * 100.0)
+    assert sol.status == "infeasible" and status == STATUS_CODES["infeasible"] and info[6] >= 1e8
+    assert np.all(u == 0.0)  # no certified gain yet
+    assert min(fresh.problem._backend._solver.block_weights) < 0.01
     sol = ctrl.solve(near)
     status, gamma, u_near, _, _ = csolver.solve(near)
     assert (sol.status, status) == ("optimal", STATUS_CODES["optimal"])
@@ -163,6 +171,27 @@ def test_far_state_proved_infeasible(tmp_path: Path, kind: str) -> None:
     assert np.isnan(gamma)
     # u: the last certified gain (the near state's) times x
     np.testing.assert_allclose(u, u_near / near[0] * far[0], rtol=1e-12)
+
+
+def test_block_weights_at_a_far_first_state(tmp_path: Path) -> None:
+    """A first solve far out fixes block weights other than 1 (lmi.ipm.blocks.block_weights),
+    in C as in Python: Kothare's example 1 at 1e5 x0 (weights down to 2^-7)."""
+    from benchmarks.suites.methods_problems import build_problem
+    from rmpc import RMPC
+
+    pb = build_problem("kothare_ex1")
+    ctrl = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint)
+    csolver = _compile(ctrl, tmp_path)
+    x = pb.x0 * 1e5
+    for _ in range(3):
+        sol = ctrl.solve(x)
+        status, gamma, u, its, _ = csolver.solve(x)
+        assert (sol.status, status) == ("optimal", 0)
+        assert its == sol.iterations  # the same start point and path (50 iterations cold)
+        assert abs(gamma - sol.gamma) <= 1e-6 * sol.gamma
+        assert np.max(np.abs(u - sol.F @ x)) <= 1e-6 * pb.u_max
+        x = 0.9 * x
+    assert min(ctrl.problem._backend._solver.block_weights) < 0.01
 
 
 def test_bad_states_give_a_status_and_a_finite_u(tmp_path: Path) -> None:
