@@ -203,11 +203,16 @@ def test_bad_states_give_a_status_and_a_finite_u(tmp_path: Path) -> None:
         assert np.all(u == 0.0)
     status, _, u, _, _ = csolver.solve(np.zeros(6))
     assert status == STATUS_CODES["zero_state"] and np.all(u == 0.0)
+    status, _, u, _, _ = csolver.solve(np.array([1e300, -1e300, 1e300, 0, 0, 0]))  # |x| overflows
+    assert status == STATUS_CODES["nonfinite_x"] and np.all(u == 0.0)
     assert csolver.solve(x0)[0] == 0
     x_bad = x0.copy()
     x_bad[2] = np.nan
     status, _, u, _, _ = csolver.solve(x_bad)
     assert status == STATUS_CODES["nonfinite_x"] and np.all(np.isfinite(u))
+    # after a certified gain too: a state whose norm overflows (1e200^2) gets no command
+    status, _, u, _, _ = csolver.solve(np.array([0.0, 1e200, 0.0, 0.0, 0.0, 0.0]))
+    assert status == STATUS_CODES["nonfinite_x"] and np.all(u == 0.0)
 
 
 def test_header_holds_the_python_data_bit_for_bit() -> None:
@@ -279,8 +284,33 @@ def test_dense_kernels_match_numpy(tmp_path: Path) -> None:
                              e3.ctypes.data_as(_D), work3.ctypes.data_as(_D)) == -1
 
 
-def test_sanitizer_build_runs_clean(tmp_path: Path) -> None:
-    ctrl, plant, x0 = _paper_p_e1()
+def _sanitizer_case(name: str) -> tuple[object, list[np.ndarray], float]:
+    """A controller, the states of a Python run (its solves' order) and the input scale."""
+    from benchmarks.suites.methods_problems import build_problem
+    from rmpc import RMPC
+
+    if name == "e1":
+        ctrl, plant, x = _paper_p_e1()
+        a, b = plant.nominal
+        states = []
+        for _ in range(8):
+            states.append(x.copy())
+            x = a @ x + b @ (ctrl.solve(x).F @ x)
+        ctrl.reset()
+        return ctrl, states, 1.0
+    if name == "kothare_ex1_far":  # scaled coordinates, peak bound, block weights
+        pb = build_problem("kothare_ex1")
+        ctrl = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint)
+        return ctrl, [pb.x0 * 1e5, pb.x0 * 9e4, pb.x0], float(pb.u_max)
+    ctrl = _unstable("ellipsoid")  # a solve, then a proof of infeasibility
+    return ctrl, [np.array([0.1, 0.05]), np.array([100.0, 50.0])], 1.0
+
+
+@pytest.mark.parametrize("name", ["e1", "kothare_ex1_far", "unstable"])
+def test_sanitizer_build_runs_clean(tmp_path: Path, name: str) -> None:
+    """The driver (``lmi/ccore/driver.c``) built with ``-fsanitize=address,undefined`` runs the
+    comparison with the Python path clean, non-finite and zero states included."""
+    ctrl, states, u_scale = _sanitizer_case(name)
     write_solver(ctrl, tmp_path)
     shutil.copyfile(_HERE / "driver.c", tmp_path / "driver.c")
     exe = tmp_path / "driver"
@@ -290,29 +320,24 @@ def test_sanitizer_build_runs_clean(tmp_path: Path) -> None:
     if build.returncode != 0 and "sanitize" in build.stderr:
         pytest.skip(f"no sanitizer runtime here: {build.stderr.strip()[:200]}")
     assert build.returncode == 0, build.stderr
-    a, b = plant.nominal
-    states, expected = [], []
-    x = x0.copy()
-    for _ in range(8):
-        sol = ctrl.solve(x)
-        states.append(x.copy())
-        expected.append((sol.gamma, sol.F @ x))
-        x = a @ x + b @ (sol.F @ x)
-    states.append(np.full(6, np.nan))
-    states.append(np.zeros(6))
-    np.savetxt(tmp_path / "states.txt", np.array(states))
+    expected = [ctrl.solve(x) for x in states]
+    n, m = states[0].size, ctrl.plant.n_inputs
+    rows = np.array([*states, np.full(n, np.nan), np.zeros(n)])
+    np.savetxt(tmp_path / "states.txt", rows)
     run = subprocess.run([str(exe), str(tmp_path / "states.txt")], capture_output=True, text=True,
                          env={"ASAN_OPTIONS": "detect_leaks=0", "UBSAN_OPTIONS": "halt_on_error=1"})
     assert run.returncode == 0, run.stderr
     assert run.stderr == ""
     lines = [line.split() for line in run.stdout.splitlines()]
-    assert len(lines) == len(states)
-    for (gamma_py, u_py), fields in zip(expected, lines[:8], strict=True):
-        assert int(fields[0]) == 0
-        assert abs(float(fields[1]) - gamma_py) <= 1e-6 * gamma_py
-        assert np.max(np.abs(np.array(fields[3:6], dtype=float) - u_py)) <= 1e-6
-    assert int(lines[8][0]) == STATUS_CODES["nonfinite_x"] and int(lines[9][0]) == STATUS_CODES["zero_state"]
-    assert all(np.isfinite(np.array(f[3:6], dtype=float)).all() for f in lines[8:])
+    assert len(lines) == len(rows)
+    for x, sol, fields in zip(states, expected, lines, strict=False):
+        assert int(fields[0]) == STATUS_CODES[sol.status]
+        if sol.status == "optimal":
+            assert abs(float(fields[1]) - sol.gamma) <= 1e-6 * sol.gamma
+            assert np.max(np.abs(np.array(fields[3:3 + m], dtype=float) - sol.F @ x)) <= 1e-6 * u_scale
+    assert int(lines[-2][0]) == STATUS_CODES["nonfinite_x"]
+    assert int(lines[-1][0]) == STATUS_CODES["zero_state"]
+    assert all(np.isfinite(np.array(f[3:3 + m], dtype=float)).all() for f in lines)
 
 
 def test_generator_refusals(tmp_path: Path) -> None:

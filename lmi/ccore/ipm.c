@@ -1443,6 +1443,14 @@ static void apply_gain(const double *x, double *u, double *F)
         }
         u[a] = s;
     }
+    for (a = 0; a < RMPC_NU; ++a) {
+        if (!(u[a] - u[a] == 0.0)) { /* F x overflowed: no command rather than inf or NaN */
+            for (b = 0; b < RMPC_NU; ++b) {
+                u[b] = 0.0;
+            }
+            break;
+        }
+    }
     if (F != NULL) {
         for (a = 0; a < RMPC_NU * RMPC_NX; ++a) {
             F[a] = ws.has_gain ? ws.gain[a] : 0.0;
@@ -1481,6 +1489,10 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
         }
     }
     scale = norm2(x, n);
+    if (!(scale < HUGE_VAL)) { /* so large that its norm overflows: treated as non-finite */
+        apply_gain(NULL, u, F);
+        return RMPC_STATUS_NONFINITE_X;
+    }
     if (scale == 0.0) {
         apply_gain(NULL, u, F);
         return RMPC_STATUS_ZERO_STATE;

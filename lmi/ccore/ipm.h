@@ -16,7 +16,7 @@
 #define RMPC_STATUS_MAX_ITERATIONS 2     /* iteration limit */
 #define RMPC_STATUS_NUMERICAL_ERROR 3    /* breakdown or stall (insufficient progress) */
 #define RMPC_STATUS_CERTIFICATE_FAILED 4 /* converged, but an LMI recomputed at the answer fails */
-#define RMPC_STATUS_NONFINITE_X 5        /* NaN or inf in x: nothing solved, u = 0 */
+#define RMPC_STATUS_NONFINITE_X 5        /* NaN or inf in x (or |x| overflows): nothing solved, u = 0 */
 #define RMPC_STATUS_INACCURATE 6         /* stalled at reduced accuracy (Python's "inaccurate") */
 #define RMPC_STATUS_ZERO_STATE 7         /* x = 0: the problem is degenerate, u = 0 */
 #define RMPC_STATUS_HELD 8               /* rmpc_step near x_ref (hold radius): no solve, u = F_last x */
@@ -24,7 +24,7 @@
 /* Solve at the state x (RMPC_NX entries). On status 0, u = F x with the new certified gain F
  * (RMPC_NU x RMPC_NX, row-major) and gamma the certified bound; otherwise u = F_last x with the
  * last certified gain (zero before any, and for a non-finite x), F = F_last (or zeros), gamma
- * NaN. u is never NaN. F and gamma may be NULL. Returns the status. */
+ * NaN. u is never NaN or inf (zero if F x overflows). F and gamma may be NULL. Returns the status. */
 int kothare_solve(const double *x, double *u, double *F, double *gamma, int *iterations);
 
 /* Forget everything: the warm start, the equilibration (recomputed at the next solve, as a new
