@@ -79,6 +79,17 @@ def test_the_distribution_holds_the_toolkit() -> None:
     assert "benchmarks.cli" in shipped_modules()  # the ``rmpc`` command
 
 
+def test_the_distribution_holds_the_c_core() -> None:
+    """The C sources of :mod:`lmi.ccore` are package data (``write_solver`` copies them from the
+    installed package): every ``.c`` and ``.h`` there matches a pattern of ``lmi``'s."""
+    config = read_configuration(ROOT / "pyproject.toml", expand=True)
+    assert "lmi.ccore" in config["tool"]["setuptools"]["packages"]
+    patterns = config["tool"]["setuptools"]["package-data"]["lmi"]
+    sources = sorted(p.relative_to(ROOT / "lmi").as_posix() for p in (ROOT / "lmi" / "ccore").glob("*.[ch]"))
+    assert {"ccore/ipm.c", "ccore/ipm.h", "ccore/dense.c", "ccore/dense.h", "ccore/driver.c"} <= set(sources)
+    assert [s for s in sources if not any(Path(s).match(p) for p in patterns)] == []
+
+
 def test_the_distribution_holds_no_development_tool() -> None:
     packages = shipped_packages()
     assert [p for p in packages if package_of(p) not in PACKAGES] == []

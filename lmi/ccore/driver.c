@@ -1,0 +1,49 @@
+/* A small driver of the C core (lmi/ccore): reads states (RMPC_NX numbers a line) from the file
+ * given as the first argument, solves at each with kothare_solve, and prints a line per state:
+ * status, gamma, iterations, u (RMPC_NU entries, %.17g) and the solve's wall time in ns
+ * and its thread CPU time in ns (clock_gettime, CLOCK_MONOTONIC and CLOCK_THREAD_CPUTIME_ID). Used by the sanitizer test and the timing script. */
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <time.h>
+
+#include "rmpc_problem.h"
+#include "ipm.h"
+
+int main(int argc, char **argv)
+{
+    FILE *in;
+    double x[RMPC_NX], u[RMPC_NU], gamma;
+    int it, i, status;
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s STATES\n", argv[0]);
+        return 2;
+    }
+    in = fopen(argv[1], "r");
+    if (in == NULL) {
+        fprintf(stderr, "%s: cannot open %s\n", argv[0], argv[1]);
+        return 2;
+    }
+    kothare_reset();
+    for (;;) {
+        struct timespec t0, t1, c0, c1;
+        long ns, cpu;
+        for (i = 0; i < RMPC_NX; ++i) {
+            if (fscanf(in, "%lf", &x[i]) != 1) {
+                fclose(in);
+                return 0;
+            }
+        }
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        status = kothare_solve(x, u, NULL, &gamma, &it);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
+        ns = (long)(t1.tv_sec - t0.tv_sec) * 1000000000L + (t1.tv_nsec - t0.tv_nsec);
+        cpu = (long)(c1.tv_sec - c0.tv_sec) * 1000000000L + (c1.tv_nsec - c0.tv_nsec);
+        printf("%d %.17g %d", status, gamma, it);
+        for (i = 0; i < RMPC_NU; ++i) {
+            printf(" %.17g", u[i]);
+        }
+        printf(" %ld %ld\n", ns, cpu);
+    }
+}

@@ -1,0 +1,380 @@
+"""Write the problem header of the C core for one Kothare problem (:mod:`lmi.ccore`).
+
+:func:`problem_header` turns the data the Python path solves (the blocks ``C_j``, ``A_ij`` of
+:class:`lmi.backends.ipm.IPMKothare` in its state coordinates, the bound-scaled entries, the
+solver's settings, and the original :class:`lmi.KothareData` for the certificate) into
+``rmpc_problem.h``: sizes as macros (``RMPC_NX``, ``RMPC_NU``, ``RMPC_NV``, the block orders...)
+and the data as ``static const`` arrays of exact C99 hexadecimal literals (``float.hex``: every
+double round-trips bit for bit). ``ipm.c`` includes it, so one source serves every size.
+:func:`write_solver` writes that header next to copies of the C sources.
+
+The coefficient entries are the non-zero upper-triangle entries of each block, ordered by block,
+then packed position (row by row, as ``numpy.triu_indices``), then variable: the order in which
+:func:`lmi.ipm.kernels.scaling_and_schur_rows` accumulates each row of ``P'``.
+"""
+
+from __future__ import annotations
+
+import shutil
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from toolkit_common.errors import InvalidArgumentError
+
+__all__ = ["LIMITS", "SOURCES", "STATUS_CODES", "controller_source", "problem_header", "write_solver"]
+
+#: The C sources the header goes with (package data of :mod:`lmi.ccore`).
+SOURCES = ("ipm.c", "ipm.h", "dense.c", "dense.h")
+
+#: The status codes of ``kothare_solve`` (``ipm.h`` defines them as ``RMPC_STATUS_*``).
+STATUS_CODES: dict[str, int] = {
+    "optimal": 0,
+    "infeasible": 1,
+    "max_iterations": 2,
+    "numerical_error": 3,
+    "certificate_failed": 4,
+    "nonfinite_x": 5,
+    "inaccurate": 6,
+    "zero_state": 7,
+    "held": 8,
+}
+
+#: Sizes the C core accepts: variables, block order, blocks (the workspace grows as
+#: ``variables x packed size``; the certificate's vertex LMI has order ``2 n + p + m``).
+LIMITS = {"variables": 600, "order": 64, "blocks": 64}
+
+
+def _lit(value: float) -> str:
+    value = float(value)
+    if np.isnan(value):
+        raise InvalidArgumentError("problem", "finite data", "NaN")
+    if np.isinf(value):
+        return "HUGE_VAL" if value > 0 else "(-HUGE_VAL)"
+    return value.hex()
+
+
+def _doubles(name: str, values: Any) -> str:
+    flat = np.asarray(values, dtype=float).ravel()
+    if flat.size == 0:
+        flat = np.zeros(1)
+    body = ",\n    ".join(", ".join(_lit(v) for v in flat[i:i + 4]) for i in range(0, flat.size, 4))
+    return f"static const double {name}[{flat.size}] = {{\n    {body}\n}};\n"
+
+
+def _ints(name: str, values: Any) -> str:
+    flat = np.asarray(values, dtype=np.int64).ravel()
+    if flat.size == 0:
+        flat = np.zeros(1, dtype=np.int64)
+    body = ",\n    ".join(", ".join(str(int(v)) for v in flat[i:i + 16]) for i in range(0, flat.size, 16))
+    return f"static const int {name}[{flat.size}] = {{\n    {body}\n}};\n"
+
+
+def _backend(problem: Any) -> Any:
+    """The :class:`~lmi.backends.ipm.IPMKothare` of ``problem`` (a :class:`lmi.KothareProblem`,
+    an :class:`rmpc.RMPC` of Kothare's form, or the back-end itself), checked."""
+    from lmi.backends.ipm import IPMKothare
+
+    backend = problem
+    for attr in ("problem", "_backend"):
+        if not isinstance(backend, IPMKothare) and hasattr(backend, attr):
+            backend = getattr(backend, attr)
+    if not isinstance(backend, IPMKothare):
+        raise InvalidArgumentError(
+            "problem", "a KothareProblem with backend='ipm' (or an RMPC of Kothare's form, or IPMKothare)",
+            type(problem).__name__ if backend is problem else type(backend).__name__)
+    if backend.nesting:
+        raise InvalidArgumentError("problem", "the on-line problem (no nesting block)", "nesting=True")
+    if backend._t.ndim != 1:
+        raise InvalidArgumentError("problem", "diagonal state coordinates (no rebalanced retry yet)",
+                                   "a rebalanced (full) coordinate change")
+    return backend
+
+
+def problem_header(problem: Any) -> str:
+    """The text of ``rmpc_problem.h`` for ``problem``.
+
+    Parameters
+    ----------
+    problem : KothareProblem, RMPC or IPMKothare
+        A Kothare problem solved by the ``"ipm"`` back-end (with an :class:`rmpc.RMPC` of
+        Kothare's form, its problem; the state is the deviation ``x - x_ref``, here ``x``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``problem``: another back-end or form, the nesting block of the off-line design,
+        a rebalanced coordinate change, or sizes beyond :data:`LIMITS`.
+    """
+    backend = _backend(problem)
+    cert_tol = float(getattr(getattr(problem, "problem", problem), "certificate_tol", 1e-7))
+    data = backend.original_data
+    solver = backend._solver
+    conic = backend.conic
+    blocks = backend._base_blocks
+    n, m, nv = data.n, data.m, solver.n
+    orders = [c.shape[0] for c, _ in blocks]
+    kmax = max(orders)
+    p_rows = data.Q1h.shape[0]
+    cert_k = 2 * n + p_rows + m
+    for label, value, limit in (("variables", nv, LIMITS["variables"]),
+                                ("order", max(kmax, cert_k), LIMITS["order"]),
+                                ("blocks", len(blocks), LIMITS["blocks"])):
+        if value > limit:
+            raise InvalidArgumentError("problem", f"at most {limit} {label} for the C core", f"{value}")
+    if orders[0] != n + 1 or np.any(blocks[0][0] != 0.0):
+        raise InvalidArgumentError("problem", "the state LMI as its first block", f"order {orders[0]}")
+    n_ub = int(data.u_max.size)
+    n_yb = int(data.y_max.size)
+    # bound index of every entry: -1 none, else into [u bounds, y bounds]
+    bound_of: dict[int, np.ndarray] = {}
+    for j, parts in backend._scaled_blocks:
+        idx = np.full((orders[j], orders[j]), -1, dtype=np.int64)
+        for mask, b_idx, kind in parts:
+            if kind == "u":
+                idx[mask] = 0 if n_ub == 1 else int(b_idx)
+            else:
+                idx[mask] = n_ub + (0 if n_yb == 1 else int(b_idx))
+        bound_of[j] = idx
+    offsets = [0]
+    const_vals: list[float] = []
+    ent_off, ent_var, ent_pos, ent_val, ent_bound = [0], [], [], [], []
+    pos_off, pos_row, pos_col = [0], [], []
+    for j, (const, coef) in enumerate(blocks):
+        k = orders[j]
+        iu0, iu1 = np.triu_indices(k)
+        offsets.append(offsets[-1] + iu0.size)
+        const_vals.extend(const[iu0, iu1].tolist())
+        for a, b in zip(iu0, iu1, strict=True):
+            nz = np.flatnonzero(coef[:, a, b] != 0.0)
+            if nz.size:
+                pos_row.append(int(a))
+                pos_col.append(int(b))
+            for i in nz:
+                ent_var.append(int(i))
+                ent_pos.append(len(pos_row) - 1)
+                ent_val.append(float(coef[i, a, b]))
+                ent_bound.append(int(bound_of[j][a, b]) if j in bound_of else -1)
+        ent_off.append(len(ent_var))
+        pos_off.append(len(pos_row))
+    ent_t = []  # the packed row of each entry
+    for j in range(len(blocks)):
+        for e in range(ent_off[j], ent_off[j + 1]):
+            a, b = pos_row[ent_pos[e]], pos_col[ent_pos[e]]
+            k = orders[j]
+            ent_t.append(offsets[j] + a * k - (a * (a - 1)) // 2 + (b - a))
+    max_pos_size = max((pos_off[j + 1] - pos_off[j]) * (offsets[j + 1] - offsets[j])
+                       for j in range(len(blocks)))
+    copies = solver._copies()
+
+    def affine_map(aff: Any) -> tuple[list[int], list[int], list[float]]:
+        coef = aff.coef  # (nv + 1, r, c)
+        cells, var, val = [], [], []
+        cols = coef.shape[2]
+        for i, a, b in zip(*np.nonzero(coef[1:]), strict=True):
+            cells.append(int(a) * cols + int(b))
+            var.append(int(i))
+            val.append(float(coef[1 + i, a, b]))
+        if np.any(coef[0] != 0.0):
+            raise InvalidArgumentError("problem", "Q and Y linear in the variables", "a constant part")
+        return cells, var, val
+
+    q_cells, q_var, q_val = affine_map(conic.q_affine)
+    y_cells, y_var, y_val = affine_map(conic.y_affine)
+    kind = {None: 0, "ellipsoid": 1, "peak": 2}[data.input_constraint]
+    p_out = 0 if data.C_out is None else data.C_out.shape[0]
+    t = backend._t
+    scaled = bool(np.any(t != 1.0))
+    gamma_div = 1.0 if data.formulation == "standard" else float(data.dt)
+    if not (np.array_equal(conic.objective[:1], [1.0]) and not np.any(conic.objective[1:])):
+        raise InvalidArgumentError("problem", "the objective gamma_s (the first variable)",
+                                   "another objective")
+    opts = backend._solver_options
+    macros = {
+        "RMPC_NX": n, "RMPC_NU": m, "RMPC_NV": nv, "RMPC_NB": len(blocks), "RMPC_KMAX": kmax,
+        "RMPC_SIZE": offsets[-1], "RMPC_NENT": len(ent_var), "RMPC_NPOS": len(pos_row),
+        "RMPC_BASIS": max_pos_size, "RMPC_NUB": n_ub, "RMPC_NYB": n_yb,
+        "RMPC_NBOUND": max(1, n_ub + n_yb), "RMPC_NQMAP": len(q_var), "RMPC_NYMAP": len(y_var),
+        "RMPC_NVERT": data.n_vertices, "RMPC_P1": p_rows, "RMPC_POUT": p_out, "RMPC_CERT_K": cert_k,
+        "RMPC_INPUT_KIND": kind, "RMPC_SCALED": int(scaled), "RMPC_DEGREE": int(sum(orders)),
+        "RMPC_MAX_ITER": int(opts["max_iter"]), "RMPC_WARM_MAX_ITER": int(opts["warm_max_iter"]),
+        "RMPC_WARM_START": int(backend._warm_start),
+    }
+    reals = {
+        "RMPC_TOL_FEAS": solver.tol_feas, "RMPC_TOL_GAP_ABS": solver.tol_gap_abs,
+        "RMPC_TOL_GAP_REL": solver.tol_gap_rel, "RMPC_WARM_GAP": solver.warm_gap,
+        "RMPC_WARM_FEAS": solver.warm_feas, "RMPC_INF_RADIUS": solver.infeasibility_radius,
+        "RMPC_QR_SWITCH": solver.qr_switch(), "RMPC_GAMMA_DIV": gamma_div, "RMPC_DT": float(data.dt),
+        "RMPC_CERT_TOL": cert_tol,
+    }
+    out = [
+        "/* Generated by lmi.ccore.generate: the data of one Kothare problem for ipm.c. Do not edit. */\n",
+        "#ifndef RMPC_PROBLEM_H\n#define RMPC_PROBLEM_H\n\n#include <math.h>\n\n",
+    ]
+    out += [f"#define {key} {value}\n" for key, value in macros.items()]
+    out += [f"#define {key} ({_lit(value)})\n" for key, value in reals.items()]
+    out.append("\n")
+    out.append(_ints("rmpc_order", orders))
+    out.append(_ints("rmpc_offset", offsets))
+    out.append(_ints("rmpc_copies", copies))
+    out.append(_doubles("rmpc_const", const_vals))
+    out.append(_ints("rmpc_ent_off", ent_off))
+    out.append(_ints("rmpc_ent_var", ent_var))
+    out.append(_ints("rmpc_ent_pos", ent_pos))
+    out.append(_ints("rmpc_ent_t", ent_t))
+    out.append(_ints("rmpc_ent_bound", ent_bound))
+    out.append(_doubles("rmpc_ent_val", ent_val))
+    out.append(_ints("rmpc_pos_off", pos_off))
+    out.append(_ints("rmpc_pos_row", pos_row))
+    out.append(_ints("rmpc_pos_col", pos_col))
+    out.append(_doubles("rmpc_c", conic.objective))
+    out.append(_doubles("rmpc_t", t))
+    out.append(_doubles("rmpc_bound", np.concatenate([data.u_max, data.y_max]) if n_ub + n_yb else [1.0]))
+    out.append(_ints("rmpc_q_cell", q_cells))
+    out.append(_ints("rmpc_q_var", q_var))
+    out.append(_doubles("rmpc_q_val", q_val))
+    out.append(_ints("rmpc_y_cell", y_cells))
+    out.append(_ints("rmpc_y_var", y_var))
+    out.append(_doubles("rmpc_y_val", y_val))
+    # the certificate's data (lmi.certificate.certify), in the original coordinates
+    out.append(_doubles("rmpc_cert_a", data.A))
+    out.append(_doubles("rmpc_cert_b", data.B))
+    out.append(_doubles("rmpc_cert_q1h", data.Q1h))
+    out.append(_doubles("rmpc_cert_rh", data.Rh))
+    out.append(_doubles("rmpc_cert_cout", data.C_out if data.C_out is not None else []))
+    out.append("\n#endif\n")
+    return "".join(out)
+
+
+def controller_source(controller: Any) -> str:
+    """The text of ``rmpc_online.c``: the controller interface of an :class:`rmpc.RMPC` on the C core.
+
+    ``rmpc_init()`` forgets the warm start, the equilibration and the last gain
+    (``kothare_reset``); ``rmpc_step(x, u)`` follows :meth:`rmpc.RMPC.step` for Kothare's form:
+    ``z = x - x_ref``; within the controller's ``hold_radius`` of ``x_ref`` no solve, ``u = F_last z``
+    and status ``RMPC_STATUS_HELD``; else ``kothare_solve(z, ...)`` (its status; ``u`` its certified
+    ``F z`` or the fallback ``F_last z``). ``rmpc_last_gamma()`` (NaN after a failed or held step)
+    and ``rmpc_last_iterations()`` report the last step. Compile it with ``ipm.c`` and ``dense.c``.
+
+    Parameters
+    ----------
+    controller : RMPC
+        Of Kothare's form on the ``"ipm"`` back-end, without a set-point's input or offset-free
+        action and with ``resolve_threshold = 1`` (a solve at every step).
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``controller`` for anything else.
+    """
+    # duck-typed: lmi does not import rmpc (the dependency runs rmpc -> lmi)
+    needed = ("problem", "x_ref", "u_ref", "hold_radius", "resolve_threshold", "offset_free")
+    if not all(hasattr(controller, name) for name in needed):
+        raise InvalidArgumentError("controller", "an rmpc.RMPC", type(controller).__name__)
+    _backend(controller)
+    if controller.offset_free or np.any(controller.u_ref != 0.0):
+        raise InvalidArgumentError("controller", "no set-point input and no offset-free action",
+                                   "a target input u_s")
+    if controller.resolve_threshold < 1.0:
+        raise InvalidArgumentError("controller", "resolve_threshold = 1 (a solve at every step)",
+                                   repr(controller.resolve_threshold))
+    x_ref = ", ".join(_lit(v) for v in controller.x_ref)
+    return f"""/* Generated by lmi.ccore.generate: rmpc_step of one rmpc.RMPC on the C core. Do not edit. */
+#include "rmpc_problem.h"
+
+#include <math.h>
+
+#include "ipm.h"
+
+#define RMPC_HOLD_RADIUS ({_lit(controller.hold_radius)})
+
+int rmpc_init(void);
+int rmpc_step(const double *x, double *u);
+double rmpc_last_gamma(void);
+int rmpc_last_iterations(void);
+
+static const double rmpc_x_ref[RMPC_NX] = {{{x_ref}}};
+static double rmpc_gamma_last = NAN;
+static int rmpc_iterations_last = 0;
+
+int rmpc_init(void)
+{{
+    kothare_reset();
+    rmpc_gamma_last = NAN;
+    rmpc_iterations_last = 0;
+    return 0;
+}}
+
+int rmpc_step(const double *x, double *u)
+{{
+    double z[RMPC_NX], sq = 0.0;
+    int i;
+    for (i = 0; i < RMPC_NX; ++i) {{
+        z[i] = x[i] - rmpc_x_ref[i];
+        sq += z[i] * z[i];
+    }}
+    if (sqrt(sq) <= RMPC_HOLD_RADIUS) {{
+        kothare_apply_gain(z, u);
+        rmpc_gamma_last = NAN;
+        rmpc_iterations_last = 0;
+        return RMPC_STATUS_HELD;
+    }}
+    return kothare_solve(z, u, NULL, &rmpc_gamma_last, &rmpc_iterations_last);
+}}
+
+double rmpc_last_gamma(void) {{ return rmpc_gamma_last; }}
+
+int rmpc_last_iterations(void) {{ return rmpc_iterations_last; }}
+"""
+
+
+def write_solver(problem: Any, out_dir: str | Path) -> list[Path]:
+    """Write ``rmpc_problem.h`` for ``problem`` and copies of :data:`SOURCES` into ``out_dir``.
+
+    Compile ``ipm.c`` and ``dense.c`` together (``cc -std=c99 -O2 ipm.c dense.c -lm``); ``ipm.h``
+    declares ``kothare_solve`` and the status codes. For an :class:`rmpc.RMPC`, also
+    ``rmpc_online.c`` (:func:`controller_source`: ``rmpc_init``, ``rmpc_step``...).
+
+    Parameters
+    ----------
+    problem : KothareProblem, RMPC or IPMKothare
+        See :func:`problem_header`.
+    out_dir : str or Path
+        A folder (made if missing).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``out_dir`` when it is a file or cannot be written, or ``problem`` (see
+        :func:`problem_header`).
+    """
+    text = problem_header(problem)
+    folder = Path(out_dir)
+    if folder.exists() and not folder.is_dir():
+        raise InvalidArgumentError("out_dir", "a folder", f"the file {folder}")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        written = [folder / "rmpc_problem.h"]
+        written[0].write_text(text)
+        if all(hasattr(problem, name) for name in ("hold_radius", "x_ref", "u_ref")):  # an RMPC: its step too
+            written.append(folder / "rmpc_online.c")
+            written[-1].write_text(controller_source(problem))
+        package = resources.files("lmi.ccore")
+        for name in SOURCES:
+            with resources.as_file(package / name) as src:
+                shutil.copyfile(src, folder / name)
+            written.append(folder / name)
+    except OSError as err:
+        raise InvalidArgumentError("out_dir", "a writable folder", f"{folder}: {err.strerror}") from None
+    return written
