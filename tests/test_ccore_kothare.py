@@ -353,34 +353,3 @@ def test_generator_refusals(tmp_path: Path) -> None:
     ctrl = _unstable("peak")
     with pytest.raises(InvalidArgumentError, match="out_dir"):
         write_solver(ctrl, blocker)
-
-
-def test_rmpc_step_follows_the_controller(tmp_path: Path) -> None:
-    """``rmpc_online.c``'s ``rmpc_step`` against :meth:`rmpc.RMPC.step` along E1's loop, then at
-    ``x_ref`` (the hold radius: no solve, the last gain)."""
-    ctrl, plant, x0 = _paper_p_e1()
-    written = write_solver(ctrl, tmp_path)
-    assert tmp_path / "rmpc_online.c" in written
-    lib_path = tmp_path / "libonline.so"
-    subprocess.run([CC, *FLAGS, "-shared", "-fPIC", "-o", str(lib_path),
-                    *(str(tmp_path / f) for f in ("rmpc_online.c", "ipm.c", "dense.c")), "-lm"],
-                   check=True, capture_output=True, text=True)
-    lib = ctypes.CDLL(str(lib_path))
-    lib.rmpc_last_gamma.restype = ctypes.c_double
-    assert lib.rmpc_init() == 0
-    a, b = plant.nominal
-    x = x0.copy()
-    for _ in range(10):
-        u_py = ctrl.step(x)
-        u = np.full(3, np.nan)
-        assert lib.rmpc_step(np.ascontiguousarray(x).ctypes.data_as(_D), u.ctypes.data_as(_D)) == 0
-        assert ctrl.last.status == "optimal"
-        assert abs(lib.rmpc_last_gamma() - ctrl.last.gamma) <= 1e-6 * ctrl.last.gamma
-        assert lib.rmpc_last_iterations() == ctrl.last.iterations
-        assert np.max(np.abs(u - u_py)) <= 1e-6
-        x = a @ x + b @ u_py
-    zero = np.zeros(6)
-    u = np.full(3, np.nan)
-    assert lib.rmpc_step(zero.ctypes.data_as(_D), u.ctypes.data_as(_D)) == STATUS_CODES["held"]
-    assert np.array_equal(u, ctrl.step(zero)) and ctrl.last.status == "reused"
-    assert np.isnan(lib.rmpc_last_gamma()) and lib.rmpc_last_iterations() == 0

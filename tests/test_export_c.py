@@ -503,7 +503,7 @@ def test_undesigned_and_empty_tables_are_refused(tmp_path) -> None:
 
 def test_unsupported_controllers_are_named(controllers, tmp_path) -> None:
     with pytest.raises(ArgumentTypeError, match=r"controller: expected a controller with a C export "
-                                                r"\(LQR, OfflineRMPC\), but found dict"):
+                                                r"\(LQR, OfflineRMPC, RMPC\), but found dict"):
         export_c({}, tmp_path)
 
     class MyLQR(LQR):
@@ -512,8 +512,8 @@ def test_unsupported_controllers_are_named(controllers, tmp_path) -> None:
     sub = MyLQR.__new__(MyLQR)
     with pytest.raises(ArgumentTypeError, match="found MyLQR"):
         export_c(sub, tmp_path)
-    rmpc_ctrl = RMPC(_kothare_plant(), np.diag([1.0, 0.0]), [[2e-5]], u_max=2.0)
-    with pytest.raises(InvalidArgumentError, match="the on-line solver's export is not available"):
+    rmpc_ctrl = RMPC(_kothare_plant(), np.diag([1.0, 0.0]), [[2e-5]], u_max=2.0, lyapunov="vertex")
+    with pytest.raises(InvalidArgumentError, match="Kothare's form"):
         export_c(rmpc_ctrl, tmp_path)
 
 

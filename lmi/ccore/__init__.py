@@ -6,6 +6,13 @@ block structure of Kothare's on-line problem, its per-state data update and the 
 :func:`lmi.ccore.generate.write_solver` writes the problem header they are compiled with.
 """
 
-from lmi.ccore.generate import SOURCES, STATUS_CODES, controller_source, problem_header, write_solver
+from lmi.ccore.generate import (
+    SOURCES,
+    STATUS_CODES,
+    check_controller,
+    problem_header,
+    solver_source,
+    write_solver,
+)
 
-__all__ = ["SOURCES", "STATUS_CODES", "controller_source", "problem_header", "write_solver"]
+__all__ = ["SOURCES", "STATUS_CODES", "check_controller", "problem_header", "solver_source", "write_solver"]

@@ -1485,17 +1485,17 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
     for (i = 0; i < n; ++i) {
         if (!(x[i] - x[i] == 0.0)) {
             apply_gain(NULL, u, F);
-            return RMPC_STATUS_NONFINITE_X;
+            return KOTHARE_STATUS_NONFINITE_X;
         }
     }
     scale = norm2(x, n);
     if (!(scale < HUGE_VAL)) { /* so large that its norm overflows: treated as non-finite */
         apply_gain(NULL, u, F);
-        return RMPC_STATUS_NONFINITE_X;
+        return KOTHARE_STATUS_NONFINITE_X;
     }
     if (scale == 0.0) {
         apply_gain(NULL, u, F);
-        return RMPC_STATUS_ZERO_STATE;
+        return KOTHARE_STATUS_ZERO_STATE;
     }
     for (i = 0; i < n; ++i) {
         xs[i] = x[i] / scale;
@@ -1541,10 +1541,10 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
     if (word != W_OPTIMAL) {
         apply_gain(x, u, F);
         switch (word) {
-        case W_INFEASIBLE: return RMPC_STATUS_INFEASIBLE;
-        case W_MAX_ITER: return RMPC_STATUS_MAX_ITERATIONS;
-        case W_INACCURATE: return RMPC_STATUS_INACCURATE;
-        default: return RMPC_STATUS_NUMERICAL_ERROR;
+        case W_INFEASIBLE: return KOTHARE_STATUS_INFEASIBLE;
+        case W_MAX_ITER: return KOTHARE_STATUS_MAX_ITERATIONS;
+        case W_INACCURATE: return KOTHARE_STATUS_INACCURATE;
+        default: return KOTHARE_STATUS_NUMERICAL_ERROR;
         }
     }
     /* Q~, Y~ from the variables, then back to the state's units (IPMKothare._unscale and
@@ -1589,11 +1589,11 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
     gam *= s2;
     worst = certify(x, gam, ws.qm, ws.ym);
     ws.info[4] = worst;
-    status = (worst - worst == 0.0 && worst >= -RMPC_CERT_TOL) ? RMPC_STATUS_OPTIMAL
-                                                               : RMPC_STATUS_CERTIFICATE_FAILED;
-    if (status == RMPC_STATUS_OPTIMAL) { /* F = Y Q^-1 (Q = L L') */
+    status = (worst - worst == 0.0 && worst >= -RMPC_CERT_TOL) ? KOTHARE_STATUS_OPTIMAL
+                                                               : KOTHARE_STATUS_CERTIFICATE_FAILED;
+    if (status == KOTHARE_STATUS_OPTIMAL) { /* F = Y Q^-1 (Q = L L') */
         if (dense_cholesky(ws.qm, n, n, ws.qc, n) != 0) {
-            status = RMPC_STATUS_CERTIFICATE_FAILED;
+            status = KOTHARE_STATUS_CERTIFICATE_FAILED;
         } else {
             for (a = 0; a < m; ++a) {
                 double row[RMPC_NX];
@@ -1604,14 +1604,14 @@ int kothare_solve(const double *x, double *u, double *F, double *gamma, int *ite
                 dense_backward(ws.qc, n, n, row);
                 for (b = 0; b < n; ++b) {
                     if (!(row[b] - row[b] == 0.0)) {
-                        status = RMPC_STATUS_CERTIFICATE_FAILED;
+                        status = KOTHARE_STATUS_CERTIFICATE_FAILED;
                     }
                     ws.fm[a * n + b] = row[b];
                 }
             }
         }
     }
-    if (status == RMPC_STATUS_OPTIMAL) {
+    if (status == KOTHARE_STATUS_OPTIMAL) {
         memcpy(ws.gain, ws.fm, sizeof ws.gain);
         ws.has_gain = 1;
         if (gamma != NULL) {

@@ -11,15 +11,15 @@
 #include <stddef.h>
 
 /* Status codes of kothare_solve (lmi.ccore.generate.STATUS_CODES). */
-#define RMPC_STATUS_OPTIMAL 0            /* solved and certified: u = F x with the new gain */
-#define RMPC_STATUS_INFEASIBLE 1         /* proved infeasible (the dual iterate's Farkas ray) */
-#define RMPC_STATUS_MAX_ITERATIONS 2     /* iteration limit */
-#define RMPC_STATUS_NUMERICAL_ERROR 3    /* breakdown or stall (insufficient progress) */
-#define RMPC_STATUS_CERTIFICATE_FAILED 4 /* converged, but an LMI recomputed at the answer fails */
-#define RMPC_STATUS_NONFINITE_X 5        /* NaN or inf in x (or |x| overflows): nothing solved, u = 0 */
-#define RMPC_STATUS_INACCURATE 6         /* stalled at reduced accuracy (Python's "inaccurate") */
-#define RMPC_STATUS_ZERO_STATE 7         /* x = 0: the problem is degenerate, u = 0 */
-#define RMPC_STATUS_HELD 8               /* rmpc_step near x_ref (hold radius): no solve, u = F_last x */
+#define KOTHARE_STATUS_OPTIMAL 0            /* solved and certified: u = F x with the new gain */
+#define KOTHARE_STATUS_INFEASIBLE 1         /* proved infeasible (the dual iterate's Farkas ray) */
+#define KOTHARE_STATUS_MAX_ITERATIONS 2     /* iteration limit */
+#define KOTHARE_STATUS_NUMERICAL_ERROR 3    /* breakdown or stall (insufficient progress) */
+#define KOTHARE_STATUS_CERTIFICATE_FAILED 4 /* converged, but an LMI recomputed at the answer fails */
+#define KOTHARE_STATUS_NONFINITE_X 5        /* NaN or inf in x (or |x| overflows): nothing solved, u = 0 */
+#define KOTHARE_STATUS_INACCURATE 6         /* stalled at reduced accuracy (Python's "inaccurate") */
+#define KOTHARE_STATUS_ZERO_STATE 7         /* x = 0: the problem is degenerate, u = 0 */
+#define KOTHARE_STATUS_HELD 8               /* rmpc_step near x_ref (hold radius): no solve, u = F_last x */
 
 /* Solve at the state x (RMPC_NX entries). On status 0, u = F x with the new certified gain F
  * (RMPC_NU x RMPC_NX, row-major) and gamma the certified bound; otherwise u = F_last x with the

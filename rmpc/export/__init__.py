@@ -3,7 +3,8 @@
 :func:`export_c` writes ``rmpc_controller.h`` and ``rmpc_controller.c`` (C99, no dynamic
 allocation, libm only, one static workspace; the interface and the status codes are those of
 :mod:`rmpc.export.c_writer`) for the controllers of :func:`writers`: :class:`rmpc.LQR`
-(:mod:`rmpc.export.c_gain`) and :class:`rmpc.OfflineRMPC` (:mod:`rmpc.export.c_offline`).
+(:mod:`rmpc.export.c_gain`), :class:`rmpc.OfflineRMPC` (:mod:`rmpc.export.c_offline`) and the
+on-line :class:`rmpc.RMPC` of Kothare's form with its solver (:mod:`rmpc.export.c_online`).
 ``docs/export_c.rst`` describes the interface, the fallbacks and the limits.
 """
 
@@ -14,20 +15,13 @@ from collections.abc import Callable
 from typing import Any
 
 from rmpc.export.c_writer import CProgram, ExportResult, write_program
-from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.errors import ArgumentTypeError
 
 __all__ = ["ExportResult", "export_c", "writers"]
 
 #: A writer: the controller in, the program to write out (it raises on a controller it cannot
 #: export, naming what is missing).
 Writer = Callable[[Any], CProgram]
-
-
-def _online_not_available(ctrl: Any) -> CProgram:
-    raise InvalidArgumentError(
-        "controller", "a controller with a C export (LQR, OfflineRMPC)",
-        f"an {type(ctrl).__name__}: the on-line solver's export is not available in this build",
-    )
 
 
 def writers() -> dict[type, Writer]:
@@ -37,11 +31,12 @@ def writers() -> dict[type, Writer]:
     """
     from rmpc.export.c_gain import lqr_program
     from rmpc.export.c_offline import offline_program
+    from rmpc.export.c_online import online_program
     from rmpc.mpc.lqr import LQR
     from rmpc.mpc.offline import OfflineRMPC
     from rmpc.mpc.robust_mpc import RMPC
 
-    return {LQR: lqr_program, OfflineRMPC: offline_program, RMPC: _online_not_available}
+    return {LQR: lqr_program, OfflineRMPC: offline_program, RMPC: online_program}
 
 
 def export_c(controller: Any, out_dir: str | os.PathLike[str]) -> ExportResult:
@@ -49,8 +44,9 @@ def export_c(controller: Any, out_dir: str | os.PathLike[str]) -> ExportResult:
 
     Parameters
     ----------
-    controller : LQR or OfflineRMPC
-        A designed controller (an :class:`~rmpc.OfflineRMPC` with its table).
+    controller : LQR, OfflineRMPC or RMPC
+        A designed controller (an :class:`~rmpc.OfflineRMPC` with its table; an
+        :class:`~rmpc.RMPC` of Kothare's form on the ``"ipm"`` back-end).
     out_dir : str or os.PathLike
         The folder to write into, created when missing; existing files of the same names are
         replaced.
@@ -67,8 +63,9 @@ def export_c(controller: Any, out_dir: str | os.PathLike[str]) -> ExportResult:
         an ``out_dir`` that is not a path.
     InvalidArgumentError
         For a controller with no design yet, sizes beyond the limits (``RMPC_NX``, ``RMPC_NU``
-        at most 64, at most 1000 ellipsoids), an :class:`~rmpc.RMPC` (the on-line solver's
-        export is not in this build), or an ``out_dir`` that is a file or cannot be written.
+        at most 64, at most 1000 ellipsoids; the C core's limits for an RMPC), an
+        :class:`~rmpc.RMPC` of a form or back-end the C solver does not carry (the message
+        names it), or an ``out_dir`` that is a file or cannot be written.
 
     Examples
     --------
@@ -83,8 +80,7 @@ def export_c(controller: Any, out_dir: str | os.PathLike[str]) -> ExportResult:
     table = writers()
     writer = table.get(type(controller))
     if writer is None:
-        exported = (cls.__name__ for cls, w in table.items() if w is not _online_not_available)
-        supported = ", ".join(sorted(exported))
+        supported = ", ".join(sorted(cls.__name__ for cls in table))
         raise ArgumentTypeError(
             "controller", f"a controller with a C export ({supported})", type(controller).__name__
         )

@@ -45,6 +45,7 @@ __all__ = [
     "MAX_NX",
     "SOURCE_NAME",
     "STATUS_CODES",
+    "ZERO_COMMAND_CODES",
     "CArray",
     "CProgram",
     "ExportResult",
@@ -91,7 +92,26 @@ STATUS_CODES: tuple[StatusCode, ...] = (
                "the command computed from a finite x overflowed (an entry is not finite); u = 0"),
     StatusCode("RMPC_STATUS_NULL_ARGUMENT", 4, "(no Python counterpart)",
                "x or u is a null pointer; u = 0 when u is not null"),
+    StatusCode("RMPC_STATUS_INFEASIBLE", 5, "infeasible",
+               "on-line robust MPC: the LMIs are proved infeasible at x (the solver's Farkas ray); "
+               "u = F_last (x - x_ref), the last certified gain (0 before any)"),
+    StatusCode("RMPC_STATUS_MAX_ITERATIONS", 6, "max_iterations",
+               "on-line robust MPC: the iteration limit was reached; u = F_last (x - x_ref)"),
+    StatusCode("RMPC_STATUS_NUMERICAL_ERROR", 7, "numerical_error",
+               "on-line robust MPC: the solver broke down or stalled; u = F_last (x - x_ref)"),
+    StatusCode("RMPC_STATUS_UNCERTIFIED", 8, "uncertified",
+               "on-line robust MPC: the solver converged but an LMI recomputed at its answer fails "
+               "the certificate; u = F_last (x - x_ref)"),
+    StatusCode("RMPC_STATUS_INACCURATE", 9, "inaccurate",
+               "on-line robust MPC: the solver stalled at reduced accuracy; u = F_last (x - x_ref) "
+               "(the Python controller applies such an answer when its certificate holds)"),
+    StatusCode("RMPC_STATUS_HELD", 10, "reused",
+               "on-line robust MPC: x is within the hold radius of x_ref, where the problem "
+               "degenerates; no solve, u = F_last (x - x_ref), as the Python step"),
 )
+#: The codes whose command is zero (no state or command to use); every other code's ``u`` is the
+#: controller's answer or the fallback its text names.
+ZERO_COMMAND_CODES = ("RMPC_STATUS_BAD_STATE", "RMPC_STATUS_OVERFLOW", "RMPC_STATUS_NULL_ARGUMENT")
 _CODE = {code.name: code for code in STATUS_CODES}
 
 
@@ -201,6 +221,12 @@ class CProgram:
         ``rmpc_ws.gamma`` and ``rmpc_ws.iterations``.
     accessors : tuple of (prototype, comment, body)
         Extra public functions (``"int rmpc_last_index(void)"``).
+    init : str
+        C statements ``rmpc_init`` runs after resetting the workspace (a solver's own reset).
+    helper_table_bytes : int
+        The constant data the ``helpers`` hold (a solver's problem data), counted in
+        :attr:`ExportResult.table_bytes`; a solver's own work arrays are not (the on-line
+        export reports them through ``rmpc_solver_workspace_bytes()``).
     """
 
     controller: str
@@ -216,6 +242,8 @@ class CProgram:
     fields: tuple[WorkspaceField, ...] = ()
     helpers: str = ""
     accessors: tuple[tuple[str, str, str], ...] = ()
+    init: str = ""
+    helper_table_bytes: int = 0
 
     def __post_init__(self) -> None:
         for name, value, most in (("RMPC_NX", self.nx, MAX_NX), ("RMPC_NU", self.nu, MAX_NU)):
@@ -338,7 +366,7 @@ static void rmpc_zero(double *u)
 static int rmpc_finish(int status, double *u)
 {
     rmpc_ws.status = status;
-    if (status != RMPC_OK && status != RMPC_STATUS_OUTSIDE) {
+    if (@ZERO_CODES@) {
         rmpc_ws.gamma = NAN;
         rmpc_ws.iterations = 0;
         @RESET@
@@ -353,6 +381,7 @@ int rmpc_init(void)
 {
     memset(&rmpc_ws, 0, sizeof rmpc_ws);
 @INIT@
+@SOLVER_INIT@
     return RMPC_OK;
 }
 
@@ -420,7 +449,11 @@ def render_source(program: CProgram) -> str:
     def reset(indent: str) -> str:
         return "".join(f"{indent}rmpc_ws.{f.name} = {f.initial};\n" for f in program.fields)
 
-    step = _STEP.replace("@INIT@", init).replace("        @RESET@\n", reset(" " * 8))
+    solver_init = textwrap.indent(program.init.strip("\n"), "    ") if program.init else ""
+    step = _STEP.replace("@SOLVER_INIT@\n", solver_init + "\n" if solver_init else "")
+    step = step.replace("@INIT@", init)
+    zero_codes = " || ".join(f"status == {name}" for name in ZERO_COMMAND_CODES)
+    step = step.replace("@ZERO_CODES@", zero_codes).replace("        @RESET@\n", reset(" " * 8))
     out.append(step.replace("@RESET@\n", reset(" " * 4)))
     for proto, _, body in program.accessors:
         out.append(f"{proto}\n{{\n{body.rstrip()}\n}}\n")
@@ -508,7 +541,8 @@ def write_program(program: CProgram, out_dir: str | os.PathLike[str]) -> ExportR
         sizes[name] = len(data)
     return ExportResult(
         header=folder / HEADER_NAME, source=folder / SOURCE_NAME, sizes=sizes,
-        table_bytes=program.table_bytes, workspace_bytes=program.workspace_bytes,
+        table_bytes=program.table_bytes + program.helper_table_bytes,
+        workspace_bytes=program.workspace_bytes,
         controller=program.controller, nx=program.nx, nu=program.nu,
         returns=tuple(_CODE[name].value for name in program.returns),
     )
