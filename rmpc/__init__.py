@@ -12,6 +12,7 @@ from toolkit_common.lazy import lazy_exports
 
 if TYPE_CHECKING:
     from rmpc.controller import Controller, Status, StepInfo, StepInputs
+    from rmpc.io.registry import load
     from rmpc.laws.flexible.adaptive_pd import AdaptivePD
     from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
     from rmpc.laws.flexible.attitude_pd import AttitudePD
@@ -43,6 +44,7 @@ if TYPE_CHECKING:
 # the module defining each public name, imported when the name is first looked up
 _EXPORTS = {
     "rmpc.controller": ("Controller", "Status", "StepInfo", "StepInputs"),
+    "rmpc.io.registry": ("load",),
     "rmpc.laws.flexible.adaptive_pd": ("AdaptivePD",),
     "rmpc.laws.flexible.adaptive_smc": ("AdaptiveSMC",),
     "rmpc.laws.flexible.attitude_pd": ("AttitudePD",),
@@ -103,6 +105,7 @@ __all__ = [
     "Trajectory",
     "TuningFunctionAB",
     "flexible_lqr",
+    "load",
     "simulate",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

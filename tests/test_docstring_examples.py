@@ -87,6 +87,8 @@ MODULES_WITH_EXAMPLES = (
     "rmpc.controller",
     "rmpc.errors",
     "rmpc.estimators.linear",
+    "rmpc.io.design",
+    "rmpc.io.registry",
     "rmpc.laws.flexible.adaptive_pd",
     "rmpc.laws.flexible.adaptive_smc",
     "rmpc.laws.flexible.attitude_pd",
