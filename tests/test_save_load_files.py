@@ -86,8 +86,9 @@ def test_a_damaged_file_is_refused_by_its_checksum(saved: Path) -> None:
 
 def test_a_truncated_file_says_it_ends_early(saved: Path) -> None:
     data = saved.read_bytes()
-    saved.write_bytes(data[: len(data) // 2])
-    _refused(saved, "truncated")
+    for cut in [*(len(data) * k // 10 for k in range(1, 10)), len(data) - 2, 7, 10, 13]:
+        saved.write_bytes(data[:cut])
+        _refused(saved, "truncated")
 
 
 @pytest.mark.parametrize("content", [b"\x89PNG\r\n\x1a\n\x00\x00", b"format = 'rmpc-controller'\n", b"",

@@ -163,7 +163,7 @@ def read_file(path: Any) -> ControllerFile:
     try:
         payload = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as err:
-        if err.pos >= len(text.rstrip()):
+        if err.pos >= len(text.rstrip()) or err.msg.startswith("Unterminated string"):
             found = f"a JSON document that ends early at character {err.pos} (a truncated file)"
         else:
             found = f"text that is not JSON ({err.msg} at line {err.lineno}, column {err.colno})"
