@@ -13,6 +13,7 @@ from toolkit_common.lazy import lazy_exports
 if TYPE_CHECKING:
     from rmpc.controller import Controller, Status, StepInfo, StepInputs
     from rmpc.export import export_c
+    from rmpc.io.registry import load
     from rmpc.laws.flexible.adaptive_pd import AdaptivePD
     from rmpc.laws.flexible.adaptive_smc import AdaptiveSMC
     from rmpc.laws.flexible.attitude_pd import AttitudePD
@@ -45,6 +46,7 @@ if TYPE_CHECKING:
 _EXPORTS = {
     "rmpc.controller": ("Controller", "Status", "StepInfo", "StepInputs"),
     "rmpc.export": ("export_c",),
+    "rmpc.io.registry": ("load",),
     "rmpc.laws.flexible.adaptive_pd": ("AdaptivePD",),
     "rmpc.laws.flexible.adaptive_smc": ("AdaptiveSMC",),
     "rmpc.laws.flexible.attitude_pd": ("AttitudePD",),
@@ -106,6 +108,7 @@ __all__ = [
     "TuningFunctionAB",
     "export_c",
     "flexible_lqr",
+    "load",
     "simulate",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -8,6 +8,7 @@ True
 from toolkit_common.errors import (
     ArgumentTypeError,
     ConfigError,
+    ControllerFileError,
     InvalidArgumentError,
     NoCertifiedGainWarning,
     SingularityError,
@@ -19,6 +20,7 @@ from toolkit_common.errors import (
 __all__ = [
     "ArgumentTypeError",
     "ConfigError",
+    "ControllerFileError",
     "InvalidArgumentError",
     "NoCertifiedGainWarning",
     "SingularityError",

@@ -91,6 +91,8 @@ MODULES_WITH_EXAMPLES = (
     "rmpc.estimators.robust",
     "rmpc.export",
     "rmpc.export.c_writer",
+    "rmpc.io.design",
+    "rmpc.io.registry",
     "rmpc.laws.flexible.adaptive_pd",
     "rmpc.laws.flexible.adaptive_smc",
     "rmpc.laws.flexible.attitude_pd",

@@ -10,6 +10,7 @@ each other.
 from toolkit_common.errors import (
     ArgumentTypeError,
     ConfigError,
+    ControllerFileError,
     InvalidArgumentError,
     SingularityError,
     SolverError,
@@ -20,6 +21,7 @@ from toolkit_common.errors import (
 __all__ = [
     "ArgumentTypeError",
     "ConfigError",
+    "ControllerFileError",
     "InvalidArgumentError",
     "SingularityError",
     "SolverError",

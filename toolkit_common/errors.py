@@ -68,6 +68,14 @@ class StoreError(InvalidArgumentError):
     """
 
 
+class ControllerFileError(InvalidArgumentError):
+    """A saved controller file is missing, damaged, truncated, foreign or newer than this toolkit,
+    or cannot be written where asked (:func:`rmpc.load`, ``ctrl.save(path)``).
+
+    ``argument`` is the file's path; the message says what was expected and what was found.
+    """
+
+
 class SingularityError(ToolkitError, ArithmeticError):
     """A model was evaluated where it is singular (3-2-1 Euler angles at pitch = +-90 deg)."""
 

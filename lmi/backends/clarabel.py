@@ -86,9 +86,21 @@ class ClarabelKothare(KothareBackend):
         self, data: KothareData, options: dict[str, Any] | None = None, *, conic: KothareConic | None = None
     ) -> None:
         self.data = data
-        self.settings = clarabel_settings(options)
+        self._options = None if options is None else dict(options)
+        self.settings = clarabel_settings(self._options)
         self._blas = SingleThreadBlas()
         self.conic = KothareConic(data) if conic is None else conic
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Copies and pickles leave Clarabel's settings object behind (it does not pickle);
+        :meth:`__setstate__` builds it again from the options."""
+        state = dict(self.__dict__)
+        del state["settings"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self.settings = clarabel_settings(self._options)
 
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
               outer: np.ndarray | None = None) -> RawResult:

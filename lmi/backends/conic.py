@@ -178,6 +178,26 @@ class KothareConic:
         self.objective = np.zeros(nv)
         self.objective[0] = 1.0
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Copies and pickles hold the cones as ``(kind, dimension)`` (Clarabel's cone objects do
+        not pickle); :meth:`__setstate__` builds them again."""
+        state = dict(self.__dict__)
+        state["cones"] = [
+            ("psd" if isinstance(cone, clarabel.PSDTriangleConeT) else "nonneg", int(stop - start))
+            for cone, start, stop in zip(self.cones, self.offsets[:-1], self.offsets[1:], strict=True)
+        ]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        specs = state["cones"]
+        self.__dict__.update(state)
+        # a PSD triangle cone of order k has k (k + 1) / 2 rows
+        self.cones = [
+            clarabel.PSDTriangleConeT(round((np.sqrt(8 * dim + 1) - 1) / 2)) if kind == "psd"
+            else clarabel.NonnegativeConeT(dim)
+            for kind, dim in specs
+        ]
+
     # -- construction helpers ----------------------------------------------------------
     def _vertex_lmi(
         self, a: np.ndarray, b: np.ndarray, q: AffineMatrix, y: AffineMatrix, nv: int

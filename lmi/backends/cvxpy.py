@@ -123,6 +123,13 @@ class CvxpyKothare(KothareBackend):
             cons.append(cp.diag(zv) <= 1.0)
         self.problem = cp.Problem(cp.Minimize(gs), cons)
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Copies and pickles hold the same problem without the solvers cvxpy cached in it
+        (Clarabel's solver does not pickle); the next solve builds them again."""
+        state = dict(self.__dict__)
+        state["problem"] = cp.Problem(self.problem.objective, self.problem.constraints)
+        return state
+
     def solve(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray) -> RawResult:
         self.x.value = x
         if self.inv_u is not None:

@@ -250,6 +250,14 @@ class FormProblem:
             x=ti @ x, u_max=u_max, y_max=y_tight, w_max=w_max, lam=lam, dt=data.dt,
         )
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Copies and pickles leave the solvers built so far behind (cvxpy's and Clarabel's do not
+        pickle); the next solve builds them again, as after :meth:`reset` but in the same
+        coordinates."""
+        state = dict(self.__dict__)
+        state["_solvers"] = {}
+        return state
+
     # -- solve ---------------------------------------------------------------------------------
     def reset(self) -> None:
         """Forget the solvers built so far (their warm starts) and any rebalanced coordinates: the

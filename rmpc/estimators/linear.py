@@ -22,13 +22,15 @@ needs ``rank [[A - I, B], [C, 0]] = n + m`` and at least as many outputs as inpu
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from models.linear import unreachable_modes
+from rmpc.io.design import Design, encode
+from rmpc.io.saveable import Saveable
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector
 
@@ -59,7 +61,7 @@ def _output_matrix(C: ArrayLike, n: int) -> np.ndarray:
         raise InvalidArgumentError("C", "a real p x n matrix", f"{err}") from None
     if np.iscomplexobj(c) or c.dtype == object:
         raise InvalidArgumentError("C", "a real p x n matrix", f"dtype {c.dtype}")
-    c = c.astype(float)
+    c = np.ascontiguousarray(c, dtype=float)
     if c.ndim != 2 or c.shape[1] != n or c.shape[0] < 1:
         raise InvalidArgumentError("C", f"a p x {n} matrix (the plant has {n} states)", f"shape {c.shape}")
     if not np.all(np.isfinite(c)):
@@ -72,7 +74,7 @@ def _unobservable_modes(a: np.ndarray, c: np.ndarray, only_unstable: bool) -> li
     return unreachable_modes(a.T, c.T, only_unstable=only_unstable)
 
 
-class LinearEstimator:
+class LinearEstimator(Saveable):
     """The current-form estimator shared by :class:`Luenberger` and :class:`KalmanFilter`.
 
     Attributes
@@ -117,6 +119,33 @@ class LinearEstimator:
         self._x0 = np.zeros(n) if x0 is None else as_vector(x0, "x0", n)
         self.M = np.zeros((n + n_d, self.n_outputs))
         self.reset()
+
+    # -- save and load ---------------------------------------------------------------------
+    #: What a subclass adds to the saved design (attribute names of arrays), read back as they were.
+    _saved_arrays: ClassVar[tuple[str, ...]] = ()
+
+    def _design(self) -> dict[str, Any]:
+        """The model, the measurement, the disturbance model, the initial guess and the gain ``M``
+        (with :attr:`_saved_arrays`): the gain as computed, not computed again on loading."""
+        extra = {name: getattr(self, name) for name in self._saved_arrays}
+        return encode({
+            "A": self.A, "B": self.B, "dt": self.dt, "C": self.C, "disturbance_model": self.disturbance_model,
+            "x0": self._x0, "M": self.M, **extra,
+        }, f"{type(self).__name__} design")
+
+    @classmethod
+    def _from_design(cls, design: Design) -> Self:
+        est = cls.__new__(cls)
+        LinearEstimator.__init__(est, (design.array("A", 2), design.array("B", 2)), design.array("C", 2),
+                                 design.optional_text("disturbance_model"), design.array("x0", 1))
+        est.dt = design.optional_number("dt")
+        gain = design.array("M", 2)
+        if gain.shape != est.M.shape:
+            raise InvalidArgumentError("design.M", f"shape {est.M.shape}", f"shape {gain.shape}")
+        est.M = gain
+        for name in cls._saved_arrays:
+            setattr(est, name, design.array(name, 2))
+        return est
 
     def reset(self, x0: ArrayLike | None = None) -> None:
         """Start again from ``x0`` (default: the constructor's guess) and zero disturbance."""
@@ -202,7 +231,7 @@ class Luenberger(LinearEstimator):
             if m_mat.shape != (size, self.n_outputs) or not np.all(np.isfinite(m_mat)):
                 raise InvalidArgumentError("gain", f"a finite {size} x {self.n_outputs} matrix",
                                            f"shape {m_mat.shape}")
-            self.M = m_mat
+            self.M = np.ascontiguousarray(m_mat)
             return
         wanted = np.asarray(poles, dtype=complex).reshape(-1)
         if wanted.size != size or np.any(np.abs(wanted) >= 1.0):
@@ -221,7 +250,8 @@ class Luenberger(LinearEstimator):
         except ValueError as err:  # repeated beyond the outputs' rank, unpaired complex, ...
             raise InvalidArgumentError("poles", "eigenvalues a gain can place (python-control place)",
                                        f"{np.asarray(poles).tolist()}: {err}") from None
-        self.M = np.asarray(k_mat).T
+        # C order, as a loaded estimator's gain: BLAS may round a product differently by layout
+        self.M = np.ascontiguousarray(np.asarray(k_mat).T)
 
 
 class KalmanFilter(LinearEstimator):
@@ -252,6 +282,7 @@ class KalmanFilter(LinearEstimator):
     """
 
     kind = "kalman"
+    _saved_arrays = ("P", "W", "V")
 
     def __init__(self, plant: Any, C: ArrayLike, process_noise: ArrayLike | float,
                  measurement_noise: ArrayLike | float, *, disturbance_model: str | None = None,
@@ -273,7 +304,8 @@ class KalmanFilter(LinearEstimator):
 
         self.P = sla.solve_discrete_are(self.A_aug.T, self.C_aug.T, w, v)
         s = self.C_aug @ self.P @ self.C_aug.T + v
-        self.M = np.linalg.solve(s, self.C_aug @ self.P).T
+        # C order, as Luenberger's gain
+        self.M = np.ascontiguousarray(np.linalg.solve(s, self.C_aug @ self.P).T)
         self.W, self.V = w, v
 
 

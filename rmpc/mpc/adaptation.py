@@ -37,7 +37,8 @@ from __future__ import annotations
 import copy
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import ClassVar, Self
+from types import MappingProxyType
+from typing import Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -53,12 +54,14 @@ __all__ = [
     "DEFAULT_GAIN_NORMALIZED",
     "DEFAULT_GAIN_PLAIN",
     "DEFAULT_RESET_PERIOD",
+    "RULES",
     "AdaptationRule",
     "AdaptationStep",
     "LyapunovRule",
     "MITRule",
     "ParameterIntegrator",
     "SensitivityFilter",
+    "rule_from_settings",
 ]
 
 #: Default gain ``g`` of the Lyapunov rule (1/s^2): an estimator bandwidth of about 10 rad/s.
@@ -144,6 +147,17 @@ class AdaptationRule(ABC):
         bound_rule._estimate = ParameterIntegrator(b_mat.shape[1], dt, bound=bound)
         bound_rule.prepare(a_mat, b_mat, dt)
         return bound_rule
+
+    def settings(self) -> dict[str, Any]:
+        """The constructor's arguments of this rule (what a saved controller holds of it).
+
+        A rule of the toolkit (:data:`RULES`) has them; any other rule is refused here, so a
+        CRMPC with a rule of the user's own cannot be saved (pickle keeps one that pickles).
+        """
+        raise InvalidArgumentError(
+            "adaptation", "a rule of rmpc.mpc.adaptation.RULES (lyapunov, mit) to save the controller",
+            type(self).__name__,
+        )
 
     @abstractmethod
     def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
@@ -269,6 +283,9 @@ class LyapunovRule(AdaptationRule):
         # in the range of B'; components of theta that B maps to zero are left where they are.
         return self.gain * (np.linalg.pinv(gram, rcond=RANK_TOL, hermitian=True) @ (pb.T @ e))
 
+    def settings(self) -> dict[str, Any]:
+        return {"gain": self.gain}
+
     def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
         self._a, self._b = a, b
         self._b_delta = b / dt
@@ -390,6 +407,13 @@ class MITRule(AdaptationRule):
             grad = grad / (self.alpha + float(np.sum(sens * sens)))
         return -self.gain * grad
 
+    def settings(self) -> dict[str, Any]:
+        return {
+            "gain": self.gain, "normalized": self.normalized, "alpha": self.alpha,
+            "reset_period": self.reset_period, "reference_gain": self.reference_gain,
+            "error_output": self.error_output,
+        }
+
     def prepare(self, a: np.ndarray, b: np.ndarray, dt: float) -> None:
         n, m = b.shape
         self._a, self._b = a, b
@@ -450,3 +474,24 @@ class MITRule(AdaptationRule):
         kind = "normalised" if self.normalized else "plain"
         period = "None" if self.reset_period is None else f"{self.reset_period:g}"
         return f"MITRule(gain={self.gain:g}, {kind}, alpha={self.alpha:g}, reset_period={period})"
+
+
+#: The adaptation rules by :attr:`~AdaptationRule.name` (a saved CRMPC names its rule so).
+RULES: MappingProxyType[str, type[AdaptationRule]] = MappingProxyType({
+    LyapunovRule.name: LyapunovRule, MITRule.name: MITRule,
+})
+
+
+def rule_from_settings(name: str, settings: dict[str, Any]) -> AdaptationRule:
+    """The (unbound) rule called ``name`` with ``settings`` (:meth:`AdaptationRule.settings`).
+
+    Examples
+    --------
+    >>> from rmpc.mpc.adaptation import MITRule, rule_from_settings
+    >>> rule = MITRule(gain=5.0, reset_period=1.0)
+    >>> rule_from_settings(rule.name, rule.settings())
+    MITRule(gain=5, normalised, alpha=0.001, reset_period=1)
+    """
+    if name not in RULES:
+        raise InvalidArgumentError("adaptation", f"a rule among {', '.join(RULES)}", repr(name))
+    return RULES[name](**settings)

@@ -55,8 +55,10 @@ from numpy.typing import ArrayLike
 from lmi.data import input_bound_vector
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
-from rmpc.mpc.adaptation import AdaptationRule, LyapunovRule
-from rmpc.mpc.robust_mpc import RMPC, input_constraint_kind
+from rmpc.io.design import Design, encode, plant_design, snapshot
+from rmpc.io.saveable import Saveable
+from rmpc.mpc.adaptation import RULES, AdaptationRule, LyapunovRule, rule_from_settings
+from rmpc.mpc.robust_mpc import RMPC, input_constraint_kind, read_target, rmpc_arguments, target_design
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_optional_limits, as_vector, check_choice
 
@@ -71,7 +73,7 @@ TORQUE_BUDGETS = ("current", "split", "none")
 _OWN_ARGUMENTS = ("self", "plant", "Q", "R", "u_max", "input_constraint")
 
 
-class CRMPC:
+class CRMPC(Saveable):
     """Robust MPC plus a model reference adaptive system: paper P's CRMPC.
 
     Parameters
@@ -217,6 +219,44 @@ class CRMPC:
         a_nom, b_nom = (np.array(mat, dtype=float) for mat in plant.nominal)
         self.adaptation = adaptation.bind(a_nom, b_nom, self.dt, self.theta_bound)
         self.last: StepInfo | None = None
+        self._arguments: dict[str, Any] = snapshot({
+            "Q": Q, "R": R, "u_max": u_max, "input_constraint": kind, "rmpc_options": options,
+        })
+
+    # -- save and load ---------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The plant, the constructor's arguments, the adaptation rule by name with its settings
+        and the inner RMPC's set-point; not the estimate ``theta`` nor the reference model's state
+        (run-time state: a loaded CRMPC is as after :meth:`reset`)."""
+        rule = self.adaptation
+        if RULES.get(rule.name) is not type(rule):
+            AdaptationRule.settings(rule)  # refused, naming the rule
+        return {
+            "plant": plant_design(self.plant),
+            "arguments": encode({**self._arguments, "theta_bound": self.theta_bound,
+                                 "torque_budget": self.torque_budget}, "CRMPC arguments"),
+            "adaptation": {"rule": self.adaptation.name,
+                           "settings": encode(self.adaptation.settings(), "CRMPC adaptation")},
+            "reference": target_design(self.rmpc.target),
+        }
+
+    @classmethod
+    def _from_design(cls, design: Design) -> CRMPC:
+        arguments, adaptation = design.part("arguments"), design.part("adaptation")
+        options = arguments.part("rmpc_options")
+        rule = rule_from_settings(str(adaptation.text("rule")), adaptation.plain("settings"))
+        adaptation.finish()
+        ctrl = cls(
+            design.plant(), arguments.array("Q", 2), arguments.array("R", 2), arguments.bound("u_max"),
+            arguments.optional_text("input_constraint"), adaptation=rule,
+            theta_bound=arguments.optional_array("theta_bound", 1),
+            torque_budget=arguments.text("torque_budget"),
+            rmpc_options=rmpc_arguments(options, partial=True),
+        )
+        options.finish()
+        arguments.finish()
+        ctrl.rmpc._restore_target(read_target(design, "reference", ctrl.plant))
+        return ctrl
 
     def _theta_bound(self, value: Any, m: int) -> np.ndarray | None:
         if isinstance(value, str):

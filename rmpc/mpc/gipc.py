@@ -37,6 +37,7 @@ min(du_max, u_max - u(k-1))``). ``H`` and ``C`` are built once; per step only ``
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -46,6 +47,8 @@ from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
+from rmpc.io.design import Design, encode, plant_design
+from rmpc.io.saveable import Saveable
 from rmpc.qp import QP, QPBackend, make_backend
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import (
@@ -121,7 +124,7 @@ def _horizon(value: Any, name: str, upper: int | None = None, limit: int | None 
     return value
 
 
-class GIPC:
+class GIPC(Saveable):
     """Incremental (velocity-form) MPC with input and input-increment bounds (paper P's GIPC).
 
     Parameters
@@ -278,6 +281,8 @@ class GIPC:
                 "backend", "a back-end name or a rmpc.qp.QPBackend", type(backend).__name__
             )
         self.dt = plant.dt
+        self.plant = plant
+        self._limits = (limit, entries_limit)
         self._n, self._m, self._q = n, m, q
         self.A, self.B = plant.nominal
 
@@ -382,6 +387,38 @@ class GIPC:
                    "raw_status": res.raw_status, "step_time": time.perf_counter() - start},
         )
         return u.copy()
+
+    # -- save and load ---------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The plant, the horizons, weights, bounds, outputs, reference, ``u0`` and the QP back-end
+        by name with its settings (a back-end class of :data:`rmpc.qp.BACKENDS` only)."""
+        from rmpc.qp.factory import BACKENDS
+
+        backend = self.backend
+        if BACKENDS.get(backend.name) is not type(backend):
+            raise InvalidArgumentError(
+                "backend",
+                f"one of the toolkit's QP back-ends ({', '.join(BACKENDS)}) to save the controller",
+                type(backend).__name__,
+            )
+        return {"plant": plant_design(self.plant), **encode({
+            "Np": self.Np, "Nc": self.Nc, "Qy": self.Qy, "R_du": self.R_du, "u_max": self.u_max,
+            "du_max": self.du_max, "C": self.C, "backend": backend.name,
+            "solver_options": dataclasses.asdict(backend.settings), "x_ref": self.x_ref, "u0": self.u0,
+            "max_horizon": self._limits[0], "max_prediction_entries": self._limits[1],
+        }, "GIPC design")}
+
+    @classmethod
+    def _from_design(cls, design: Design) -> GIPC:
+        return cls(
+            design.plant(), Np=design.integer("Np"), Nc=design.integer("Nc"),
+            Qy=design.array("Qy", 2), R_du=design.array("R_du", 2),
+            u_max=design.optional_array("u_max", 1), du_max=design.optional_array("du_max", 1),
+            C=design.array("C", 2), backend=design.text("backend"),
+            solver_options=design.mapping("solver_options"), x_ref=design.array("x_ref", 1),
+            u0=design.array("u0", 1), max_horizon=design.integer("max_horizon"),
+            max_prediction_entries=design.integer("max_prediction_entries"),
+        )
 
     def settings(self) -> dict[str, Any]:
         """Every parameter of the controller, for reports."""

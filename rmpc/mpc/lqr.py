@@ -3,20 +3,22 @@
 from __future__ import annotations
 
 import time
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
+from rmpc.io.design import Design, encode, plant_design
+from rmpc.io.saveable import Saveable
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_pd, check_psd
 
 __all__ = ["LQR"]
 
 
-class LQR:
+class LQR(Saveable):
     """Infinite-horizon discrete LQR, ``u = F (x - x_ref)`` with ``F = -K`` from ``control.dlqr``.
 
     Parameters
@@ -87,13 +89,40 @@ class LQR:
             raise InvalidArgumentError(
                 "plant", "a stabilisable (A, B) with detectable (Q, A)", f"dlqr failed: {err}"
             ) from None
-        self.K = np.asarray(k)
-        self.P = np.asarray(s)
+        # C order, as a loaded controller's gain: BLAS may round a product differently by layout
+        self._set(plant, vertex, np.ascontiguousarray(k), np.ascontiguousarray(s), x_ref)
+
+    def _set(self, plant: PolytopicModel, vertex: int | None, k: np.ndarray, s: np.ndarray,
+             x_ref: ArrayLike | None) -> None:
+        n = plant.n_states
+        self.plant, self.vertex = plant, None if vertex is None else int(vertex)
+        self.K = k
+        self.P = s
         self.F = -self.K
         self.dt = plant.dt
         self.x_ref = np.zeros(n) if x_ref is None else as_vector(x_ref, "x_ref", n)
         self._n = n
         self.last: StepInfo | None = None
+
+    # -- save and load ---------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The plant, the weights, the vertex, the reference and the gain with its Riccati solution."""
+        return {"plant": plant_design(self.plant), **encode(
+            {"Q": self.Q, "R": self.R, "vertex": self.vertex, "x_ref": self.x_ref, "K": self.K, "P": self.P},
+            "LQR design")}
+
+    @classmethod
+    def _from_design(cls, design: Design) -> LQR:
+        """The saved gain as it was (no Riccati equation solved again)."""
+        plant = design.plant()
+        n, m = plant.n_states, plant.n_inputs
+        ctrl = cls.__new__(cls)
+        ctrl.Q = check_psd(as_matrix(design.array("Q"), "design.Q", (n, n)), "design.Q")
+        ctrl.R = check_pd(as_matrix(design.array("R"), "design.R", (m, m)), "design.R")
+        k = as_matrix(design.array("K"), "design.K", (m, n))
+        s = as_matrix(design.array("P"), "design.P", (n, n))
+        ctrl._set(plant, design.optional_integer("vertex"), k, s, design.array("x_ref", 1))
+        return ctrl
 
     def reset(self) -> None:
         """Nothing to forget but the last step's info."""

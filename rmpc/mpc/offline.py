@@ -22,6 +22,8 @@ from numpy.typing import ArrayLike
 from lmi.status import INFEASIBLE, OPTIMAL
 from models import PolytopicModel
 from rmpc.controller import Status, StepInfo, StepInputs, check_step_inputs
+from rmpc.io.design import Design, encode, plant_design, snapshot
+from rmpc.io.saveable import Saveable
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_vector, check_bool, check_choice, check_positive
 
@@ -40,7 +42,7 @@ LEVEL_TOL = 1e-6
 _ONE = 1.0 + LEVEL_TOL
 
 
-class OfflineRMPC:
+class OfflineRMPC(Saveable):
     """Off-line robust MPC over a polytopic model (Wan & Kothare 2003), the ``step(x)`` protocol.
 
     Parameters
@@ -172,8 +174,73 @@ class OfflineRMPC:
         self._auto = x_design is None
         self._fresh = True
         self._count = 0
+        # the constructor's arguments as save writes them (copies: later changes by the caller do not leak in)
+        self._arguments: dict[str, Any] = snapshot({
+            "Q": Q, "R": R, "u_max": u_max, "input_constraint": input_constraint,
+            "output_matrix": output_matrix, "y_max": y_max, "n_ellipsoids": self.n_ellipsoids,
+            "shrink": self.shrink, "path": self.path, "backend": backend, "solver": solver,
+            "solver_options": solver_options, "formulation": formulation,
+            "certificate_tol": certificate_tol, "cost": cost, "lyapunov": lyapunov,
+        })
         if x_design is not None:
-            self._design(x_design)
+            self._design_table(x_design)
+
+    @classmethod
+    def from_table(
+        cls,
+        plant: PolytopicModel,
+        table: OfflineTable,
+        Q: ArrayLike,
+        R: ArrayLike,
+        u_max: ArrayLike | None = None,
+        input_constraint: Literal["ellipsoid", "peak"] | str | None = "auto",
+        **options: Any,
+    ) -> OfflineRMPC:
+        """The controller of an ellipsoid table designed before (nothing is solved).
+
+        Parameters
+        ----------
+        plant, Q, R, u_max, input_constraint, options
+            As the constructor (``x_design`` excepted): the problem the table was designed for.
+        table : lmi.offline.OfflineTable
+            The table, e.g. ``other.table`` of a designed controller; its ellipsoids must have the
+            plant's sizes. It is kept as the controller's table, never redesigned.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import PolytopicModel
+        >>> from rmpc import OfflineRMPC
+        >>> plant = PolytopicModel([(np.array([[1.1]]), np.array([[1.0]])),
+        ...                         (np.array([[1.1]]), np.array([[0.5]]))], dt=1.0)
+        >>> ctrl = OfflineRMPC(plant, Q=np.eye(1), R=np.eye(1), u_max=1.0, x_design=[1.0], n_ellipsoids=3)
+        >>> copy = OfflineRMPC.from_table(plant, ctrl.table, Q=np.eye(1), R=np.eye(1), u_max=1.0)
+        >>> bool(copy.step([0.4]) == ctrl.step([0.4])), copy.table is ctrl.table
+        (True, True)
+        """
+        if "x_design" in options:
+            raise InvalidArgumentError("x_design", "no x_design (the table is given)",
+                                       repr(options["x_design"]))
+        from lmi.offline import OfflineTable
+
+        if not isinstance(table, OfflineTable):
+            raise ArgumentTypeError("table", "an lmi.offline.OfflineTable", type(table).__name__)
+        ctrl = cls(plant, Q, R, u_max, input_constraint, **options)
+        n, m = plant.n_states, plant.n_inputs
+        for i, entry in enumerate(table.ellipsoids):
+            shapes = (np.shape(entry.Q), np.shape(entry.F))
+            if shapes != ((n, n), (m, n)):
+                raise InvalidArgumentError(
+                    f"table.ellipsoids[{i}]",
+                    f"Q of shape {(n, n)} and F of shape {(m, n)} (the plant's sizes)",
+                    f"{shapes[0]} and {shapes[1]}",
+                )
+        if table.interpolable.shape != (max(table.n_ellipsoids - 1, 0),):
+            raise InvalidArgumentError("table.interpolable", f"{max(table.n_ellipsoids - 1, 0)} flags",
+                                       f"shape {table.interpolable.shape}")
+        ctrl._store(table)
+        ctrl._auto = False
+        return ctrl
 
     @property
     def input_constraint(self) -> str | None:
@@ -196,11 +263,11 @@ class OfflineRMPC:
 
         A table designed here is kept until the next call (no automatic redesign).
         """
-        table = self._design(x_design)
+        table = self._design_table(x_design)
         self._auto = False
         return table
 
-    def _design(self, x_design: ArrayLike) -> OfflineTable:
+    def _design_table(self, x_design: ArrayLike) -> OfflineTable:
         arr = np.asarray(x_design, dtype=float) if not isinstance(x_design, str) else None
         if arr is None or arr.ndim not in (1, 2):
             raise InvalidArgumentError(
@@ -241,6 +308,44 @@ class OfflineRMPC:
         self._split = count * n
         self._gammas = table.gammas.tolist()
         self._interp = (table.interpolable & self._interpolate).tolist() if count > 1 else []
+
+    # -- save and load ------------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The plant, the constructor's arguments, whether the table is redesigned for a run that
+        starts outside it (``x_design=None``), and the table (nothing designed yet: an error)."""
+        if self.table is None:
+            raise InvalidArgumentError(
+                "OfflineRMPC", "a designed table to save (x_design=..., design(x), or a first step)",
+                "no table yet",
+            )
+        return {
+            "plant": plant_design(self.plant),
+            "arguments": encode({**self._arguments, "interpolate": self._interpolate},
+                                "OfflineRMPC arguments"),
+            "redesign_outside": self._auto,
+            "table": _table_design(self.table),
+        }
+
+    @classmethod
+    def _from_design(cls, design: Design) -> OfflineRMPC:
+        arguments = design.part("arguments")
+        readers = {
+            "Q": lambda k: arguments.array(k, 2), "R": lambda k: arguments.array(k, 2),
+            "u_max": arguments.bound, "input_constraint": lambda k: arguments.optional_text(k),
+            "output_matrix": lambda k: arguments.optional_array(k, 2), "y_max": arguments.bound,
+            "n_ellipsoids": arguments.integer, "shrink": arguments.number, "path": arguments.text,
+            "interpolate": arguments.flag, "backend": arguments.text,
+            "solver": lambda k: arguments.optional_text(k),
+            "solver_options": lambda k: arguments.optional_mapping(k),
+            "formulation": arguments.text, "certificate_tol": arguments.number, "cost": arguments.text,
+            "lyapunov": arguments.text,
+        }
+        values = {name: read(name) for name, read in readers.items()}
+        arguments.finish()
+        table = design.part("table")
+        ctrl = cls.from_table(design.plant(), _table_from_design(table), **values)
+        ctrl._auto = design.flag("redesign_outside")
+        return ctrl
 
     def reset(self) -> None:
         """Forget the last step; the table is kept (see ``x_design`` for when it is redesigned)."""
@@ -300,7 +405,7 @@ class OfflineRMPC:
         inside = self._count > 0 and float(np.sum((self._lookup[: self._n] @ z) ** 2)) <= _ONE
         if self._auto and not inside:
             t0 = time.perf_counter()
-            self._design(z)
+            self._design_table(z)
             design_time = time.perf_counter() - t0
         u = self.step(z)
         assert self.last is not None
@@ -310,3 +415,57 @@ class OfflineRMPC:
         )
         return u
 
+
+
+def _table_design(table: OfflineTable) -> dict[str, Any]:
+    """An :class:`~lmi.offline.OfflineTable` as JSON values (every field, each ellipsoid's too)."""
+    entries = [
+        {
+            "status": e.status, "x": e.x, "gamma": e.gamma, "Q": e.Q, "Y": e.Y, "F": e.F,
+            "certificate": None if e.certificate is None else {"margins": dict(e.certificate.margins),
+                                                                "tol": e.certificate.tol},
+            "nesting_margin": e.nesting_margin, "solve_time": e.solve_time,
+            "solver_status": e.solver_status, "iterations": e.iterations,
+        }
+        for e in table.ellipsoids
+    ]
+    return encode({
+        "ellipsoids": entries, "interpolation_margins": table.interpolation_margins,
+        "interpolable": table.interpolable, "design_time": table.design_time,
+        "stop_reason": table.stop_reason, "failed_status": table.failed_status,
+        "skipped": [list(item) for item in table.skipped],
+    }, "OfflineRMPC table")
+
+
+def _table_from_design(design: Design) -> OfflineTable:
+    """The :class:`~lmi.offline.OfflineTable` :func:`_table_design` wrote."""
+    from lmi.certificate import Certificate
+    from lmi.offline import NestedEllipsoid, OfflineTable
+
+    entries = []
+    for part in design.parts("ellipsoids"):
+        cert = part.optional_part("certificate")
+        certificate = None
+        if cert is not None:
+            margins = cert.mapping("margins")
+            certificate = Certificate({str(k): float(v) for k, v in margins.items()}, cert.number("tol"))
+            cert.finish()
+        entries.append(NestedEllipsoid(
+            status=part.text("status"), x=part.array("x", 1), gamma=part.number("gamma"),
+            Q=part.array("Q", 2), Y=part.array("Y", 2), F=part.array("F", 2), certificate=certificate,
+            nesting_margin=part.number("nesting_margin"), solve_time=part.number("solve_time"),
+            solver_status=part.text("solver_status"), iterations=part.optional_integer("iterations"),
+        ))
+        part.finish()
+    skipped = design.value("skipped")
+    if not isinstance(skipped, list) or not all(isinstance(s, list) and len(s) == 2 for s in skipped):
+        raise InvalidArgumentError("design.table.skipped", "a list of [position, level] pairs",
+                                   repr(skipped)[:80])
+    table = OfflineTable(
+        ellipsoids=tuple(entries), interpolation_margins=design.array("interpolation_margins", 1),
+        interpolable=design.booleans("interpolable"), design_time=design.number("design_time"),
+        stop_reason=design.text("stop_reason"), failed_status=design.optional_text("failed_status"),
+        skipped=tuple((int(i), float(level)) for i, level in skipped),
+    )
+    design.finish()
+    return table

@@ -15,6 +15,8 @@ from lmi import KothareProblem, LMISolution
 from lmi.forms import FormProblem, form_options
 from models import PolytopicModel
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.io.design import Design, encode, plant_design, snapshot
+from rmpc.io.saveable import Saveable
 from rmpc.mpc.diagnosis import FailureDiagnosis, diagnose
 from rmpc.mpc.fallback import CertifiedGain
 from rmpc.mpc.methods import method_options
@@ -22,7 +24,7 @@ from rmpc.mpc.setpoint import SteadyTarget, steady_target
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["RMPC", "input_constraint_kind"]
+__all__ = ["RMPC", "input_constraint_kind", "read_target", "rmpc_arguments", "target_design"]
 
 
 def input_constraint_kind(input_constraint: str | None, u_max: ArrayLike) -> str | None:
@@ -35,7 +37,61 @@ def input_constraint_kind(input_constraint: str | None, u_max: ArrayLike) -> str
     return input_constraint
 
 
-class RMPC:
+def rmpc_arguments(design: Design, partial: bool = False) -> dict[str, Any]:
+    """The keyword arguments of :class:`RMPC` (all but the plant) read from a saved design.
+
+    ``partial``: only those present (CRMPC's ``rmpc_options``); otherwise every one, each required.
+    """
+    readers: dict[str, Any] = {
+        "Q": lambda d, k: d.array(k, 2), "R": lambda d, k: d.array(k, 2), "u_max": Design.bound,
+        "input_constraint": lambda d, k: d.optional_text(k),
+        "output_matrix": lambda d, k: d.optional_array(k, 2), "y_max": Design.bound,
+        "x_ref": lambda d, k: d.optional_array(k, 1), "backend": Design.text,
+        "solver": lambda d, k: d.optional_text(k),
+        "solver_options": lambda d, k: d.optional_mapping(k), "formulation": Design.text,
+        "certificate_tol": Design.number, "on_failure": Design.text, "hold_radius": Design.number,
+        "resolve_threshold": Design.number, "lyapunov": Design.text, "cost": Design.text,
+        "free_moves": Design.integer, "saturation": lambda d, k: d.optional_text(k),
+        "soft": lambda d, k: d.optional_mapping(k), "disturbance": _disturbance,
+        "offset_free": Design.flag,
+    }
+    return {name: read(design, name) for name, read in readers.items() if not partial or design.has(name)}
+
+
+def target_design(target: SteadyTarget | None) -> dict[str, Any] | None:
+    """The set-point of :meth:`RMPC.set_reference` as JSON values (``None``: none set)."""
+    if target is None:
+        return None
+    return encode({"x": target.x, "u": target.u, "outputs": target.outputs, "reference": target.reference})
+
+
+def read_target(design: Design, name: str, plant: PolytopicModel) -> SteadyTarget | None:
+    """The set-point :func:`target_design` wrote, its sizes checked against ``plant``."""
+    part = design.optional_part(name)
+    if part is None:
+        return None
+    target = SteadyTarget(part.array("x", 1), part.array("u", 1),
+                          part.array("outputs", 2), part.array("reference", 1))
+    part.finish()
+    n, m = plant.n_states, plant.n_inputs
+    if target.x.shape != (n,) or target.u.shape != (m,):
+        raise InvalidArgumentError(f"design.{name}", f"x of {n} and u of {m} values",
+                                   f"{target.x.shape} and {target.u.shape}")
+    return target
+
+
+def _disturbance(design: Design, name: str) -> tuple[Any, ...] | None:
+    """``(E, w_max, lam)`` of the disturbance form, or ``None``."""
+    part = design.value(name)
+    if part is None:
+        return None
+    if not isinstance(part, list) or len(part) != 3:
+        raise InvalidArgumentError(f"design.{name}", "[E, w_max, lam]", repr(part)[:80])
+    values = Design({"E": part[0], "w_max": part[1], "lam": part[2]}, f"design.{name}")
+    return (values.array("E", 2), values.number("w_max"), values.optional_number("lam"))
+
+
+class RMPC(Saveable):
     """Robust MPC over a polytopic model (Kothare et al. 1996), the ``step(x)`` protocol.
 
     Parameters
@@ -216,6 +272,42 @@ class RMPC:
             self.accepts = frozenset({"u_max", "d_hat"})
         self.dt = plant.dt
         self.last: StepInfo | None = None
+        disturbance = self.form.disturbance
+        # the design as constructed (what save writes; copies, so later changes by the caller do not leak in)
+        self._arguments: dict[str, Any] = snapshot({
+            "Q": Q, "R": R, "u_max": u_max, "input_constraint": input_constraint,
+            "output_matrix": output_matrix, "y_max": y_max, "x_ref": x_ref, "backend": backend,
+            "solver": solver, "solver_options": solver_options, "formulation": formulation,
+            "certificate_tol": certificate_tol, "on_failure": on_failure, "hold_radius": hold_radius,
+            "resolve_threshold": resolve_threshold, "lyapunov": lyapunov, "cost": cost,
+            "free_moves": free_moves, "saturation": saturation, "soft": soft,
+            "disturbance": (None if disturbance is None
+                            else (disturbance.E, disturbance.w_max, disturbance.lam)),
+            "offset_free": self.offset_free,
+        })
+
+    # -- save and load ---------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The plant, the constructor's arguments and the set-point (:meth:`set_reference`)."""
+        return {
+            "plant": plant_design(self.plant),
+            "arguments": encode(self._arguments, "RMPC arguments"),
+            "reference": target_design(self.target),
+        }
+
+    @classmethod
+    def _from_design(cls, design: Design) -> RMPC:
+        arguments = design.part("arguments")
+        ctrl = cls(design.plant(), **rmpc_arguments(arguments))
+        arguments.finish()
+        ctrl._restore_target(read_target(design, "reference", ctrl.plant))
+        return ctrl
+
+    def _restore_target(self, target: SteadyTarget | None) -> None:
+        """Hold a saved set-point as :meth:`set_reference` did (nothing solved again)."""
+        if target is not None:
+            self.target = target
+            self.x_ref, self.u_ref = target.x.copy(), target.u.copy()
 
     def set_reference(self, reference: ArrayLike, outputs: ArrayLike) -> SteadyTarget:
         """Hold the outputs ``C_r x`` (``outputs``) at ``reference`` from the next step on.

@@ -27,16 +27,41 @@ from numpy.typing import ArrayLike
 from lmi import KothareProblem, LMISolution
 from models import PolytopicModel, RigidSatellite
 from rmpc.controller import StepInfo, StepInputs, check_step_inputs
+from rmpc.io.design import Design, encode
+from rmpc.io.saveable import Saveable
 from rmpc.mpc.diagnosis import diagnose
 from rmpc.mpc.fallback import CertifiedGain
 from rmpc.mpc.robust_mpc import input_constraint_kind
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["ScheduledRMPC"]
+__all__ = ["SatellitePolytopes", "ScheduledRMPC"]
 
 
-class ScheduledRMPC:
+class SatellitePolytopes:
+    """``polytope_at`` of :meth:`ScheduledRMPC.for_satellite`: the rigid satellite's inertia
+    polytope at the measured attitude with zero rates.
+
+    A class rather than a closure, so that the schedule pickles and a saved controller can name
+    it (:meth:`ScheduledRMPC.save`).
+
+    Parameters
+    ----------
+    satellite : RigidSatellite
+    dt, spread : float
+    mode : {"scalar", "box"}
+        As :meth:`models.RigidSatellite.polytope`.
+    """
+
+    def __init__(self, satellite: RigidSatellite, dt: float, spread: float, mode: str) -> None:
+        self.satellite, self.dt, self.spread, self.mode = satellite, float(dt), float(spread), mode
+
+    def __call__(self, x: np.ndarray) -> PolytopicModel:
+        x_op = np.concatenate((np.asarray(x[:3], dtype=float), np.zeros(3)))
+        return self.satellite.polytope(x_op, self.dt, self.spread, self.mode)  # type: ignore[arg-type]
+
+
+class ScheduledRMPC(Saveable):
     """Robust MPC whose polytope is rebuilt at the measured state at every step.
 
     Parameters
@@ -130,12 +155,42 @@ class ScheduledRMPC:
             raise ArgumentTypeError("satellite", "a models.RigidSatellite", type(satellite).__name__)
         dt = check_positive(dt, "dt")
         satellite.inertia_vertices(spread, mode)  # checks spread and mode now, not at the first step
+        return cls(SatellitePolytopes(satellite, dt, spread, mode), Q, R, u_max, input_constraint, **options)
 
-        def polytope_at(x: np.ndarray) -> PolytopicModel:
-            x_op = np.concatenate((np.asarray(x[:3], dtype=float), np.zeros(3)))
-            return satellite.polytope(x_op, dt, spread, mode)
+    # -- save and load ---------------------------------------------------------------------
+    def _design(self) -> dict[str, Any]:
+        """The schedule (the satellite's inertia, ``dt``, ``spread``, ``mode``) and the options; a
+        schedule that is a user's function cannot be saved (a file holds data, not code)."""
+        schedule = self.polytope_at
+        if not isinstance(schedule, SatellitePolytopes):
+            raise InvalidArgumentError(
+                "polytope_at", "the schedule of ScheduledRMPC.for_satellite to save the controller (a file "
+                "holds data, not code; pickle keeps a function that pickles)",
+                getattr(schedule, "__qualname__", type(schedule).__name__),
+            )
+        return encode({
+            "schedule": {"inertia": schedule.satellite.inertia, "dt": schedule.dt, "spread": schedule.spread,
+                         "mode": schedule.mode},
+            "options": self.options, "on_failure": self.on_failure, "hold_radius": self.hold_radius,
+        }, "ScheduledRMPC design")
 
-        return cls(polytope_at, Q, R, u_max, input_constraint, **options)
+    @classmethod
+    def _from_design(cls, design: Design) -> ScheduledRMPC:
+        schedule = design.part("schedule")
+        options = design.part("options")
+        satellite = RigidSatellite(schedule.array("inertia", 2))
+        ctrl = cls.for_satellite(
+            satellite, dt=schedule.number("dt"), spread=schedule.number("spread"),
+            Q=options.array("Q", 2), R=options.array("R", 2), u_max=options.bound("u_max"),
+            input_constraint=options.optional_text("input_constraint"),
+            mode=schedule.text("mode"),
+            backend=options.text("backend"), formulation=options.text("formulation"),
+            certificate_tol=options.number("certificate_tol"), on_failure=design.text("on_failure"),
+            hold_radius=design.number("hold_radius"),
+        )
+        schedule.finish()
+        options.finish()
+        return ctrl
 
     @property
     def on_failure(self) -> str:

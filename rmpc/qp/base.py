@@ -140,6 +140,17 @@ class QPBackend(ABC):
         self._size = (0, 0)
         self._vec: dict[str, np.ndarray] = {}
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Copies and pickles hold the settings and the current problem, not the solver (OSQP's,
+        Clarabel's and cvxpy's do not pickle): :meth:`__setstate__` builds it again, so a
+        restored back-end answers as one set up afresh with the same data (no warm start)."""
+        return {"settings": self.settings, "qp": None if self._qp is None else self.problem}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        type(self).__init__(self, state["settings"])
+        if state["qp"] is not None:
+            self.setup(state["qp"])
+
     # -- the verbs -------------------------------------------------------------------
     def setup(self, qp: QP) -> None:
         """Store ``qp`` and build the solver (matrices are fixed from here on)."""
