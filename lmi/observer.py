@@ -67,7 +67,7 @@ from lmi.ipm import BlockLMISolver
 from lmi.status import INFEASIBLE, NUMERICAL_ERROR, OPTIMAL, SOLVER_ERROR
 from toolkit_common.errors import InvalidArgumentError
 
-__all__ = ["ALPHA_GRID", "ObserverDesign", "design_robust_observer"]
+__all__ = ["ALPHA_GRID", "ObserverDesign", "certify_observer", "design_robust_observer"]
 
 #: The contraction parameters ``alpha`` tried first; the best is refined by golden section.
 ALPHA_GRID: tuple[float, ...] = (0.02, 0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.75, 0.9)
@@ -107,6 +107,8 @@ class ObserverDesign:
     solve_time: float
     nominal: tuple[np.ndarray, np.ndarray] = field(repr=False, default=(np.zeros((0, 0)), np.zeros((0, 0))))
     C: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((0, 0)))
+    mu: np.ndarray | None = field(repr=False, default=None)
+    Z: np.ndarray | None = field(repr=False, default=None)
 
     @property
     def ok(self) -> bool:
@@ -332,9 +334,42 @@ def design_robust_observer(
         _, alpha, values, cert = min(answers, key=lambda item: item[0])
         p_mat = 0.5 * (values["P"] + values["P"].T)
         m_mat = np.linalg.solve(p_mat, values["Y"])
-        return ObserverDesign(OPTIMAL, m_mat, p_mat, alpha, cert, "optimal", total, (a0, b0), c)
+        mu = np.array([values[f"mu{i}"][0, 0] for i in range(channels)])
+        return ObserverDesign(OPTIMAL, m_mat, p_mat, alpha, cert, "optimal", total, (a0, b0), c, mu,
+                              0.5 * (values["Z"] + values["Z"].T))
     words = "; ".join(f"alpha {a:.3g}: {w}" for a, (_s, w, _v) in sorted(tried.items()))
     statuses = {s for s, _w, _v in tried.values()}
     status = INFEASIBLE if statuses == {INFEASIBLE} else NUMERICAL_ERROR
     return ObserverDesign(status, None, None, float("nan"), Certificate({"none": -np.inf}, tol),
                           f"no certified answer ({words})", total, (a0, b0), c)
+
+
+def certify_observer(
+    vertices: list[tuple[ArrayLike, ArrayLike]],
+    nominal: tuple[ArrayLike, ArrayLike],
+    C: ArrayLike,
+    noise_bound: ArrayLike,
+    state_bound: ArrayLike | None,
+    input_bound: ArrayLike | None,
+    alpha: float,
+    P: ArrayLike,
+    M: ArrayLike,
+    mu: ArrayLike,
+    Z: ArrayLike,
+    tol: float = 1e-7,
+) -> Certificate:
+    """The design's blocks recomputed at a given answer (``Y = P M``): a gain and bound read back
+    from a file are checked again, not trusted.
+
+    Parameters are those of :func:`design_robust_observer` and the answer's ``alpha``, ``P``,
+    ``M``, multipliers ``mu`` and trace bound ``Z``.
+    """
+    a0, b0 = (np.atleast_2d(np.asarray(mat, dtype=float)) for mat in nominal)
+    c = np.atleast_2d(np.asarray(C, dtype=float))
+    data = _data(list(vertices), (a0, b0), c, noise_bound, state_bound, input_bound)
+    p_mat = np.asarray(P, dtype=float)
+    mu = np.asarray(mu, dtype=float).ravel()
+    if mu.size != data.mismatch[0].shape[1] + c.shape[0]:
+        return Certificate({"multipliers_count": -np.inf}, tol)
+    return _observer_margins(data, float(alpha), p_mat, p_mat @ np.asarray(M, dtype=float), mu,
+                             np.asarray(Z, dtype=float), tol)

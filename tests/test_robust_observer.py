@@ -212,3 +212,39 @@ def test_simulate_with_uniform_noise_keeps_the_error_in_the_bound():
     with pytest.raises(InvalidArgumentError, match="noise_kind"):
         simulate(ctrl, Truth(), np.zeros(2), duration=0.2, dt=0.1, measurement=c, noise=1e-3,
                  noise_kind="laplace", estimator=obs)
+
+
+def test_save_and_load_keep_the_gain_and_recheck_the_certificate(tmp_path):
+    import json
+    import pickle
+
+    import rmpc
+
+    plant = _damped_polytope()
+    obs = RobustObserver(plant, C=[[1.0, 0.0]], noise_bound=1e-3, state_bound=[1.0, 1.0], input_bound=2.0)
+    path = obs.save(tmp_path / "observer.rmpc")
+    loaded = rmpc.load(path)
+    copied = pickle.loads(pickle.dumps(obs))
+    for other in (loaded, copied):
+        assert type(other) is RobustObserver and other.design.certificate.ok
+        assert np.array_equal(other.M, obs.M) and np.array_equal(other.P, obs.P)
+        assert np.array_equal(other.estimate_disturbance()[1], obs.estimate_disturbance()[1])
+    ys = np.random.default_rng(2).normal(size=(20, 1))
+    obs.reset()
+    loaded.reset()
+    for k, y in enumerate(ys):
+        u = None if k == 0 else np.array([0.1])
+        assert np.array_equal(loaded.update(y, u), obs.update(y, u))
+    # a file whose bound no longer holds for its gain (a smaller P, checksum rewritten) is refused
+    from rmpc.io.format import read_file
+
+    doc = json.loads(path.read_text())
+    doc["design"]["P"] = (0.5 * np.asarray(obs.P)).tolist()
+    tampered = tmp_path / "tampered.rmpc"
+    from rmpc.io import format as file_format
+
+    doc["sha256"] = file_format.checksum({k: v for k, v in doc.items() if k != "sha256"})
+    tampered.write_text(json.dumps(doc))
+    read_file(tampered)  # the envelope is intact
+    with pytest.raises(InvalidArgumentError, match="certificate"):
+        rmpc.load(tampered)

@@ -21,14 +21,17 @@ observer's design assumed holds when ``sqrt(Q_ii) + sqrt((P^-1)_ii) <= state_bou
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from lmi.observer import ObserverDesign, design_robust_observer
+from lmi.certificate import Certificate
+from lmi.observer import ObserverDesign, certify_observer, design_robust_observer
+from lmi.status import OPTIMAL
 from models import PolytopicModel
 from rmpc.estimators.linear import LinearEstimator, _unobservable_modes
+from rmpc.io.design import Design, encode
 from toolkit_common.errors import InvalidArgumentError, SolverError
 
 __all__ = ["RobustObserver"]
@@ -104,11 +107,9 @@ class RobustObserver(LinearEstimator):
                 f"unseen modes {[complex(round(z.real, 9), round(z.imag, 9)) for z in unseen]}",
             )
         self.vertices = _vertices(plant, (self.A, self.B))
-        self.noise_bound = noise_bound
-        self.state_bound = None if state_bound is None else np.broadcast_to(
-            np.asarray(state_bound, dtype=float), (self.n_states,)).copy()
         design = design_robust_observer(self.vertices, (self.A, self.B), self.C, noise_bound,
                                         state_bound, input_bound)
+        self._keep_bounds(noise_bound, state_bound, input_bound)
         if not design.ok:
             raise SolverError(
                 f"RobustObserver: no gain with a certified error bound ({design.status}: "
@@ -120,6 +121,47 @@ class RobustObserver(LinearEstimator):
         self.M = design.M
         self.P = design.P
         self.alpha = design.alpha
+
+    def _keep_bounds(self, noise_bound: ArrayLike, state_bound: ArrayLike | None,
+                     input_bound: ArrayLike | None) -> None:
+        """The design's bounds as arrays (they were checked by the design)."""
+        def vector(value: ArrayLike | None, size: int) -> np.ndarray | None:
+            return None if value is None else np.broadcast_to(np.asarray(value, dtype=float), (size,)).copy()
+
+        self.noise_bound = vector(noise_bound, self.n_outputs)
+        self.state_bound = vector(state_bound, self.n_states)
+        self.input_bound = vector(input_bound, self.n_inputs)
+
+    # -- save and load: the gain and the bound as designed, their certificate checked again --
+    def _design(self) -> dict[str, Any]:
+        base = super()._design()
+        extra = {
+            "vertices_A": np.stack([a for a, _ in self.vertices]),
+            "vertices_B": np.stack([b for _, b in self.vertices]),
+            "noise_bound": self.noise_bound, "state_bound": self.state_bound,
+            "input_bound": self.input_bound, "P": self.P, "alpha": self.alpha,
+            "mu": self.design.mu, "Z": self.design.Z,
+        }
+        return {**base, **encode(extra, "RobustObserver design")}
+
+    @classmethod
+    def _from_design(cls, design: Design) -> Self:
+        est = super()._from_design(design)
+        est.vertices = list(zip(design.array("vertices_A", 3), design.array("vertices_B", 3), strict=True))
+        est._keep_bounds(design.array("noise_bound", 1), design.optional_array("state_bound", 1),
+                         design.optional_array("input_bound", 1))
+        est.P, est.alpha = design.array("P", 2), design.number("alpha")
+        mu, z_mat = design.array("mu", 1), design.array("Z", 2)
+        cert: Certificate = certify_observer(
+            est.vertices, (est.A, est.B), est.C, est.noise_bound, est.state_bound, est.input_bound,
+            est.alpha, est.P, est.M, mu, z_mat)
+        if not cert.ok:
+            raise InvalidArgumentError(
+                "design", "a robust observer whose certificate holds at the saved gain and bound",
+                f"worst relative margin {cert.worst:.3g}")
+        est.design = ObserverDesign(OPTIMAL, est.M, est.P, est.alpha, cert, "loaded", 0.0, (est.A, est.B),
+                                    est.C, mu, z_mat)
+        return est
 
     @property
     def half_widths(self) -> np.ndarray:

@@ -29,6 +29,7 @@ KINDS: MappingProxyType[str, str] = MappingProxyType({
     "LQR": "rmpc.mpc.lqr:LQR",
     "Luenberger": "rmpc.estimators.linear:Luenberger",
     "KalmanFilter": "rmpc.estimators.linear:KalmanFilter",
+    "RobustObserver": "rmpc.estimators.robust:RobustObserver",
 })
 
 
