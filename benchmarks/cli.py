@@ -409,6 +409,9 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     demo.add_argument("--duration", type=float, default=30.0, help="simulated time in s")
     demo.set_defaults(func=_cmd_demo)
     _add_bench(sub)
+    from benchmarks.export_command import add_export_parser
+
+    add_export_parser(sub, _out_dir)
     command = next((a for a in (argv or []) if not a.startswith("-")), None)
     if argv is None or command == "timing":
         _add_timing(sub)
