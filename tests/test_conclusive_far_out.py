@@ -13,9 +13,10 @@ Every answer is
 * ``"infeasible"`` with a Farkas ray that :func:`lmi.infeasibility.check_farkas` accepts,
   checked again here on the conic data of the problem as it was solved (Kothare's form).
 
-On main before this change 5 of the 81 Kothare-form cases (fresh controllers) and 1 of the 81
-vertex-form cases ended ``numerical_error`` (Kothare's example 2 along ``(1, 1, 0, 0)`` at 1e3..1e5,
-along ``(0, 0, 1, 1)`` at 1; example 1 along a random direction at 1e4).
+Before this change 5 of the 72 Kothare-form cases and 1 of the 45 vertex-form cases ended
+``numerical_error`` (Kothare's example 2 along ``(1, 1, 0, 0)`` at 1e3..1e5 and along
+``(0, 0, 1, 1)`` at 1, example 1 along the random direction at 1e4; the vertex form along
+``(1, 1, 0, 0)`` at 1e5).
 """
 
 from __future__ import annotations
