@@ -19,11 +19,16 @@ from lmi.backends.ipm import IPMKothare
 from lmi.certificate import Certificate, certify
 from lmi.data import Formulation, InputConstraint, KothareData, build_kothare_data
 from lmi.infeasibility import InfeasibilityCertificate
-from lmi.status import OPTIMAL, UNCERTIFIED
+from lmi.status import INACCURATE, OPTIMAL, UNCERTIFIED
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_vector, check_positive
 
-__all__ = ["KothareProblem", "LMISolution"]
+__all__ = ["MIX_WEIGHTS", "KothareProblem", "LMISolution"]
+
+#: The weights of a strictly feasible point (phase one's) mixed into an answer that is not
+#: certified (see :meth:`KothareProblem.solve`), smallest first: the first whose mix passes is
+#: taken; the last, 1, is the point itself.
+MIX_WEIGHTS: tuple[float, ...] = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0)
 
 
 @dataclass(frozen=True)
@@ -139,8 +144,10 @@ class KothareProblem:
         ``"ipm"`` (default: the toolkit's own structure-exploiting interior-point method
         :mod:`lmi.ipm`, data built once, warm-started; an infeasible problem is proved so by
         the run's own dual iterates or, after a failed solve, by phase one (status
-        ``"infeasible"`` with ``LMISolution.infeasibility``), and what neither settles goes to
-        Clarabel; :mod:`lmi.backends.ipm`),
+        ``"infeasible"`` with ``LMISolution.infeasibility``); a strictly feasible point phase
+        one finds is mixed into an answer that is not certified, or is the answer, status
+        ``"inaccurate"`` with ``gamma`` an upper bound (:data:`MIX_WEIGHTS`); what neither settles
+        goes to Clarabel; :mod:`lmi.backends.ipm`),
         ``"clarabel"`` (Clarabel's own API, data built once) or
         ``"cvxpy"`` with ``solver`` naming any installed
         cvxpy conic solver (``"CLARABEL"``, ``"SCS"``, ...).
@@ -314,10 +321,47 @@ class KothareProblem:
         except np.linalg.LinAlgError:
             f_mat = None
         status = raw.status
-        if status == OPTIMAL and (not cert.ok or f_mat is None or not np.all(np.isfinite(f_mat))):
+        certified = cert.ok and f_mat is not None and bool(np.all(np.isfinite(f_mat)))
+        if raw.interior is not None and not (certified and status in (OPTIMAL, INACCURATE)):
+            mixed = self._mixed(raw, raw.interior, x, s2, data)
+            if mixed is not None:
+                return mixed
+        if status == OPTIMAL and not certified:
             status = UNCERTIFIED
         return LMISolution(
             status, gamma, q_mat, y_mat, f_mat, raw.solve_time, raw.iterations, raw.solver_status,
             cert, self.backend, x,
             gamma_dual=None if raw.gamma_dual is None else raw.gamma_dual * s2,
         )
+
+    def _mixed(self, raw: RawResult, interior: tuple[float, np.ndarray, np.ndarray], x: np.ndarray,
+               s2: float, data: KothareData | None) -> LMISolution | None:
+        """An answer that is not certified (or not an answer: a failure word with its last
+        iterate) mixed with a strictly feasible point (phase one's): ``(1 - w) answer + w point``
+        for the first weight ``w`` of :data:`MIX_WEIGHTS` whose certificate holds (``w = 1``: the
+        point itself), status ``"inaccurate"``, its ``gamma`` an upper bound on the optimum;
+        ``None`` if none holds.
+
+        Every LMI is affine in ``(gamma, Q, Y)``, so the mix is feasible wherever both are; at the
+        optimum of a thin feasible set (``Q`` spanning ten decades or more) the optimum sits on
+        the boundary and the recomputed peak-bound margin ``1 - (Y Q^-1 Y')_jj / u_j^2`` falls a
+        little below ``-certificate_tol`` (measured: -3e-7 on Kothare's example 2 at 7e3 times
+        beyond the bound), while the point has a positive margin."""
+        gamma_p, q_p, y_p = interior
+        data = self.data if data is None else data
+        for w in MIX_WEIGHTS:
+            gamma = ((1.0 - w) * raw.gamma + w * gamma_p) * s2
+            q_mat = 0.5 * ((1.0 - w) * (raw.Q + raw.Q.T) + w * (q_p + q_p.T)) * s2  # type: ignore[operator]
+            y_mat = ((1.0 - w) * raw.Y + w * y_p) * s2  # type: ignore[operator]
+            cert = certify(data, x, gamma, q_mat, y_mat, tol=self.certificate_tol)
+            try:
+                f_mat = np.linalg.solve(q_mat.T, y_mat.T).T
+            except np.linalg.LinAlgError:
+                continue
+            if cert.ok and np.all(np.isfinite(f_mat)):
+                how = "phase one's point" if w == 1.0 else f"mixed with phase one's point at w={w:g}"
+                return LMISolution(
+                    INACCURATE, gamma, q_mat, y_mat, f_mat, raw.solve_time, raw.iterations,
+                    f"{raw.solver_status}; {how} (gamma an upper bound)", cert, self.backend, x,
+                )
+        return None

@@ -98,8 +98,9 @@ def test_on_failure_raise():
 
 
 def test_solver_stopped_early_is_a_fallback():
-    """``max_iter = 2`` (no Clarabel fallback): the IPM stops early; RMPC records it and falls back."""
-    options = {"max_iter": 2, "fallback": False}
+    """``max_iter = 2`` (no Clarabel fallback, no phase one): the IPM stops early; RMPC records it
+    and falls back."""
+    options = {"max_iter": 2, "fallback": False, "phase_one": False}
     ctrl = _controller(solver_options=options)
     with pytest.warns(NoCertifiedGainWarning, match="'max_iterations'.*max_iter"):
         u = ctrl.step(NEAR)
@@ -107,6 +108,19 @@ def test_solver_stopped_early_is_a_fallback():
     np.testing.assert_array_equal(u, np.zeros(1))
     with pytest.raises(SolverError):
         _controller(solver_options=options, on_failure="raise").step(NEAR)
+
+
+def test_solver_stopped_early_with_phase_one_applies_its_certified_point():
+    """The same early stop with phase one (the default): phase one's strictly feasible point is
+    the answer, ``"inaccurate"`` with its certificate, and it is applied (no fallback)."""
+    ctrl = _controller(solver_options={"max_iter": 2, "fallback": False})
+    u = ctrl.step(NEAR)
+    sol = ctrl.last.extra["solution"]
+    assert ctrl.last.status == "inaccurate" and not ctrl.last.fallback, sol.solver_status
+    assert sol.solver_status.startswith("ipm max_iterations; phase one feasible")
+    assert sol.solver_status.endswith("phase one's point (gamma an upper bound)")
+    assert sol.certificate.ok and min(sol.certificate.margins.values()) > 0.0
+    np.testing.assert_allclose(u, sol.F @ NEAR, rtol=1e-12)
 
 
 # -- certificates ----------------------------------------------------------------------------

@@ -38,6 +38,10 @@ class RawResult:
     #: The back-end's own dual bound on the optimal ``gamma`` (Clarabel's dual objective), in
     #: the units of :attr:`gamma`; ``None`` where the back-end reports none.
     gamma_dual: float | None = None
+    #: ``(gamma, Q, Y)`` of a strictly feasible point the IPM's phase one found on the way, in the
+    #: units of :attr:`gamma`, :attr:`Q`, :attr:`Y`; :class:`lmi.KothareProblem` mixes it into an
+    #: answer whose certificate fails (``None``: no such point).
+    interior: tuple[float, np.ndarray, np.ndarray] | None = None
 
 
 class KothareBackend(ABC):

@@ -6,7 +6,9 @@ The LMIs are the same conic data as for :class:`lmi.backends.clarabel.ClarabelKo
 the state block's constant and the bound scalings of the input (and output) blocks change; they
 are written in place. Successive solves are warm-started (see :data:`DEFAULT_IPM_OPTIONS`). A
 solve that fails goes to phase one and then to a :class:`~lmi.backends.clarabel.ClarabelKothare`
-the back-end owns, built on the same conic data (:meth:`IPMKothare.solve`).
+the back-end owns, built on the same conic data (:meth:`IPMKothare.solve`); a strictly
+feasible point phase one found goes with the answer (``RawResult.interior``), so that no
+solve whose phase one decided ends ``"numerical_error"``.
 
 With ``nesting=True`` the conic data have one more block, the nesting ``Q_outer - Q >= 0`` of
 the off-line design (:class:`lmi.offline.NestedKothareProblem`), and every solve takes the outer
@@ -32,7 +34,7 @@ from lmi.ipm import BlockLMISolver
 from lmi.ipm.solver import INFEASIBILITY_RADIUS
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
-from lmi.status import INFEASIBLE, NUMERICAL_ERROR, OPTIMAL
+from lmi.status import INACCURATE, INFEASIBLE, NUMERICAL_ERROR, OPTIMAL
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
@@ -276,9 +278,17 @@ class IPMKothare(KothareBackend):
         the proof passes :func:`lmi.infeasibility.check_farkas` on the conic data of the
         fallback (independent of the IPM's own packing, equilibration and factored forms), the
         answer is ``"infeasible"`` with that certificate (``RawResult.infeasibility``) and
-        ``solver_status`` ``"ipm <word>; phase one infeasible"``. Otherwise the failed solve is
-        handed to Clarabel as before (same conic data), which classifies it or solves it;
-        ``solver_status`` then reads ``"ipm <word>; phase one <word>; clarabel <word>"``.
+        ``solver_status`` ``"ipm <word>; phase one infeasible"``. If phase one is inconclusive,
+        the solve is retried cold in coordinates balanced on the failed run's ``Q~`` whatever its
+        residuals (:meth:`_retry_inconclusive`; ``"...; rebalanced <word>"``), with phase one
+        again if that fails. If phase one finds a strictly feasible point, the solve is retried
+        cold in coordinates balanced on that point's ``Q~`` (:meth:`_retry_on_point`;
+        ``"...; rebalanced on it <word>"``), and the point goes with the answer as its
+        ``interior`` (:meth:`_with_point`): :class:`lmi.KothareProblem` mixes it into an answer
+        that is not certified, or gives it as the answer (``"inaccurate"``, ``gamma`` an upper
+        bound). Otherwise the failed solve is handed to Clarabel as before (same conic data),
+        which classifies it or solves it; ``solver_status`` then reads ``"ipm <word>; phase one
+        <word>; clarabel <word>"``.
         Before that, a failed solve whose relative residuals came below
         :data:`REBALANCE_MAX_RESIDUAL` and whose last ``Q~`` has a condition number above
         :data:`lmi.scaling.MIN_SPREAD` is retried cold once in coordinates in which that ``Q~``
@@ -317,19 +327,36 @@ class IPMKothare(KothareBackend):
             )
             if raw.status == OPTIMAL:
                 return self._unscale(raw, norm)
-        u_max, y_max = us, ys
+        point: RawResult | None = None
         if self._phase_one:
-            raw = self._decide(raw, xs, u_max, y_max, *_nest_args(qs))
+            raw, feasible_x = self._decide(raw, xs, us, ys, *_nest_args(qs))
             if raw.status == INFEASIBLE:
                 return raw
+            if feasible_x is None and raw.Q is not None and self._rebalance:
+                # phase one inconclusive (its optimum t* ~ 0 in these coordinates: the feasible
+                # set too thin for them): once more in coordinates balanced on the failed run's
+                # Q~, whatever its residuals, and phase one again there
+                raw, feasible_x = self._retry_inconclusive(raw, xs, x, u_max, y_max, outer)
+                if raw.status in (OPTIMAL, INFEASIBLE):
+                    return raw
+            if feasible_x is not None:
+                raw, point = self._retry_on_point(raw, feasible_x, x, u_max, y_max, outer)
+                if raw.status == OPTIMAL:
+                    return raw
+            xs, us, ys, norm = self._balanced(x, u_max, y_max)
+            qs = self._outer_scaled(outer, norm)
         if not self._fallback:
-            return self._unscale(raw, norm)
-        backup = self.fallback_solver.solve(xs, u_max, y_max, *_nest_args(qs))
+            answer = self._unscale(raw, norm)
+            if point is not None:
+                answer = dataclasses.replace(answer, solver_status=f"ipm {raw.solver_status}")
+            return answer if point is None else self._with_point(answer, point)
+        backup = self.fallback_solver.solve(xs, us, ys, *_nest_args(qs))
         iterations = None if backup.iterations is None else backup.iterations + (raw.iterations or 0)
-        return self._unscale(dataclasses.replace(
+        answer = self._unscale(dataclasses.replace(
             backup, solver_status=f"ipm {raw.solver_status}; clarabel {backup.solver_status}",
             iterations=iterations, solve_time=raw.solve_time + backup.solve_time,
         ), norm)
+        return answer if point is None else self._with_point(answer, point)
 
     def _balanced(self, x: np.ndarray, u_max: np.ndarray,
                   y_max: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -386,7 +413,13 @@ class IPMKothare(KothareBackend):
         """
         if raw.Q is None or self._last_residual > REBALANCE_MAX_RESIDUAL:
             return None
-        q_mat = 0.5 * (raw.Q + raw.Q.T)
+        return self._balanced_on(0.5 * (raw.Q + raw.Q.T), xs)
+
+    def _balanced_on(self, q_mat: np.ndarray, xs: np.ndarray) -> np.ndarray | None:
+        """The coordinates ``T L ||L^-1 xs||`` in which ``Q~ = q_mat = L L'`` (current
+        coordinates, normalised state ``xs``) is a multiple of the identity (see
+        :meth:`_rebalanced_scaling`); ``None`` unless ``q_mat`` is finite, positive definite
+        and spans more than :data:`lmi.scaling.MIN_SPREAD`."""
         if not np.all(np.isfinite(q_mat)):
             return None
         lam = np.linalg.eigvalsh(q_mat)
@@ -397,17 +430,18 @@ class IPMKothare(KothareBackend):
         return self._t[:, None] * step if self._t.ndim == 1 else self._t @ step
 
     def _decide(self, raw: RawResult, xs: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
-                outer: np.ndarray | None = None) -> RawResult:
+                outer: np.ndarray | None = None) -> tuple[RawResult, np.ndarray | None]:
         """Phase one after the failed solve ``raw`` (blocks already at this state): ``raw`` as
         ``"infeasible"`` with the checked certificate, or ``raw`` with phase one's word, time
-        and iterations added."""
+        and iterations added; and phase one's strictly feasible point (the solver's variables)
+        when it found one, else ``None``."""
         start = time.perf_counter()
         try:
             with self._blas.limit():
                 res = self._solver.phase_one()
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
             return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {err!r}",
-                                       solve_time=raw.solve_time + time.perf_counter() - start)
+                                       solve_time=raw.solve_time + time.perf_counter() - start), None
         word = res.status
         cert = None
         if res.status == "infeasible":
@@ -418,9 +452,97 @@ class IPMKothare(KothareBackend):
         elapsed = raw.solve_time + time.perf_counter() - start
         if cert is not None and cert.ok:
             return RawResult(INFEASIBLE, f"ipm {raw.solver_status}; phase one infeasible", np.nan, None,
-                             None, iterations, elapsed, infeasibility=cert)
+                             None, iterations, elapsed, infeasibility=cert), None
+        feasible_x = res.x if res.status == "feasible" and res.x is not None else None
         return dataclasses.replace(raw, solver_status=f"{raw.solver_status}; phase one {word}",
-                                   iterations=iterations, solve_time=elapsed)
+                                   iterations=iterations, solve_time=elapsed), feasible_x
+
+    def _retry_inconclusive(self, raw: RawResult, xs: np.ndarray, x: np.ndarray, u_max: np.ndarray,
+                            y_max: np.ndarray, outer: np.ndarray | None
+                            ) -> tuple[RawResult, np.ndarray | None]:
+        """After phase one was inconclusive: a cold retry in coordinates balanced on the failed
+        run's ``Q~`` (:meth:`_balanced_on`, whatever the run's residuals), then, if that fails
+        too, phase one there (:meth:`_decide`). Returns the answer (``"optimal"`` in the caller's
+        coordinates, ``"infeasible"`` with its checked proof, or ``raw`` with the words, times and
+        iterations added) and phase one's strictly feasible point, if it found one."""
+        t_new = self._balanced_on(0.5 * (raw.Q + raw.Q.T), xs) if raw.Q is not None else None
+        if t_new is None:
+            return raw, None
+        start = time.perf_counter()
+        self._build(t_new)
+        xs, us, ys, norm = self._balanced(x, u_max, y_max)
+        qs = self._outer_scaled(outer, norm)
+        retry = self._solve_ipm(xs, us, ys, qs)
+        merged = dataclasses.replace(
+            retry, solver_status=f"{raw.solver_status}; rebalanced {retry.solver_status}",
+            iterations=(raw.iterations or 0) + (retry.iterations or 0),
+            solve_time=raw.solve_time + time.perf_counter() - start,
+        )
+        if merged.status == OPTIMAL:
+            # at a feasible set this thin the optimum's recomputed margins may fall just below the
+            # certificate's tolerance (Kothare's example 2 at 7e4 times beyond the bound: -3.5e-5):
+            # phase one here gives the strictly feasible point to mix in (KothareProblem._mixed)
+            decided, inner = self._decide(merged, xs, us, ys, *_nest_args(qs))
+            interior = None
+            if inner is not None:
+                q_in, y_in = self.conic.variables(inner)
+                interior = self._interior(self._unscale(dataclasses.replace(
+                    merged, gamma=self.gamma(inner[0]), Q=0.5 * (q_in + q_in.T), Y=y_in), norm))
+            return self._unscale(dataclasses.replace(
+                merged, solver_status=f"ipm {merged.solver_status}", iterations=decided.iterations,
+                solve_time=decided.solve_time, interior=interior), norm), None
+        if merged.status == INFEASIBLE:
+            return dataclasses.replace(merged, solver_status=f"ipm {merged.solver_status}"), None
+        return self._decide(merged, xs, us, ys, *_nest_args(qs))
+
+    def _retry_on_point(self, raw: RawResult, feasible_x: np.ndarray, x: np.ndarray, u_max: np.ndarray,
+                        y_max: np.ndarray, outer: np.ndarray | None) -> tuple[RawResult, RawResult]:
+        """After phase one found the strictly feasible ``feasible_x`` (the solver's variables in the
+        current coordinates): that point as an answer in the caller's coordinates (status
+        ``"inaccurate"``, see :meth:`_with_point`), and a cold retry in coordinates
+        balanced on its ``Q~`` (:meth:`_balanced_on`): ``"optimal"`` in the caller's
+        coordinates (carrying the point as its ``interior``), or ``raw`` with the retry's word,
+        time and iterations added (``raw`` as it is without ``rebalance``)."""
+        xs, _, _, norm = self._balanced(x, u_max, y_max)
+        q_mat, y_mat = self.conic.variables(feasible_x)
+        q_mat = 0.5 * (q_mat + q_mat.T)
+        point = self._unscale(dataclasses.replace(
+            raw, status=INACCURATE, gamma=self.gamma(feasible_x[0]), Q=q_mat, Y=y_mat), norm)
+        t_new = self._balanced_on(q_mat, xs) if self._rebalance else None
+        if t_new is None:
+            return raw, point
+        start = time.perf_counter()
+        self._build(t_new)
+        xs, us, ys, norm = self._balanced(x, u_max, y_max)
+        retry = self._solve_ipm(xs, us, ys, self._outer_scaled(outer, norm))
+        merged = dataclasses.replace(
+            raw, solver_status=f"{raw.solver_status}; rebalanced on it {retry.solver_status}",
+            iterations=(raw.iterations or 0) + (retry.iterations or 0),
+            solve_time=raw.solve_time + time.perf_counter() - start,
+        )
+        if retry.status == OPTIMAL:
+            return self._unscale(dataclasses.replace(
+                retry, solver_status=f"ipm {merged.solver_status}", iterations=merged.iterations,
+                solve_time=merged.solve_time, interior=self._interior(point)), norm), point
+        return merged, point
+
+    @staticmethod
+    def _interior(point: RawResult) -> tuple[float, np.ndarray, np.ndarray]:
+        """``(gamma, Q, Y)`` of phase one's point (caller's coordinates, normalised state)."""
+        assert point.Q is not None and point.Y is not None
+        return point.gamma, point.Q, point.Y
+
+    @classmethod
+    def _with_point(cls, answer: RawResult, point: RawResult) -> RawResult:
+        """The last stage's ``answer`` (caller's coordinates) carrying phase one's strictly feasible
+        ``point`` as its ``interior``, which :class:`lmi.KothareProblem` mixes in (or gives as the
+        answer) if the answer is not certified; an answer without ``Q`` is replaced by the point
+        itself, ``"inaccurate"``: a gain whose ``gamma`` is only an upper bound on the optimum."""
+        if answer.Q is not None and answer.Y is not None:
+            return dataclasses.replace(answer, interior=cls._interior(point))
+        return dataclasses.replace(
+            point, solver_status=f"{answer.solver_status}; phase one's point (gamma an upper bound)",
+            iterations=answer.iterations, solve_time=answer.solve_time, interior=cls._interior(point))
 
     def farkas_check(self, z_blocks: list[np.ndarray], xs: np.ndarray, u_max: np.ndarray,
                      y_max: np.ndarray, outer: np.ndarray | None = None) -> InfeasibilityCertificate:

@@ -30,11 +30,12 @@ from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
-from lmi.kothare import KothareProblem, LMISolution
+from lmi.kothare import MIX_WEIGHTS, KothareProblem, LMISolution
 from lmi.scaling import MIN_SPREAD, state_scaling
 from lmi.status import (
     CLARABEL_STATUS_MAP,
     CVXPY_STATUS_MAP,
+    INACCURATE,
     INFEASIBLE,
     NUMERICAL_ERROR,
     OPTIMAL,
@@ -67,10 +68,17 @@ class _Solved:
     """One solver's answer in the solver's coordinates (``z``), or none."""
 
     def __init__(self, status: str, solver_status: str, z: np.ndarray | None, iterations: int | None,
-                 solve_time: float, infeasibility: InfeasibilityCertificate | None = None) -> None:
+                 solve_time: float, infeasibility: InfeasibilityCertificate | None = None,
+                 point: np.ndarray | None = None) -> None:
         self.status, self.solver_status, self.z = status, solver_status, z
         self.iterations, self.solve_time = iterations, solve_time
         self.infeasibility = infeasibility
+        #: phase one's strictly feasible point (solver's coordinates), when it found one
+        self.point = point
+        #: that point's variables in the original coordinates (kept across a rebalanced retry)
+        self.interior: dict[str, np.ndarray] | None = None
+        #: the answer's variables in the original coordinates, when they are given rather than ``z``
+        self.values: dict[str, np.ndarray] | None = None
 
 
 class FormProblem:
@@ -361,16 +369,71 @@ class FormProblem:
                 solved.iterations = (solved.iterations or 0) + (first.iterations or 0)
                 solved.solver_status = f"{first.solver_status}; rebalanced {solved.solver_status}"
             proved = solved.infeasibility is not None and solved.infeasibility.ok
+            if solved.status not in (OPTIMAL, INFEASIBLE) and self._settings["phase_one"]:
+                solved, fd = self._settle(solved, fd, xs, us, ys, w_max, lam)
+                proved = solved.infeasibility is not None and solved.infeasibility.ok
             if solved.status != OPTIMAL and not proved and self._settings["fallback"]:
                 first = solved
                 solved = self._solve_clarabel(fd)
                 solved.solve_time += first.solve_time
                 solved.solver_status = f"ipm:{first.solver_status}; clarabel:{solved.solver_status}"
+                solved.interior = first.interior
+            if solved.interior is not None and (solved.z is None or not np.all(np.isfinite(solved.z))):
+                solved = self._point_answer(solved)
         elif self.backend == "clarabel":
             solved = self._solve_clarabel(fd)
         else:
             solved = self._solve_cvxpy(fd, keep)
         return self._finish(solved, x, scale, xs, us, ys, w_max, lam)
+
+    def _settle(self, solved: _Solved, fd: FormData, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
+                w_max: float, lam: float) -> tuple[_Solved, FormData]:
+        """A failed ipm solve (phase one done) settled as :meth:`lmi.KothareProblem.solve` settles
+        Kothare's problem: if phase one was inconclusive, once more in coordinates balanced on the
+        last failed run, with phase one again; if phase one found a strictly
+        feasible point, a cold retry in coordinates balanced on that point, which is kept
+        (``interior``) for :meth:`_finish` to mix into an optimum whose certificate fails or to
+        give as the answer. Returns the answer and the form data of the coordinates it is in."""
+        if solved.point is None:
+            t_new = self._rebalanced(solved, xs)
+            if t_new is not None:
+                first, self._t = solved, t_new
+                self._solvers.clear()
+                fd = self._form_data(xs, us, ys, w_max, lam)
+                solved = self._solve_ipm(fd)
+                solved.solve_time += first.solve_time
+                solved.iterations = (solved.iterations or 0) + (first.iterations or 0)
+                solved.solver_status = f"{first.solver_status}; rebalanced {solved.solver_status}"
+                if solved.status in (OPTIMAL, INFEASIBLE):
+                    return solved, fd
+        if solved.point is None:
+            return solved, fd
+        interior = self._original(self.layout.values(solved.point))
+        solved.interior = interior
+        t_new = self._rebalanced(_Solved(solved.status, "", solved.point, None, 0.0), xs)
+        if t_new is None or not self._settings["rebalance"]:
+            return solved, fd
+        first, self._t = solved, t_new
+        self._solvers.clear()
+        fd = self._form_data(xs, us, ys, w_max, lam)
+        retry = self._solve_ipm(fd, phase_one=False)
+        retry.solve_time += first.solve_time
+        retry.iterations = (retry.iterations or 0) + (first.iterations or 0)
+        retry.solver_status = f"{first.solver_status}; rebalanced on it {retry.solver_status}"
+        retry.interior = interior
+        if retry.status == INFEASIBLE:  # a ray against phase one's point: not believed
+            retry.status, retry.infeasibility, retry.z = NUMERICAL_ERROR, None, None
+        return retry, fd
+
+    @staticmethod
+    def _point_answer(solved: _Solved) -> _Solved:
+        """Phase one's strictly feasible point as the answer of a solve that gave none,
+        ``"inaccurate"`` (``gamma`` an upper bound on the optimum; :meth:`_finish` certifies it
+        as any answer)."""
+        out = _Solved(INACCURATE, f"{solved.solver_status}; phase one's point (gamma an upper bound)", None,
+                      solved.iterations, solved.solve_time)
+        out.values = out.interior = solved.interior
+        return out
 
     def _rebalanced(self, solved: _Solved, xs: np.ndarray) -> np.ndarray | None:
         """Coordinates balanced on a failed run's Lyapunov matrix (the mean of the ``Q_j`` in the
@@ -446,7 +509,8 @@ class FormProblem:
             proof = self._check_ray(fd, one.Z)
             if proof.ok:
                 return _Solved(INFEASIBLE, word, None, its, elapsed, proof)
-        return _Solved(failed.status, word, failed.z, its, elapsed)
+        point = one.x if one.status == "feasible" else None
+        return _Solved(failed.status, word, failed.z, its, elapsed, point=point)
 
     def _check_ray(self, fd: FormData, z_blocks: list[np.ndarray]) -> InfeasibilityCertificate:
         """A Farkas ray of the ipm, checked on the conic data of the problem as solved."""
@@ -523,11 +587,33 @@ class FormProblem:
     def _finish(self, solved: _Solved, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray,
                 ys: np.ndarray, w_max: float, lam: float) -> LMISolution:
         backend = self.backend if self.backend != "cvxpy" else "cvxpy:CLARABEL"
-        if solved.z is None or not np.all(np.isfinite(solved.z)):
+        if solved.values is None and (solved.z is None or not np.all(np.isfinite(solved.z))):
             return LMISolution(solved.status, np.nan, None, None, None, solved.solve_time, solved.iterations,
                                solved.solver_status, None, backend, x,
                                solved.infeasibility if solved.status == INFEASIBLE else None)
-        values = self._original(self.layout.values(solved.z))
+        values = solved.values if solved.values is not None else self._original(self.layout.values(solved.z))
+        sol = self._answer(values, solved.status, solved, x, scale, xs, us, ys, w_max, lam)
+        certified = sol.certificate is not None and sol.certificate.ok and sol.F is not None
+        if solved.interior is not None and not (certified and sol.status in (OPTIMAL, INACCURATE)):
+            # not certified (an optimum on the boundary of a thin feasible set, its recomputed
+            # margins just below the tolerance; a failure word's last iterate): mixed with phase
+            # one's strictly feasible point (every block is affine in the variables, so the mix is
+            # feasible wherever both are), the smallest weight first, the point itself last
+            for w in MIX_WEIGHTS:
+                mixed = {name: (1.0 - w) * val + w * solved.interior[name] for name, val in values.items()}
+                trial = self._answer(mixed, INACCURATE, solved, x, scale, xs, us, ys, w_max, lam)
+                if trial.certificate is not None and trial.certificate.ok and trial.F is not None:
+                    how = "phase one's point" if w == 1.0 else f"mixed with phase one's point at w={w:g}"
+                    return dataclasses.replace(trial, solver_status=f"{solved.solver_status}; {how} "
+                                                                    "(gamma an upper bound)")
+        return sol
+
+    def _answer(self, values: dict[str, np.ndarray], status: str, solved: _Solved, x: np.ndarray,
+                scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray, w_max: float,
+                lam: float) -> LMISolution:
+        """The solution at ``values`` (original coordinates, normalised state), certified: ``status``
+        becomes ``"uncertified"`` if it is ``"optimal"`` and the certificate fails."""
+        backend = self.backend if self.backend != "cvxpy" else "cvxpy:CLARABEL"
         # the certificate: every block recomputed at the answer, original coordinates, x / ||x||
         check = write(Program(self.layout, values), self.options,
                       self._form_data(xs, us, ys, w_max, lam, t=np.ones(self.data.n)))
@@ -553,7 +639,6 @@ class FormProblem:
         slack = None
         if opts.soft is not None:
             slack = {key: s2 * float(values[f"s_{key}"][0, 0]) for key in opts.soft}
-        status = solved.status
         finite = f_mat is not None and np.all(np.isfinite(f_mat)) and q_mat is not None
         if status == OPTIMAL and not (cert.ok and finite):
             status = UNCERTIFIED
