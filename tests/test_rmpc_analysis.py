@@ -77,3 +77,28 @@ def test_bad_input_names_the_argument() -> None:
         ellipse_points(-np.eye(2))
     with pytest.raises(InvalidArgumentError, match="dims"):
         ellipse_points(np.eye(2), dims=(0, 0))
+
+
+def test_a_certified_inaccurate_answer_counts_as_inside_and_an_uncertified_one_does_not():
+    """The region is where a certified gain exists: the controller applies an "inaccurate" answer
+    whose certificate holds, so the search must count it (and stop at one whose certificate fails)."""
+    from types import SimpleNamespace
+
+    from rmpc.analysis import boundary_along
+
+    class Fake:
+        def __init__(self, edge: float, ok_beyond: bool) -> None:
+            self.edge, self.ok_beyond = edge, ok_beyond
+
+        def solve(self, x):
+            t = float(np.linalg.norm(x))
+            if t <= self.edge:
+                return SimpleNamespace(status="optimal", certificate=SimpleNamespace(ok=True))
+            if t <= 3.0 * self.edge:
+                return SimpleNamespace(status="inaccurate", certificate=SimpleNamespace(ok=self.ok_beyond))
+            return SimpleNamespace(status="infeasible", certificate=None)
+
+    t_cert, why = boundary_along(Fake(2.0, True), np.array([1.0, 0.0]))
+    assert t_cert == pytest.approx(6.0, rel=2e-3) and why == "infeasible"
+    t_uncert, why = boundary_along(Fake(2.0, False), np.array([1.0, 0.0]))
+    assert t_uncert == pytest.approx(2.0, rel=2e-3) and why == "inaccurate"

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rmpc.mpc.fallback import is_certified
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import check_positive
 
@@ -33,9 +34,10 @@ def _certified(ctrl: Any, x: np.ndarray, counts: dict[str, int], deadline: float
         raise TimeBudgetExceeded
     sol = ctrl.solve(x)
     counts[sol.status] = counts.get(sol.status, 0) + 1
-    if sol.status != "optimal":
+    certified = is_certified(sol)  # "optimal", or "inaccurate" with its certificate: a gain exists
+    if not certified:
         last[0] = sol.status
-    return sol.status == "optimal"
+    return certified
 
 
 def boundary_along(
@@ -48,7 +50,8 @@ def boundary_along(
     ----------
     ctrl : object with ``solve(x)``
         A robust MPC (:class:`rmpc.RMPC`, ...) whose ``solve`` returns an
-        :class:`lmi.LMISolution`; ``"optimal"`` counts as certified.
+        :class:`lmi.LMISolution`; an answer whose gain the controller would apply counts as
+        certified (``"optimal"``, or ``"inaccurate"`` with its certificate holding).
     d : (n,) ndarray
         The direction (its length sets the unit of ``t``).
     t_max : float
