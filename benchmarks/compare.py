@@ -36,6 +36,9 @@ __all__ = ["compare_records", "compare_runs", "is_run_dependent", "main"]
 _RUN_DEPENDENT = ("time", "machine", "versions", "load", "wall", "elapsed")
 #: Field names that contain one of those parts but are settings of the case.
 _SETTINGS = frozenset({"duration", "disturbance_start", "t_on", "t_off", "time_scale"})
+#: Field names without one of those parts that are still measurements of the run (a ratio of
+#: two solve times).
+_RUN_FIELDS = frozenset({"cvxpy_ratio"})
 
 
 def is_run_dependent(name: str) -> bool:
@@ -43,6 +46,8 @@ def is_run_dependent(name: str) -> bool:
     key = str(name).lower()
     if key in _SETTINGS:
         return False
+    if key in _RUN_FIELDS:
+        return True
     if key.endswith(("_s", "_ms")) or "p50" in key or "p95" in key:
         return True
     return any(part in key for part in _RUN_DEPENDENT)
@@ -53,7 +58,22 @@ def _record_key(record: dict[str, Any], index: int, timing: bool) -> str:
         parts = [record.get(k) for k in ("problem", "formulation", "backend", "vertices", "n_states")]
         return " | ".join(str(p) for p in parts if p is not None) + f" | #{index}"
     label = record.get("label") or record.get("case_id")
-    return " | ".join(str(p) for p in (record.get("experiment"), label) if p is not None)
+    parts = (record.get("experiment"), label)
+    if all(p is None for p in parts):  # the methods suite: one record per problem and method
+        parts = (record.get("problem"), record.get("method"))
+    return " | ".join(str(p) for p in parts if p is not None)
+
+
+def _paired(records: Sequence[dict[str, Any]], timing: bool) -> dict[str, dict[str, Any]]:
+    """The records by key; keys that repeat get their position (``#2``...) so none is dropped."""
+    keys = [_record_key(r, i, timing) for i, r in enumerate(records)]
+    seen: dict[str, int] = {}
+    out = {}
+    for key, record in zip(keys, records, strict=True):
+        count = seen.get(key, 0)
+        seen[key] = count + 1
+        out[key if keys.count(key) == 1 else f"{key} #{count + 1}"] = record
+    return out
 
 
 def _walk(a: Any, b: Any, path: str, rtol: float, out: list[str]) -> None:
@@ -95,7 +115,8 @@ def compare_records(
     Parameters
     ----------
     before, after : sequence of dict
-        The records of two runs: suite records are paired by ``experiment`` and ``label``,
+        The records of two runs: suite records are paired by ``experiment`` and ``label`` (the
+        methods suite's by ``problem`` and ``method``; a key that repeats by its position too),
         timing records (``timing=True``) by problem, formulation, back-end, vertices, size and
         position.
     rtol : float
@@ -104,8 +125,8 @@ def compare_records(
         The records are ``rmpc timing``'s.
     """
     rtol = check_positive(rtol, "rtol", allow_zero=True)
-    pairs_a = {_record_key(r, i, timing): r for i, r in enumerate(before)}
-    pairs_b = {_record_key(r, i, timing): r for i, r in enumerate(after)}
+    pairs_a = _paired(before, timing)
+    pairs_b = _paired(after, timing)
     out: list[str] = []
     for key in sorted(set(pairs_a) | set(pairs_b)):
         if key not in pairs_a:

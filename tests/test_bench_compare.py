@@ -67,3 +67,17 @@ def test_timing_records_pair_by_problem_and_a_mixed_pair_is_an_error(tmp_path) -
     (tmp_path / "s" / "results.json").write_text("[]")
     with pytest.raises(ValueError, match="after"):
         compare_runs(tmp_path / "t1", tmp_path / "s")
+
+
+def test_methods_records_pair_by_problem_and_method_and_repeated_keys_keep_every_record() -> None:
+    """The methods suite's records have no experiment or label: each (problem, method) is its own
+    record, and a change in any of them is found (before, all collapsed onto one key)."""
+    before = [{"problem": p, "method": m, "gamma": 1.0, "cvxpy_ratio": 3.0}
+              for p in ("ex1", "ex2") for m in ("kothare", "vertex")]
+    after = [dict(r) for r in before]
+    after[0]["gamma"] = 2.0
+    after[3]["cvxpy_ratio"] = 5.0  # a ratio of two solve times: a measurement of the run
+    assert compare_records(before, after) == ["ex1 | kothare: gamma: 1.0 -> 2.0"]
+    twice = [{"experiment": "E1", "label": "RMPC", "x": 1}, {"experiment": "E1", "label": "RMPC", "x": 2}]
+    changed = [{"experiment": "E1", "label": "RMPC", "x": 1}, {"experiment": "E1", "label": "RMPC", "x": 3}]
+    assert compare_records(twice, changed) == ["E1 | RMPC #2: x: 2 -> 3"]
