@@ -342,7 +342,13 @@ class FormProblem:
             pick = min(certified, key=self._objective)
             return dataclasses.replace(pick, solve_time=total_time, iterations=total_its)
         pick = tried[LAMBDA_GRID[best]]
-        word = f"{pick.solver_status} (no certified answer at any of the {len(tried)} lam tried)"
+        if all(s.status == INFEASIBLE for s in tried.values()):
+            # each proof holds for its own lam: the LMIs are bilinear in lam, so the grid's proofs
+            # say nothing of the lam between them (give lam to decide one value)
+            word = (f"{pick.solver_status} (proved infeasible at each of the {len(tried)} lam tried, "
+                    "not for the lam between them)")
+        else:
+            word = f"{pick.solver_status} (no certified answer at any of the {len(tried)} lam tried)"
         return dataclasses.replace(pick, solve_time=total_time, iterations=total_its, solver_status=word,
                                    lam=LAMBDA_GRID[best])
 
