@@ -16,6 +16,7 @@ then packed position (row by row, as ``numpy.triu_indices``), then variable: the
 from __future__ import annotations
 
 import ctypes
+import math
 import re
 import shutil
 from importlib import resources
@@ -27,8 +28,8 @@ import numpy as np
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = [
-    "LIMITS", "SOURCES", "STATUS_CODES", "check_controller", "problem_header", "solver_source",
-    "write_solver",
+    "LIMITS", "SOURCES", "STATUS_CODES", "c_double", "check_controller", "problem_header",
+    "solver_source", "write_solver",
 ]
 
 #: The C sources the header goes with (package data of :mod:`lmi.ccore`).
@@ -53,13 +54,31 @@ STATUS_CODES: dict[str, int] = {
 LIMITS = {"variables": 600, "order": 64, "blocks": 64}
 
 
+def c_double(value: float, *, infinite: bool = False, name: str = "value") -> str:
+    """``value`` as a C99 hexadecimal floating constant, exact bit for bit (``float.hex``).
+
+    With ``infinite``, an infinity is written ``HUGE_VAL`` (``<math.h>``); otherwise it is an
+    error, as NaN always is (naming ``name``). The one writer of numbers into generated C: the
+    problem header here and the exports of :mod:`rmpc.export`.
+
+    Examples
+    --------
+    >>> c_double(0.1), c_double(-2.0), c_double(0.0)
+    ('0x1.999999999999ap-4', '-0x1.0000000000000p+1', '0x0.0p+0')
+    >>> float.fromhex(c_double(0.1)) == 0.1, c_double(float("inf"), infinite=True)
+    (True, 'HUGE_VAL')
+    """
+    number = float(value)
+    if math.isnan(number) or (math.isinf(number) and not infinite):
+        expected = "a number that is not NaN" if infinite else "a finite number to write as a C constant"
+        raise InvalidArgumentError(name, expected, repr(number))
+    if math.isinf(number):
+        return "HUGE_VAL" if number > 0 else "(-HUGE_VAL)"
+    return number.hex()
+
+
 def _lit(value: float) -> str:
-    value = float(value)
-    if np.isnan(value):
-        raise InvalidArgumentError("problem", "finite data", "NaN")
-    if np.isinf(value):
-        return "HUGE_VAL" if value > 0 else "(-HUGE_VAL)"
-    return value.hex()
+    return c_double(value, infinite=True, name="problem data")
 
 
 def _doubles(name: str, values: Any) -> str:

@@ -16,7 +16,7 @@ the common interface::
 ``rmpc_step`` checks its arguments (a null pointer, a NaN or an infinity in ``x``), calls
 ``rmpc_compute`` on a copy of ``x`` and checks that the command is finite; the status codes are
 those of :data:`STATUS_CODES`, listed in the header. Every number is written as a C99
-hexadecimal floating constant (:func:`c_double`), which the compiler reads exactly: the tables in
+hexadecimal floating constant (:func:`lmi.ccore.generate.c_double`), which the compiler reads exactly: the tables in
 C hold the same doubles as the Python controller.
 
 The arithmetic is written one rounding per statement (each product is stored before it is
@@ -28,7 +28,6 @@ added) so that a compiler in a standard mode (``-std=c99``, or clang's default
 from __future__ import annotations
 
 import ctypes
-import math
 import os
 import textwrap
 from collections.abc import Sequence
@@ -37,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lmi.ccore.generate import c_double
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
 __all__ = [
@@ -113,22 +113,6 @@ STATUS_CODES: tuple[StatusCode, ...] = (
 #: controller's answer or the fallback its text names.
 ZERO_COMMAND_CODES = ("RMPC_STATUS_BAD_STATE", "RMPC_STATUS_OVERFLOW", "RMPC_STATUS_NULL_ARGUMENT")
 _CODE = {code.name: code for code in STATUS_CODES}
-
-
-def c_double(value: float) -> str:
-    """``value`` as a C99 hexadecimal floating constant, exact bit for bit.
-
-    Examples
-    --------
-    >>> c_double(0.1), c_double(-2.0), c_double(0.0)
-    ('0x1.999999999999ap-4', '-0x1.0000000000000p+1', '0x0.0p+0')
-    >>> float.fromhex(c_double(0.1)) == 0.1
-    True
-    """
-    number = float(value)
-    if not math.isfinite(number):
-        raise InvalidArgumentError("value", "a finite number to write as a C constant", repr(number))
-    return number.hex()
 
 
 @dataclass(frozen=True)
