@@ -16,8 +16,8 @@ the common interface::
 ``rmpc_step`` checks its arguments (a null pointer, a NaN or an infinity in ``x``), calls
 ``rmpc_compute`` on a copy of ``x`` and checks that the command is finite; the status codes are
 those of :data:`STATUS_CODES`, listed in the header. Every number is written as a C99
-hexadecimal floating constant (:func:`lmi.ccore.generate.c_double`), which the compiler reads exactly: the tables in
-C hold the same doubles as the Python controller.
+hexadecimal floating constant (:func:`lmi.ccore.generate.c_double`), which the compiler reads
+exactly: the tables in C hold the same doubles as the Python controller.
 
 The arithmetic is written one rounding per statement (each product is stored before it is
 added) so that a compiler in a standard mode (``-std=c99``, or clang's default
