@@ -18,6 +18,7 @@ rather than timed by untried code.
 from __future__ import annotations
 
 import importlib.util
+import re
 import subprocess
 import sys
 import tempfile
@@ -26,6 +27,8 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["SCRIPT", "cvxpygen_attempt", "error_lines"]
+
+_EXCEPTION = re.compile(r"^[A-Za-z_.]*(Error|Exception): ")
 
 #: The child process: build the cvxpy problem of the section's LMIs and generate code for it.
 SCRIPT = """
@@ -42,18 +45,25 @@ cpg.generate_code(problem._backend.problem, code_dir="kothare_cpg", solver="CLAR
 
 
 def error_lines(output: str, limit: int = 6) -> list[str]:
-    """The distinct lines of ``output`` that report an error, in order, at most ``limit``.
+    r"""The distinct lines of ``output`` that report an error, in order, at most ``limit``.
+
+    An error line starts with ``error`` (pip, cargo, the compilers), names an exception
+    (``ImportError: ...``) or says something ``could not`` be found or reached (CMake, a resolver);
+    warnings are left out, even those that quote an error.
 
     Examples
     --------
-    >>> error_lines("ok\\n  error: failed to get `amd`\\nwarning: x\\nImportError: no module\\n")
-    ['error: failed to get `amd`', 'ImportError: no module']
+    >>> log = "ok\n  error: failed to get `amd`\nwarning: network error\n[6] Could not resolve host: x\n"
+    >>> error_lines(log + "ImportError: no module")
+    ['error: failed to get `amd`', '[6] Could not resolve host: x', 'ImportError: no module']
     """
     found: list[str] = []
     for raw in output.splitlines():
         line = raw.strip()
         low = line.lower()
-        if ("error" in low or "could not" in low) and line not in found:
+        if low.startswith("warning"):
+            continue
+        if (low.startswith("error") or "could not" in low or _EXCEPTION.match(line)) and line not in found:
             found.append(line)
     return found[:limit]
 
