@@ -1,8 +1,8 @@
 """CVXPYgen on Kothare's LMIs: does its generated code (the Clarabel path for PSD cones) build here?
 
-CVXPYgen (Schaller, Banjac, Diamond, Agrawal, Stellato and Boyd) generates C for a parametrised
-cvxpy problem; for positive semidefinite cones only its Clarabel path applies, which compiles
-Clarabel's Rust core (cargo, its crates, BLAS and LAPACK) into the generated code. The ``C``
+CVXPYgen (the ``cvxpygen`` package) generates C for a parametrised cvxpy problem; for positive
+semidefinite cones only its Clarabel path applies, which compiles Clarabel's Rust core (cargo,
+its crates, BLAS and LAPACK) into the generated code. The ``C``
 section of ``rmpc timing`` (:mod:`benchmarks.timing.c_exports`) calls :func:`cvxpygen_attempt`
 on the same LMIs it times (the cvxpy back-end's problem of :class:`lmi.KothareProblem`,
 ``delta_shared``) and records what happened: not installed, or the generation or build failed
