@@ -421,7 +421,7 @@ def c_markdown(report: dict[str, Any]) -> list[str]:
                          f"| {r['max_abs_err_u']:.1e} |")
     lines += ["", "CVXPYgen on the same LMIs (its Clarabel path, the only one for PSD cones):", ""]
     for att in summary["cvxpygen"]:
-        what = "; ".join(f"`{e}`" for e in att["errors"]) or "built"
+        what = "; ".join(f"`` {e} ``" for e in att["errors"]) or "built"
         lines.append(f"- {att['vertices']} vertices: {att['outcome']} ({att['attempt_s']:.1f} s): {what}")
     lines += ["", "### Targets", "", "| target | vertices | measured | target | met | note |",
               "| --- | --- | --- | --- | --- | --- |"]
