@@ -135,3 +135,12 @@ def test_error_lines_keep_the_errors_in_order():
     assert error_lines(log + "ImportError: cannot import name 'cpg_module'") == [
         "error: failed to get `amd`", "[6] Could not resolve host: index",
         "ImportError: cannot import name 'cpg_module'"]
+
+
+def test_the_exports_codes_read_as_the_python_controllers_words():
+    from rmpc.export.c_writer import STATUS_CODES
+
+    words = {s.name: c_exports._c_word(s.value) for s in STATUS_CODES}
+    assert words["RMPC_OK"] == "optimal" and words["RMPC_STATUS_INFEASIBLE"] == "infeasible"
+    assert words["RMPC_STATUS_HELD"] == "reused" and words["RMPC_STATUS_BAD_STATE"] == "bad_state"
+    assert len(set(words.values())) == len(words)

@@ -92,8 +92,20 @@ TARGETS: tuple[tuple[str, int, str, float, str], ...] = (
 )
 
 _D = ctypes.POINTER(ctypes.c_double)
-_C_WORDS = {0: "optimal", 1: "bad_state", 2: "overflow", 3: "null_argument", 4: "held", 5: "infeasible",
-            6: "max_iterations", 7: "numerical_error", 8: "uncertified", 9: "inaccurate"}
+
+
+def _c_word(code: int) -> str:
+    """The on-line export's status code as a word: ``optimal`` for 0, the Python word of
+    :data:`rmpc.export.c_writer.STATUS_CODES` where there is one, else the C name's tail."""
+    from rmpc.export.c_writer import STATUS_CODES
+
+    if code == 0:
+        return "optimal"
+    for status in STATUS_CODES:
+        if status.value == code:
+            plain = status.word.replace("_", "").isalpha()
+            return status.word if plain else status.name.removeprefix("RMPC_STATUS_").lower()
+    return f"code {code}"
 
 
 @dataclass
@@ -142,7 +154,7 @@ class _Export:
         times.iterations.append(int(self.lib.rmpc_last_iterations()))
         times.gammas.append(float(self.lib.rmpc_last_gamma()))
         times.inputs.append(u)
-        tally(times.statuses, _C_WORDS.get(int(code), f"code {int(code)}"))
+        tally(times.statuses, _c_word(int(code)))
 
 
 def _python_step(problem: Any, x: np.ndarray, times: _Times | None) -> None:
