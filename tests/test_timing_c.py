@@ -16,7 +16,7 @@ import pytest
 
 import benchmarks.timing.c_exports as c_exports
 from benchmarks.cli import main
-from benchmarks.compare import compare_runs
+from benchmarks.compare import compare_runs, is_run_dependent
 from benchmarks.timing.c_exports import TARGETS, judge_targets
 from benchmarks.timing.cpg_attempt import error_lines
 
@@ -71,6 +71,10 @@ def test_a_quick_run_produces_the_rows(quick_run):
     text = (out / "timing.md").read_text(encoding="utf-8")
     assert "## C: the exported controllers against the anchors" in text and "### Targets" in text
     assert compare_runs(out, out) == []
+    # every field that measures time is one benchmarks.compare leaves out (two runs compare equal)
+    timed = {k for r in records for k in r if k.endswith("_s") or "over" in k}
+    assert timed >= {"cpu_p50_s", "python_p50_s", "python_over_c_p50"}
+    assert all(is_run_dependent(k) for k in timed)
 
 
 def _records(c_cpu: float, ipm_cpu: float, ellipsoids: int = 15) -> list[dict]:
