@@ -148,3 +148,26 @@ def test_the_exports_codes_read_as_the_python_controllers_words():
     assert words["RMPC_OK"] == "optimal" and words["RMPC_STATUS_INFEASIBLE"] == "infeasible"
     assert words["RMPC_STATUS_HELD"] == "reused" and words["RMPC_STATUS_BAD_STATE"] == "bad_state"
     assert len(set(words.values())) == len(words)
+
+
+@needs_cc
+@pytest.mark.filterwarnings("ignore:Solution may be inaccurate")
+def test_with_the_rmpc_section_the_section_times_at_its_states(tmp_path, monkeypatch):
+    from benchmarks.timing.common import polytope
+    from benchmarks.timing.rmpc import section_states
+
+    seen = []
+    original = c_exports.time_c
+
+    def spy(poly, cfg, states=None, bar=None):
+        seen.append(states)
+        return original(poly, cfg, states, bar)
+
+    monkeypatch.setattr(c_exports, "time_c", spy)
+    argv = ["timing", "--out", str(tmp_path), "--quick", "--problems", "RMPC", "C", "--vertices", "2",
+            "--steps", "2", "--no-progress"]
+    assert main(argv) == 0
+    (states,) = seen
+    np.testing.assert_array_equal(np.array(states), np.array(section_states(polytope(2), 2)))
+    report = json.loads((tmp_path / "timing.json").read_text(encoding="utf-8"))
+    assert {r["problem"] for r in report["records"]} == {"RMPC", "C"}
