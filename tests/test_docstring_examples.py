@@ -50,6 +50,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.suites.paper_claims",
     "benchmarks.timing.common",
     "benchmarks.timing.config",
+    "benchmarks.timing.cpg_attempt",
     "lmi.data",
     "lmi.forms.problem",
     "lmi.ipm.kernels.notice",

@@ -7,6 +7,8 @@
 - :mod:`benchmarks.timing.rmpc`, :mod:`benchmarks.timing.offline`, :mod:`benchmarks.timing.gipc`:
   the timed paths of each problem (the report's section and a stand-alone script each);
 - :mod:`benchmarks.timing.scale`: the opt-in scale section (the flexible satellite, 6-20 states);
+- :mod:`benchmarks.timing.c_exports`: the opt-in C section (the exported controllers against the
+  anchors; :mod:`benchmarks.timing.cpg_attempt` tries CVXPYgen on the same LMIs);
 - :mod:`benchmarks.timing.markdown`: ``timing.md``;
 - :mod:`benchmarks.timing.plots`: the time-distribution figures.
 """

@@ -40,7 +40,7 @@ from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import OfflineRMPC, export_c, simulate
 from toolkit_common.errors import InvalidArgumentError
 
-__all__ = ["DRIVER", "format_table", "main", "object_size", "run", "time_c_export"]
+__all__ = ["DRIVER", "compiler", "format_table", "main", "object_size", "run", "time_c_export"]
 
 #: The C timing driver: reads ``count, states``; writes the per-step time of each batch (s).
 DRIVER = r"""
@@ -100,7 +100,8 @@ int main(int argc, char **argv)
 """
 
 
-def _compiler() -> str:
+def compiler() -> str:
+    """The C compiler on the PATH (``cc``); an error naming it when there is none."""
     cc = shutil.which("cc")
     if cc is None:
         raise InvalidArgumentError("cc", "a C compiler on PATH to build the export", "none found")
@@ -111,7 +112,7 @@ def object_size(source: Path, folder: Path) -> dict[str, int]:
     """Compile ``source`` to an object (``cc -std=c99 -O2 -c``): ``size``'s text, data and bss, or
     the file size alone when ``size`` is missing."""
     obj = folder / "rmpc_controller.o"
-    subprocess.run([_compiler(), "-std=c99", "-O2", "-c", "-o", str(obj), str(source)], check=True)
+    subprocess.run([compiler(), "-std=c99", "-O2", "-c", "-o", str(obj), str(source)], check=True)
     out = {"object_file_bytes": obj.stat().st_size}
     size = shutil.which("size")
     if size is not None:
@@ -124,7 +125,7 @@ def object_size(source: Path, folder: Path) -> dict[str, int]:
 def _c_batches(folder: Path, states: np.ndarray, batches: int, calls: int) -> list[float]:
     (folder / "timing_driver.c").write_text(DRIVER)
     exe = folder / "timing_driver"
-    subprocess.run([_compiler(), "-std=c99", "-O2", "-o", str(exe), "timing_driver.c", "rmpc_controller.c",
+    subprocess.run([compiler(), "-std=c99", "-O2", "-o", str(exe), "timing_driver.c", "rmpc_controller.c",
                     "-lm"], cwd=folder, check=True, capture_output=True, text=True)
     data = np.concatenate([[float(len(states))], np.ascontiguousarray(states, dtype=float).ravel()])
     (folder / "states.bin").write_bytes(data.tobytes())
@@ -166,11 +167,15 @@ def time_c_export(ctrl: OfflineRMPC, states: np.ndarray, *, batches: int = 200, 
         py_status.append(str(ctrl.last.status))
     c_words = {0: "optimal", 1: "outside"}
     same_status = all(c_words.get(int(s), "error") == w for s, w in zip(lib_status, py_status, strict=True))
+    c_status_counts: dict[str, int] = {}
+    for code in lib_status:
+        tally(c_status_counts, c_words.get(int(code), "error"))
     c = percentiles(c_batch)
     return {
         "n_ellipsoids": ctrl.table.n_ellipsoids, "interpolate": ctrl.interpolate,
         "states": len(states), "c_batches": batches, "c_calls_per_batch": calls,
-        "c_p50_s": c["p50_s"], "c_p95_s": c["p95_s"],
+        "c_p50_s": c["p50_s"], "c_p95_s": c["p95_s"], "c_max_s": c["max_s"],
+        "c_status_counts": c_status_counts,
         "python_p50_s": py["single"]["p50_s"], "python_p95_s": py["single"]["p95_s"],
         "python_batch_p50_s": py["batch"]["p50_s"], "python_batch_p95_s": py["batch"]["p95_s"],
         "speedup_p50": py["single"]["p50_s"] / c["p50_s"],
@@ -204,7 +209,7 @@ def _c_answers(folder: Path, nu: int, states: np.ndarray) -> tuple[np.ndarray, n
     """The C export's statuses and commands at ``states`` (a driver on stdin/stdout)."""
     (folder / "answers.c").write_text(_ANSWERS)
     exe = folder / "answers"
-    subprocess.run([_compiler(), "-std=c99", "-O2", "-o", str(exe), "answers.c", "rmpc_controller.c", "-lm"],
+    subprocess.run([compiler(), "-std=c99", "-O2", "-o", str(exe), "answers.c", "rmpc_controller.c", "-lm"],
                    cwd=folder, check=True, capture_output=True, text=True)
     raw = subprocess.run([str(exe)], input=np.ascontiguousarray(states, dtype=float).tobytes(),
                          capture_output=True, check=True).stdout

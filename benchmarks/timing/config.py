@@ -36,8 +36,10 @@ PROBLEMS: tuple[str, ...] = ("RMPC", "OfflineRMPC", "GIPC")
 #: Problems a run may ask for: the default three, the scale section (:mod:`benchmarks.timing.scale`,
 #: flexible satellite with 6-20 states; opt-in with ``--problems Scale``: Clarabel alone takes seconds
 #: per solve at 14-20 states) and the per-iteration breakdown of the interior-point method on paper P
-#: with the floor of its arithmetic (:mod:`benchmarks.timing.breakdown`, ``--problems Breakdown``).
-OPTIONAL_PROBLEMS: tuple[str, ...] = ("Scale", "Breakdown")
+#: with the floor of its arithmetic (:mod:`benchmarks.timing.breakdown`, ``--problems Breakdown``),
+#: and the exported C controllers against the anchors (:mod:`benchmarks.timing.c_exports`,
+#: ``--problems C``: needs ``cc``).
+OPTIONAL_PROBLEMS: tuple[str, ...] = ("Scale", "Breakdown", "C")
 #: The polytope vertex counts (:func:`benchmarks.timing.common.polytope`).
 VERTEX_COUNTS: tuple[int, ...] = (2, 4, 8)
 #: Cheap problems (OfflineRMPC lookups, GIPC QPs: microseconds to a millisecond) follow this many

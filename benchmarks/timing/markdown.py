@@ -142,6 +142,10 @@ def format_markdown(report: dict[str, Any], plot_name: str | None = "timing.png"
         from benchmarks.timing.breakdown import breakdown_sections
 
         lines += breakdown_sections(report["breakdown"])
+    if report.get("c") is not None:
+        from benchmarks.timing.c_exports import c_markdown
+
+        lines += c_markdown(report)
     if plot_name:
         lines += ["## Distributions", "", f"![per-step time distributions]({plot_name})", ""]
     return "\n".join(lines)

@@ -62,6 +62,7 @@ __all__ = [
     "main",
     "reference_gamma_at",
     "run",
+    "section_states",
     "time_rmpc",
 ]
 
@@ -181,8 +182,9 @@ def time_rmpc(poly: PolytopicModel, cfg: TimingConfig, bar: CaseProgress | None 
     fast = paths[0]
     a0, b0 = poly.vertex(0)
     gain = np.zeros((poly.n_inputs, poly.n_states))
-    ref_gammas, ref_used, spreads = [], {}, []
+    ref_gammas, ref_used, spreads, states = [], {}, [], []
     for k in range(cfg.steps):
+        states.append(x.copy())
         shift = k % len(paths)
         fast_sol = None
         for path in paths[shift:] + paths[:shift] + refs:  # rotate the order: no path always first
@@ -196,8 +198,7 @@ def time_rmpc(poly: PolytopicModel, cfg: TimingConfig, bar: CaseProgress | None 
         tally(ref_used, used)
         if spread is not None:
             spreads.append(spread)
-        if fast_sol is not None and fast_sol.F is not None and fast_sol.ok:
-            gain = fast_sol.F
+        gain = _next_gain(fast_sol, gain)
         x = a0 @ x + b0 @ (gain @ x)
         if bar is not None:
             bar.advance(f"RMPC {poly.n_vertices} vertices, state {k + 1}/{cfg.steps}")
@@ -239,7 +240,34 @@ def time_rmpc(poly: PolytopicModel, cfg: TimingConfig, bar: CaseProgress | None 
         "states_with_several_optimal": len(spreads),
     }
     return {"records": records, "samples": samples, "ratio": ratio, "reference": reference,
-            "gamma_x0": ref_gammas[0] if ref_gammas else float("nan")}
+            "gamma_x0": ref_gammas[0] if ref_gammas else float("nan"), "states": states}
+
+
+def _next_gain(sol: LMISolution | None, gain: np.ndarray) -> np.ndarray:
+    """The gain the section's closed loop applies next: the fast path's when it is optimal, else the last."""
+    return sol.F if sol is not None and sol.F is not None and sol.ok else gain
+
+
+def section_states(poly: PolytopicModel, steps: int) -> list[np.ndarray]:
+    """The states of :func:`time_rmpc`'s closed loop, from its fast path alone.
+
+    The fast path (the toolkit's ipm, ``delta_shared``, warm-started) chains its warm starts over
+    its own solves only, so solving it alone, with the same untimed first solve at ``1.3 x0``,
+    visits the same states as the section does with every path interleaved. For a section that
+    times other paths at those states when the RMPC section did not run.
+    """
+    x = RigidSatellite.initial_state()
+    prob = KothareProblem(poly.A, poly.B, Q1, R, dt=poly.dt, u_max=U_MAX, backend="ipm",
+                          formulation="delta_shared")
+    prob.solve(1.3 * x)
+    a0, b0 = poly.vertex(0)
+    gain = np.zeros((poly.n_inputs, poly.n_states))
+    states = []
+    for _ in range(steps):
+        states.append(x.copy())
+        gain = _next_gain(prob.solve(x), gain)
+        x = a0 @ x + b0 @ (gain @ x)
+    return states
 
 
 def reference_gamma_at(poly: PolytopicModel, x: np.ndarray) -> float:

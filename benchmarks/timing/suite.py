@@ -94,15 +94,18 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
     units = (cfg.steps * len(cfg.vertices) if "RMPC" in cfg.problems else 0) + (
         len(cfg.vertices) if "OfflineRMPC" in cfg.problems else 0) + (1 if "GIPC" in cfg.problems else 0) + (
         2 * len(cfg.scale_sizes) if "Scale" in cfg.problems else 0) + (
-        len(cfg.vertices) if "Breakdown" in cfg.problems else 0)
+        len(cfg.vertices) if "Breakdown" in cfg.problems else 0) + (
+        len(cfg.vertices) if "C" in cfg.problems else 0)
     records: list[dict[str, Any]] = []
     samples: dict[str, np.ndarray] = {}
     ratios, references = [], []
     gipc_ref = None
+    c_runs: list[dict[str, Any]] = []
     with CaseProgress(units, "rmpc timing", enabled=cfg.progress) as bar:
         for count in cfg.vertices:
             poly = polytope(count)
             gamma_x0 = None
+            rmpc_states = None
             if "RMPC" in cfg.problems:
                 res = time_rmpc(poly, cfg, bar)
                 records += res["records"]
@@ -110,11 +113,19 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
                 ratios.append(res["ratio"])
                 references.append(res["reference"])
                 gamma_x0 = res["gamma_x0"]
+                rmpc_states = res["states"]
             if "OfflineRMPC" in cfg.problems:
                 res = time_offline(poly, cfg, gamma_x0)
                 records += res["records"]
                 samples.update(res["samples"])
                 bar.advance(f"OfflineRMPC {count} vertices")
+            if "C" in cfg.problems:
+                from benchmarks.timing.c_exports import time_c
+
+                res = time_c(poly, cfg, rmpc_states, bar)
+                records += res["records"]
+                samples.update(res["samples"])
+                c_runs.append(res)
         if "GIPC" in cfg.problems:
             res = time_gipc(cfg, bar)
             records += res["records"]
@@ -143,6 +154,7 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
         "rebuild_over_fast": ratios,
         "reference": {"RMPC": references, "GIPC": gipc_ref},
         "breakdown": breakdowns,
+        "c": _c_summary(records, c_runs),
         "settings": {
             "steps": cfg.steps, "cheap_steps": cfg.cheap_steps, "rebuild_steps": cfg.rebuild_steps,
             "scs_steps": cfg.scs_steps, "vertices": list(cfg.vertices), "problems": list(cfg.problems),
@@ -156,6 +168,17 @@ def _run(cfg: TimingConfig) -> dict[str, Any]:
         "wall_time_s": time.perf_counter() - start,
     }
     return {"report": json_safe(report), "samples": samples}
+
+
+def _c_summary(records: list[dict[str, Any]], runs: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The C section's compiler, CVXPYgen's outcomes and the targets (``None``: not asked for)."""
+    if not runs:
+        return None
+    from benchmarks.timing.c_exports import judge_targets
+
+    attempts = {r["cvxpygen"]["vertices"]: r["cvxpygen"] for r in runs if r["cvxpygen"] is not None}
+    return {"compiler": runs[0]["compiler"], "note": runs[0]["note"], "cvxpygen": list(attempts.values()),
+            "targets": judge_targets(records, attempts) if runs[0]["compiler"] else []}
 
 
 # -- the files ------------------------------------------------------------------------------------
@@ -194,10 +217,15 @@ def run_timing_command(args: argparse.Namespace) -> int:
     report = result["report"]
     print(f"rmpc timing: {len(report['records'])} records in {report['wall_time_s']:.1f} s; "
           f"report in {cfg.out}/timing.md")
+    if report["c"] is not None and report["c"]["note"]:
+        print(f"  C section: {report['c']['note']}")
     for q in report["rebuild_over_fast"]:
         ratio = q["rebuild_over_fast"]
         print(f"  {q['vertices']} vertices: rebuild-per-step / fast path (p50) = {ratio:.1f}x")
     for r in report["records"]:
+        if r["problem"] == "C" and r["backend"] == "c-export" and r["formulation"] == "delta_shared":
+            print(f"  C export, {r['vertices']} vertices: p50 {1e3 * r['cpu_p50_s']:.2f} ms thread CPU "
+                  f"({1e3 * r['p50_s']:.2f} ms wall), {r['status_counts']}")
         if r["problem"] == "Scale" and r["backend"] == "ipm":
             print(f"  scale {r['n_states']} states, {r['vertices']} vertices: ipm p50 "
                   f"{1e3 * r['p50_s']:.1f} ms, {r['status_counts']}")
@@ -223,10 +251,12 @@ def add_timing_parser(subparsers: Any) -> None:
     parser.add_argument("--vertices", nargs="+", default=None, metavar="V",
                         help="polytope vertex counts among 2 4 8 (default all three)")
     parser.add_argument("--problems", nargs="+", default=None, metavar="P",
-                        help="problems among RMPC OfflineRMPC GIPC Scale Breakdown (default the first "
+                        help="problems among RMPC OfflineRMPC GIPC Scale Breakdown C (default the first "
                         "three; Scale: the flexible satellite at 6-20 states, see benchmarks.timing.scale; "
                         "Breakdown: the ipm's time per kernel and iteration on paper P and the floor of its "
-                        "arithmetic, see benchmarks.timing.breakdown)")
+                        "arithmetic, see benchmarks.timing.breakdown; C: the exported C controllers (on-line "
+                        "RMPC, off-line lookup) against the Python ipm, Clarabel and CVXPYgen, their object "
+                        "code and static memory, each target met or not, see benchmarks.timing.c_exports)")
     parser.add_argument("--scale-steps", default=None, metavar="N",
                         help="Scale: closed-loop states per size and vertex count (default 10; --quick: 2)")
     parser.add_argument("--scale-sizes", nargs="+", default=None, metavar="n",
