@@ -50,6 +50,15 @@ typedef struct {
     double z[NB * KK];
 } point_t;
 
+/* An iterate kept for later (the warm start, the best and the stalled points): x and each
+ * block's upper triangle row by row, in the packed layout's order without its weights, so that
+ * restoring it gives back the symmetric blocks exactly. */
+typedef struct {
+    double x[NV];
+    double s[SZ];
+    double z[SZ];
+} saved_t;
+
 static struct workspace {
     int laid_out;           /* the packed layout's tables filled */
     int ready;              /* equilibration fixed */
@@ -60,7 +69,8 @@ static struct workspace {
     double ent_w[SZ];
     double bound[RMPC_NBOUND];
     double hvec[SZ], cvec[NV], val[RMPC_NENT], spv[RMPC_NENT], gv[RMPC_NENT];
-    point_t cur, nxt, warm, warm_next, best, stall;
+    point_t cur, nxt;
+    saved_t warm, warm_next, best, stall;
     double s_chol[NB * KK], chol_new[NB * KK];
     double kk[NB * KK], lam[NB * KM];
     double pt[NVP * SZP], qrh[NVP * SZP], tau[NV];
@@ -1061,6 +1071,32 @@ static int iteration(int *use_qr, double *theta, double mu, double ref_scale, do
 
 static void copy_point(point_t *dst, const point_t *src) { memcpy(dst, src, sizeof *dst); }
 
+static void save_point(saved_t *dst, const point_t *src)
+{
+    int t;
+    memcpy(dst->x, src->x, sizeof dst->x);
+    for (t = 0; t < SZ; ++t) {
+        int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
+        dst->s[t] = src->s[at];
+        dst->z[t] = src->z[at];
+    }
+}
+
+/* the blocks of src into dst (their leading k x k parts, the only parts read) */
+static void restore_point(point_t *dst, const saved_t *src)
+{
+    int t;
+    memcpy(dst->x, src->x, sizeof dst->x);
+    for (t = 0; t < SZ; ++t) {
+        int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
+        int mirror = ws.ent_blk[t] * KK + ws.ent_col[t] * KM + ws.ent_row[t];
+        dst->s[at] = src->s[t];
+        dst->s[mirror] = src->s[t];
+        dst->z[at] = src->z[t];
+        dst->z[mirror] = src->z[t];
+    }
+}
+
 /* BlockLMISolver._run: returns the solver's word; the answer (equilibrated x) in ws.cur */
 static int run(int warm, int max_iter, int *iterations, double *pres_o, double *dres_o, double *gap_o,
                double *radius_o)
@@ -1071,7 +1107,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
     double theta = 1.0, pres = HUGE_VAL, dres = HUGE_VAL, gap = HUGE_VAL, radius = 0.0;
     double best_m[3] = {0.0, 0.0, 0.0}, stall_m[3] = {0.0, 0.0, 0.0};
     if (warm) {
-        copy_point(&ws.cur, &ws.warm);
+        restore_point(&ws.cur, &ws.warm);
         for (i = 0; i < NV; ++i) {
             ws.cur.x[i] = ws.warm.x[i] / ws.dscale[i];
         }
@@ -1122,7 +1158,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
         }
         if (!have_stall && agree && maxd(pres, dres) <= REDUCED_TOL
             && (gap < rel_gap ? gap : rel_gap) <= REDUCED_TOL && blocks_within(ws.cur.x, REDUCED_TOL)) {
-            copy_point(&ws.best, &ws.cur);
+            save_point(&ws.best, &ws.cur);
             best_m[0] = pres;
             best_m[1] = dres;
             best_m[2] = gap;
@@ -1160,7 +1196,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
                     status = W_STALL;
                     break;
                 }
-                copy_point(&ws.stall, &ws.cur);
+                save_point(&ws.stall, &ws.cur);
                 stall_m[0] = pres;
                 stall_m[1] = dres;
                 stall_m[2] = gap;
@@ -1173,7 +1209,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
         }
         if (!have_stall && 0.1 * RMPC_WARM_GAP <= rel_gap && rel_gap <= RMPC_WARM_GAP
             && maxd(pres, dres) <= RMPC_WARM_FEAS) {
-            copy_point(&ws.warm_next, &ws.cur);
+            save_point(&ws.warm_next, &ws.cur);
             for (i = 0; i < NV; ++i) {
                 ws.warm_next.x[i] = ws.cur.x[i] * ws.dscale[i];
             }
@@ -1196,18 +1232,18 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
     }
     if (have_stall && status != W_OPTIMAL && status != W_INFEASIBLE) {
         status = W_STALL;
-        copy_point(&ws.cur, &ws.stall);
+        restore_point(&ws.cur, &ws.stall);
         pres = stall_m[0];
         dres = stall_m[1];
         gap = stall_m[2];
     }
     if (status == W_OPTIMAL && have_next) {
-        copy_point(&ws.warm, &ws.warm_next);
+        memcpy(&ws.warm, &ws.warm_next, sizeof ws.warm);
         ws.has_warm = 1;
     }
     if (status != W_OPTIMAL && have_best) {
         status = W_INACCURATE;
-        copy_point(&ws.cur, &ws.best);
+        restore_point(&ws.cur, &ws.best);
         pres = best_m[0];
         dres = best_m[1];
         gap = best_m[2];
