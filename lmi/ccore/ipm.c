@@ -38,6 +38,18 @@
 #define REFINE_STEPS 3
 #define SQRT2 1.4142135623730951
 
+/* Phase times, in a profiling build only (KOTHARE_PHASE_TIMES, see ipm.h): PHASE_NOW() reads
+ * the caller's clock, PHASE_ADD adds the time since t0 to a phase; otherwise both vanish. */
+#ifdef KOTHARE_PHASE_TIMES
+static double phase_sec[KOTHARE_NPHASES];
+static long phase_count[KOTHARE_NPHASES];
+#define PHASE_NOW() kothare_phase_clock()
+#define PHASE_ADD(p, t0) (phase_sec[p] += kothare_phase_clock() - (t0), ++phase_count[p])
+#else
+#define PHASE_NOW() 0.0
+#define PHASE_ADD(p, t0) ((void)(t0))
+#endif
+
 /* the solver's own words */
 enum { W_OPTIMAL, W_INFEASIBLE, W_MAX_ITER, W_NUMERICAL, W_STALL, W_INACCURATE };
 /* newton step codes (lmi.ipm.kernels) */
@@ -904,7 +916,7 @@ static void congruence_t(int j, const double *mat, double *out)
 static int newton_step(int use_qr, double *theta, double mu, double ref_scale, double err_limit)
 {
     int j, a, b, c, t, i, tries;
-    double alpha_aff, sigma, alpha;
+    double alpha_aff, sigma, alpha, t0;
     for (j = 0; j < NB; ++j) { /* rpt = K rp K' */
         int k = rmpc_order[j];
         const double *kj = ws.kk + j * KK;
@@ -938,12 +950,16 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
             ws.u[rmpc_offset[j] + a * k - (a * (a - 1)) / 2] = -ws.lam[j * KM + a];
         }
     }
+    t0 = PHASE_NOW();
     if (use_qr) {
         newton_qr(ws.u, ref_scale, ws.dx, ws.dsa, ws.dza);
     } else {
         newton_chol(ws.u, ref_scale, ws.dx, ws.dsa, ws.dza);
     }
+    PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
+    t0 = PHASE_NOW();
     alpha_aff = max_step(ws.dsa, ws.dza);
+    PHASE_ADD(KOTHARE_PHASE_STEP_LENGTH, t0);
     if (alpha_aff > 1.0) {
         alpha_aff = 1.0;
     }
@@ -977,15 +993,20 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
         }
         pack_block(ws.m4, j, ws.ucor);
     }
+    t0 = PHASE_NOW();
     if (use_qr) {
         newton_qr(ws.ucor, ref_scale, ws.dx, ws.dst, ws.dzt);
     } else {
         double err = newton_chol(ws.ucor, ref_scale, ws.dx, ws.dst, ws.dzt);
         if (!(err <= err_limit)) {
+            PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
             return STEP_INACCURATE;
         }
     }
+    PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
+    t0 = PHASE_NOW();
     alpha = 0.99 * max_step(ws.dst, ws.dzt);
+    PHASE_ADD(KOTHARE_PHASE_STEP_LENGTH, t0);
     if (alpha > 1.0) {
         alpha = 1.0;
     }
@@ -1049,24 +1070,40 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
 /* kernels.iteration.rows_iteration */
 static int iteration(int *use_qr, double *theta, double mu, double ref_scale, double err_limit)
 {
-    int code;
-    if (!scaling_and_p()) {
+    int code, ok;
+    double t0 = PHASE_NOW();
+    ok = scaling_and_p();
+    PHASE_ADD(KOTHARE_PHASE_SCALING, t0);
+    if (!ok) {
         return STEP_LOST_PD;
     }
     if (!*use_qr) {
+        t0 = PHASE_NOW();
         schur_complement();
-        if (dense_cholesky(ws.h, NV, NV, ws.l, NV) == 0 && factor_ok()) {
+        PHASE_ADD(KOTHARE_PHASE_SCHUR, t0);
+        t0 = PHASE_NOW();
+        ok = dense_cholesky(ws.h, NV, NV, ws.l, NV) == 0 && factor_ok();
+        PHASE_ADD(KOTHARE_PHASE_CHOLESKY, t0);
+        if (ok) {
+            t0 = PHASE_NOW();
             code = newton_step(0, theta, mu, ref_scale, err_limit);
+            PHASE_ADD(KOTHARE_PHASE_NEWTON, t0);
             if (code != STEP_INACCURATE) {
                 return code;
             }
         }
     }
     *use_qr = 1;
-    if (!householder_qr()) {
+    t0 = PHASE_NOW();
+    ok = householder_qr();
+    PHASE_ADD(KOTHARE_PHASE_QR, t0);
+    if (!ok) {
         return STEP_SINGULAR;
     }
-    return newton_step(1, theta, mu, ref_scale, HUGE_VAL);
+    t0 = PHASE_NOW();
+    code = newton_step(1, theta, mu, ref_scale, HUGE_VAL);
+    PHASE_ADD(KOTHARE_PHASE_NEWTON, t0);
+    return code;
 }
 
 static void copy_point(point_t *dst, const point_t *src) { memcpy(dst, src, sizeof *dst); }
@@ -1465,6 +1502,14 @@ void kothare_reset(void)
 
 size_t kothare_workspace_bytes(void) { return sizeof ws; }
 
+#ifdef KOTHARE_PHASE_TIMES
+void kothare_phase_times(double seconds[KOTHARE_NPHASES], long counts[KOTHARE_NPHASES])
+{
+    memcpy(seconds, phase_sec, sizeof phase_sec);
+    memcpy(counts, phase_count, sizeof phase_count);
+}
+#endif
+
 void kothare_last_info(double info[8]) { memcpy(info, ws.info, sizeof ws.info); }
 
 static void apply_gain(const double *x, double *u, double *F)
@@ -1500,7 +1545,17 @@ int kothare_apply_gain(const double *x, double *u)
     return ws.has_gain;
 }
 
+static int solve_state(const double *x, double *u, double *F, double *gamma, int *iterations);
+
 int kothare_solve(const double *x, double *u, double *F, double *gamma, int *iterations)
+{
+    double t0 = PHASE_NOW();
+    int status = solve_state(x, u, F, gamma, iterations);
+    PHASE_ADD(KOTHARE_PHASE_SOLVE, t0);
+    return status;
+}
+
+static int solve_state(const double *x, double *u, double *F, double *gamma, int *iterations)
 {
     const int n = RMPC_NX, m = RMPC_NU;
     double xs[RMPC_NX], scale, nrm = 1.0, pres, dres, gap, radius = 0.0, gam, s2, worst;
