@@ -340,6 +340,51 @@ def test_sanitizer_build_runs_clean(tmp_path: Path, name: str) -> None:
     assert all(np.isfinite(np.array(f[3:3 + m], dtype=float)).all() for f in lines)
 
 
+def _driver_run(folder: Path, name: str, extra: list[str]) -> subprocess.CompletedProcess:
+    """Build the driver in ``folder`` with ``extra`` flags and run it on ``folder/states.txt``."""
+    exe = folder / name
+    sources = [str(folder / f) for f in ("ipm.c", "dense.c", "driver.c")]
+    subprocess.run([CC, *FLAGS, *extra, "-o", str(exe), *sources, "-lm"], check=True, capture_output=True,
+                   text=True)
+    return subprocess.run([str(exe), str(folder / "states.txt")], check=True, capture_output=True, text=True)
+
+
+def test_phase_times_build_changes_no_answer_and_counts_every_phase(tmp_path: Path) -> None:
+    """A ``-DKOTHARE_PHASE_TIMES`` build (what ``python -m benchmarks.timing.ccore --phases``
+    times) gives the same answers, digit for digit, as the plain build, and its phase counts
+    follow the iterations: one scaling per iteration, ``H`` or the QR (or both, at the switch)
+    in each, two Newton solves and two step lengths per step, one entry per solve."""
+    ctrl, states, _ = _sanitizer_case("e1")
+    write_solver(ctrl, tmp_path)
+    shutil.copyfile(_HERE / "driver.c", tmp_path / "driver.c")
+    n = states[0].size
+    np.savetxt(tmp_path / "states.txt", np.array([*states, np.full(n, np.nan), np.zeros(n)]))
+    plain = _driver_run(tmp_path, "plain", [])
+    timed = _driver_run(tmp_path, "timed", ["-DKOTHARE_PHASE_TIMES"])
+    assert plain.stderr == ""
+
+    def answers(out: str) -> list[list[str]]:
+        return [line.split()[:-2] for line in out.splitlines()]  # without the two times
+
+    assert answers(timed.stdout) == answers(plain.stdout)
+    fields = timed.stderr.split()
+    assert fields[0] == "phases" and len(fields) == 1 + 2 * 8
+    sec = dict(zip(("scaling", "schur", "chol", "qr", "newton", "solves", "lengths", "solve"),
+                   (float(v) for v in fields[1:9]), strict=True))
+    count = dict(zip(sec, (int(v) for v in fields[9:]), strict=True))
+    rows = answers(timed.stdout)
+    warm_iterations = sum(int(r[2]) for r in rows[1:])  # the first (cold) solve is left out
+    assert count["solve"] == len(rows) - 1
+    assert count["scaling"] == warm_iterations > 0
+    assert count["schur"] == count["chol"] and count["schur"] + count["qr"] >= count["scaling"]
+    assert 0 < count["qr"] < count["scaling"]  # paper P switches to the QR in the last iterations
+    assert count["newton"] >= count["scaling"]
+    assert count["solves"] == 2 * count["newton"] >= count["lengths"] >= count["newton"]
+    assert all(v >= 0.0 for v in sec.values())
+    assert sec["scaling"] + sec["schur"] + sec["chol"] + sec["qr"] + sec["newton"] <= sec["solve"]
+    assert sec["solves"] + sec["lengths"] <= sec["newton"]
+
+
 def test_generator_refusals(tmp_path: Path) -> None:
     from lmi import KothareProblem
 

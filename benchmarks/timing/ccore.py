@@ -9,7 +9,12 @@ thread CPU time). The first (cold) solve is left out of both. Reported: p50/p95 
 largest gamma and ``u`` differences, the object-code size (``size`` of ``ipm.o`` + ``dense.o``)
 and the static workspace, the machine and its load before and after.
 
-Run: ``python -m benchmarks.timing.ccore [--steps N] [--out FILE.json]``.
+With ``--phases``, one more build (``-O2 -DKOTHARE_PHASE_TIMES``, see ``lmi/ccore/ipm.h``) at the
+same states reports where a warm solve's time goes: the NT scaling with ``P`` formed, ``H = P'P``,
+the Cholesky factor and its pivot test, the QR of ``P``, the predictor-corrector step (its Newton
+solves and step lengths) and the rest (stopping tests, data, certificate), per solve and per entry.
+
+Run: ``python -m benchmarks.timing.ccore [--steps N] [--phases] [--out FILE.json]``.
 """
 
 from __future__ import annotations
@@ -29,11 +34,15 @@ import numpy as np
 from benchmarks.core.machine import machine_info
 from toolkit_common.errors import ConfigError
 
-__all__ = ["FLAG_SETS", "main", "time_case"]
+__all__ = ["FLAG_SETS", "PHASES", "main", "time_case"]
 
 #: Compiler flags timed: the tests' flags, and the same with the host's vector instructions.
 FLAG_SETS = {"O2": ["-O2"], "O3-native": ["-O3", "-march=native"]}
 _WARN = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+
+#: The phases of a ``-DKOTHARE_PHASE_TIMES`` build, in the order of ``KOTHARE_PHASE_*`` (ipm.h).
+PHASES = ("scaling_and_p", "schur_h", "cholesky", "qr", "newton_step", "newton_solves", "step_lengths",
+          "solve")
 
 
 def _stats(values: list[float]) -> dict[str, float]:
@@ -53,8 +62,30 @@ def _controller(n_vertices: int, bound: bool) -> Any:
     return RMPC(plant, q, r, **kw), plant
 
 
-def time_case(n_vertices: int, bound: bool, steps: int, folder: Path) -> dict[str, Any]:
-    """Time one problem: the Python closed loop, then the C driver at its states per flag set."""
+def _phases(folder: Path, solves: int) -> dict[str, Any]:
+    """Per-phase thread CPU time of the driver built with ``-O2 -DKOTHARE_PHASE_TIMES`` at the
+    states in ``folder`` (the first, cold, solve left out): per warm solve (ms) and per entry to
+    the phase (us), the entries, and the rest of a solve outside the iteration's phases."""
+    exe = folder / "driver_phases"
+    srcs = [str(folder / f) for f in ("ipm.c", "dense.c", "driver.c")]
+    subprocess.run(["cc", *_WARN, "-O2", "-DKOTHARE_PHASE_TIMES", "-o", str(exe), *srcs, "-lm"], check=True)
+    out = subprocess.run([str(exe), str(folder / "states.txt")], check=True, capture_output=True, text=True)
+    line = [row for row in out.stderr.splitlines() if row.startswith("phases ")][-1].split()[1:]
+    sec = dict(zip(PHASES, (float(v) for v in line[:len(PHASES)]), strict=True))
+    count = dict(zip(PHASES, (int(v) for v in line[len(PHASES):]), strict=True))
+    outside = ("scaling_and_p", "schur_h", "cholesky", "qr", "newton_step")
+    rest = sec["solve"] - sum(sec[name] for name in outside)
+    return {
+        "flags": "-O2 -DKOTHARE_PHASE_TIMES", "warm_solves": solves,
+        "per_solve_ms": {**{name: sec[name] / solves * 1e3 for name in PHASES}, "rest": rest / solves * 1e3},
+        "per_entry_us": {name: (sec[name] / count[name] * 1e6 if count[name] else 0.0) for name in PHASES},
+        "entries": count,
+    }
+
+
+def time_case(n_vertices: int, bound: bool, steps: int, folder: Path, phases: bool = False) -> dict[str, Any]:
+    """Time one problem: the Python closed loop, then the C driver at its states per flag set
+    (and, with ``phases``, the per-phase times of a ``-DKOTHARE_PHASE_TIMES`` build)."""
     from lmi.ccore.generate import write_solver
     from models import RigidSatellite
 
@@ -118,6 +149,8 @@ def time_case(n_vertices: int, bound: bool, steps: int, folder: Path) -> dict[st
             "max_u_abs": float(np.max(np.abs(u_c - np.array(inputs)))),
             "object_text_data_bytes": text_data, "static_bss_bytes": bss,
         }
+    if phases:
+        record["phases"] = _phases(folder, steps - 1)
     return record
 
 
@@ -127,6 +160,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                                      description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=40, help="closed-loop states per case (default 40)")
     parser.add_argument("--out", type=Path, default=None, help="write the records here (JSON)")
+    parser.add_argument("--phases", action="store_true",
+                        help="also time the phases of a warm solve (a -DKOTHARE_PHASE_TIMES build)")
     args = parser.parse_args(argv)
     if args.steps < 3:
         raise ConfigError("--steps", "an integer >= 3", repr(args.steps))
@@ -137,7 +172,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         for n_vertices in (2, 8):
             for bound in (False, True):
                 folder = Path(tmp) / f"v{n_vertices}_{int(bound)}"
-                report["cases"].append(time_case(n_vertices, bound, args.steps, folder))
+                report["cases"].append(time_case(n_vertices, bound, args.steps, folder, phases=args.phases))
     report["machine_after"] = machine_info()
     print(f"machine: {report['machine_before']['platform']}, {report['machine_before']['cpu_count']} CPUs, "
           f"load {report['machine_before']['load_average']} -> {report['machine_after']['load_average']}")
@@ -154,9 +189,31 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                   f"{c['wall']['p50_ms']:.2f} / {c['wall']['p95_ms']:.2f} | {c['cpu']['p50_ms']:.2f} / "
                   f"{c['cpu']['p95_ms']:.2f} | {c['iterations_p50']:.0f} | {c['max_gamma_rel']:.1e} | "
                   f"{c['max_u_abs']:.1e} | {c['object_text_data_bytes']} | {c['static_bss_bytes']} |")
+    if args.phases:
+        _print_phases(report["cases"])
     if args.out is not None:
         args.out.write_text(json.dumps(report, indent=2))
     return report
+
+
+def _print_phases(cases: list[dict[str, Any]]) -> None:
+    names = ("scaling_and_p", "schur_h", "cholesky", "qr", "newton_step", "newton_solves", "step_lengths",
+             "rest", "solve")
+    print("\nphases of a warm solve (-O2 -DKOTHARE_PHASE_TIMES, thread CPU time): ms per solve "
+          "(us per entry; entries per solve); newton_solves and step_lengths are part of newton_step")
+    print("| vertices | bound | " + " | ".join(names) + " |")
+    print("|---|---|" + "---|" * len(names))
+    for case in cases:
+        ph = case["phases"]
+        cells = []
+        for name in names:
+            ms = ph["per_solve_ms"][name]
+            if name == "rest":
+                cells.append(f"{ms:.2f}")
+            else:
+                per = ph["entries"][name] / ph["warm_solves"]
+                cells.append(f"{ms:.2f} ({ph['per_entry_us'][name]:.0f}; {per:.1f})")
+        print(f"| {case['vertices']} | {case['input_bound']} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

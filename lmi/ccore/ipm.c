@@ -38,6 +38,18 @@
 #define REFINE_STEPS 3
 #define SQRT2 1.4142135623730951
 
+/* Phase times, in a profiling build only (KOTHARE_PHASE_TIMES, see ipm.h): PHASE_NOW() reads
+ * the caller's clock, PHASE_ADD adds the time since t0 to a phase; otherwise both vanish. */
+#ifdef KOTHARE_PHASE_TIMES
+static double phase_sec[KOTHARE_NPHASES];
+static long phase_count[KOTHARE_NPHASES];
+#define PHASE_NOW() kothare_phase_clock()
+#define PHASE_ADD(p, t0) (phase_sec[p] += kothare_phase_clock() - (t0), ++phase_count[p])
+#else
+#define PHASE_NOW() 0.0
+#define PHASE_ADD(p, t0) ((void)(t0))
+#endif
+
 /* the solver's own words */
 enum { W_OPTIMAL, W_INFEASIBLE, W_MAX_ITER, W_NUMERICAL, W_STALL, W_INACCURATE };
 /* newton step codes (lmi.ipm.kernels) */
@@ -50,6 +62,15 @@ typedef struct {
     double z[NB * KK];
 } point_t;
 
+/* An iterate kept for later (the warm start, the best and the stalled points): x and each
+ * block's upper triangle row by row, in the packed layout's order without its weights, so that
+ * restoring it gives back the symmetric blocks exactly. */
+typedef struct {
+    double x[NV];
+    double s[SZ];
+    double z[SZ];
+} saved_t;
+
 static struct workspace {
     int laid_out;           /* the packed layout's tables filled */
     int ready;              /* equilibration fixed */
@@ -60,7 +81,8 @@ static struct workspace {
     double ent_w[SZ];
     double bound[RMPC_NBOUND];
     double hvec[SZ], cvec[NV], val[RMPC_NENT], spv[RMPC_NENT], gv[RMPC_NENT];
-    point_t cur, nxt, warm, warm_next, best, stall;
+    point_t cur, nxt;
+    saved_t warm, warm_next, best, stall;
     double s_chol[NB * KK], chol_new[NB * KK];
     double kk[NB * KK], lam[NB * KM];
     double pt[NVP * SZP], qrh[NVP * SZP], tau[NV];
@@ -894,7 +916,7 @@ static void congruence_t(int j, const double *mat, double *out)
 static int newton_step(int use_qr, double *theta, double mu, double ref_scale, double err_limit)
 {
     int j, a, b, c, t, i, tries;
-    double alpha_aff, sigma, alpha;
+    double alpha_aff, sigma, alpha, t0;
     for (j = 0; j < NB; ++j) { /* rpt = K rp K' */
         int k = rmpc_order[j];
         const double *kj = ws.kk + j * KK;
@@ -928,12 +950,16 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
             ws.u[rmpc_offset[j] + a * k - (a * (a - 1)) / 2] = -ws.lam[j * KM + a];
         }
     }
+    t0 = PHASE_NOW();
     if (use_qr) {
         newton_qr(ws.u, ref_scale, ws.dx, ws.dsa, ws.dza);
     } else {
         newton_chol(ws.u, ref_scale, ws.dx, ws.dsa, ws.dza);
     }
+    PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
+    t0 = PHASE_NOW();
     alpha_aff = max_step(ws.dsa, ws.dza);
+    PHASE_ADD(KOTHARE_PHASE_STEP_LENGTH, t0);
     if (alpha_aff > 1.0) {
         alpha_aff = 1.0;
     }
@@ -967,15 +993,20 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
         }
         pack_block(ws.m4, j, ws.ucor);
     }
+    t0 = PHASE_NOW();
     if (use_qr) {
         newton_qr(ws.ucor, ref_scale, ws.dx, ws.dst, ws.dzt);
     } else {
         double err = newton_chol(ws.ucor, ref_scale, ws.dx, ws.dst, ws.dzt);
         if (!(err <= err_limit)) {
+            PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
             return STEP_INACCURATE;
         }
     }
+    PHASE_ADD(KOTHARE_PHASE_SOLVES, t0);
+    t0 = PHASE_NOW();
     alpha = 0.99 * max_step(ws.dst, ws.dzt);
+    PHASE_ADD(KOTHARE_PHASE_STEP_LENGTH, t0);
     if (alpha > 1.0) {
         alpha = 1.0;
     }
@@ -1039,27 +1070,69 @@ static int newton_step(int use_qr, double *theta, double mu, double ref_scale, d
 /* kernels.iteration.rows_iteration */
 static int iteration(int *use_qr, double *theta, double mu, double ref_scale, double err_limit)
 {
-    int code;
-    if (!scaling_and_p()) {
+    int code, ok;
+    double t0 = PHASE_NOW();
+    ok = scaling_and_p();
+    PHASE_ADD(KOTHARE_PHASE_SCALING, t0);
+    if (!ok) {
         return STEP_LOST_PD;
     }
     if (!*use_qr) {
+        t0 = PHASE_NOW();
         schur_complement();
-        if (dense_cholesky(ws.h, NV, NV, ws.l, NV) == 0 && factor_ok()) {
+        PHASE_ADD(KOTHARE_PHASE_SCHUR, t0);
+        t0 = PHASE_NOW();
+        ok = dense_cholesky(ws.h, NV, NV, ws.l, NV) == 0 && factor_ok();
+        PHASE_ADD(KOTHARE_PHASE_CHOLESKY, t0);
+        if (ok) {
+            t0 = PHASE_NOW();
             code = newton_step(0, theta, mu, ref_scale, err_limit);
+            PHASE_ADD(KOTHARE_PHASE_NEWTON, t0);
             if (code != STEP_INACCURATE) {
                 return code;
             }
         }
     }
     *use_qr = 1;
-    if (!householder_qr()) {
+    t0 = PHASE_NOW();
+    ok = householder_qr();
+    PHASE_ADD(KOTHARE_PHASE_QR, t0);
+    if (!ok) {
         return STEP_SINGULAR;
     }
-    return newton_step(1, theta, mu, ref_scale, HUGE_VAL);
+    t0 = PHASE_NOW();
+    code = newton_step(1, theta, mu, ref_scale, HUGE_VAL);
+    PHASE_ADD(KOTHARE_PHASE_NEWTON, t0);
+    return code;
 }
 
 static void copy_point(point_t *dst, const point_t *src) { memcpy(dst, src, sizeof *dst); }
+
+static void save_point(saved_t *dst, const point_t *src)
+{
+    int t;
+    memcpy(dst->x, src->x, sizeof dst->x);
+    for (t = 0; t < SZ; ++t) {
+        int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
+        dst->s[t] = src->s[at];
+        dst->z[t] = src->z[at];
+    }
+}
+
+/* the blocks of src into dst (their leading k x k parts, the only parts read) */
+static void restore_point(point_t *dst, const saved_t *src)
+{
+    int t;
+    memcpy(dst->x, src->x, sizeof dst->x);
+    for (t = 0; t < SZ; ++t) {
+        int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
+        int mirror = ws.ent_blk[t] * KK + ws.ent_col[t] * KM + ws.ent_row[t];
+        dst->s[at] = src->s[t];
+        dst->s[mirror] = src->s[t];
+        dst->z[at] = src->z[t];
+        dst->z[mirror] = src->z[t];
+    }
+}
 
 /* BlockLMISolver._run: returns the solver's word; the answer (equilibrated x) in ws.cur */
 static int run(int warm, int max_iter, int *iterations, double *pres_o, double *dres_o, double *gap_o,
@@ -1071,7 +1144,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
     double theta = 1.0, pres = HUGE_VAL, dres = HUGE_VAL, gap = HUGE_VAL, radius = 0.0;
     double best_m[3] = {0.0, 0.0, 0.0}, stall_m[3] = {0.0, 0.0, 0.0};
     if (warm) {
-        copy_point(&ws.cur, &ws.warm);
+        restore_point(&ws.cur, &ws.warm);
         for (i = 0; i < NV; ++i) {
             ws.cur.x[i] = ws.warm.x[i] / ws.dscale[i];
         }
@@ -1122,7 +1195,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
         }
         if (!have_stall && agree && maxd(pres, dres) <= REDUCED_TOL
             && (gap < rel_gap ? gap : rel_gap) <= REDUCED_TOL && blocks_within(ws.cur.x, REDUCED_TOL)) {
-            copy_point(&ws.best, &ws.cur);
+            save_point(&ws.best, &ws.cur);
             best_m[0] = pres;
             best_m[1] = dres;
             best_m[2] = gap;
@@ -1160,7 +1233,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
                     status = W_STALL;
                     break;
                 }
-                copy_point(&ws.stall, &ws.cur);
+                save_point(&ws.stall, &ws.cur);
                 stall_m[0] = pres;
                 stall_m[1] = dres;
                 stall_m[2] = gap;
@@ -1173,7 +1246,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
         }
         if (!have_stall && 0.1 * RMPC_WARM_GAP <= rel_gap && rel_gap <= RMPC_WARM_GAP
             && maxd(pres, dres) <= RMPC_WARM_FEAS) {
-            copy_point(&ws.warm_next, &ws.cur);
+            save_point(&ws.warm_next, &ws.cur);
             for (i = 0; i < NV; ++i) {
                 ws.warm_next.x[i] = ws.cur.x[i] * ws.dscale[i];
             }
@@ -1196,18 +1269,18 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
     }
     if (have_stall && status != W_OPTIMAL && status != W_INFEASIBLE) {
         status = W_STALL;
-        copy_point(&ws.cur, &ws.stall);
+        restore_point(&ws.cur, &ws.stall);
         pres = stall_m[0];
         dres = stall_m[1];
         gap = stall_m[2];
     }
     if (status == W_OPTIMAL && have_next) {
-        copy_point(&ws.warm, &ws.warm_next);
+        memcpy(&ws.warm, &ws.warm_next, sizeof ws.warm);
         ws.has_warm = 1;
     }
     if (status != W_OPTIMAL && have_best) {
         status = W_INACCURATE;
-        copy_point(&ws.cur, &ws.best);
+        restore_point(&ws.cur, &ws.best);
         pres = best_m[0];
         dres = best_m[1];
         gap = best_m[2];
@@ -1429,6 +1502,14 @@ void kothare_reset(void)
 
 size_t kothare_workspace_bytes(void) { return sizeof ws; }
 
+#ifdef KOTHARE_PHASE_TIMES
+void kothare_phase_times(double seconds[KOTHARE_NPHASES], long counts[KOTHARE_NPHASES])
+{
+    memcpy(seconds, phase_sec, sizeof phase_sec);
+    memcpy(counts, phase_count, sizeof phase_count);
+}
+#endif
+
 void kothare_last_info(double info[8]) { memcpy(info, ws.info, sizeof ws.info); }
 
 static void apply_gain(const double *x, double *u, double *F)
@@ -1464,7 +1545,17 @@ int kothare_apply_gain(const double *x, double *u)
     return ws.has_gain;
 }
 
+static int solve_state(const double *x, double *u, double *F, double *gamma, int *iterations);
+
 int kothare_solve(const double *x, double *u, double *F, double *gamma, int *iterations)
+{
+    double t0 = PHASE_NOW();
+    int status = solve_state(x, u, F, gamma, iterations);
+    PHASE_ADD(KOTHARE_PHASE_SOLVE, t0);
+    return status;
+}
+
+static int solve_state(const double *x, double *u, double *F, double *gamma, int *iterations)
 {
     const int n = RMPC_NX, m = RMPC_NU;
     double xs[RMPC_NX], scale, nrm = 1.0, pres, dres, gap, radius = 0.0, gam, s2, worst;

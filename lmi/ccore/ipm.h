@@ -46,4 +46,22 @@ void kothare_last_info(double info[8]);
 /* Bytes of the static workspace. */
 size_t kothare_workspace_bytes(void);
 
+/* Phase times of a profiling build (compiled with -DKOTHARE_PHASE_TIMES; the program defines
+ * kothare_phase_clock, a clock in seconds, e.g. the thread's CPU time): the seconds spent in, and
+ * the number of entries to, each phase below, summed over every solve since the program started.
+ * A build without the macro has neither function and no clock calls. */
+#define KOTHARE_NPHASES 8
+#define KOTHARE_PHASE_SCALING 0     /* NT scaling of every block and P formed (per iteration) */
+#define KOTHARE_PHASE_SCHUR 1       /* H = P'P (Cholesky iterations) */
+#define KOTHARE_PHASE_CHOLESKY 2    /* Cholesky factor of H and its pivot test */
+#define KOTHARE_PHASE_QR 3          /* Householder QR of P (QR iterations) */
+#define KOTHARE_PHASE_NEWTON 4      /* the predictor-corrector step, all of it (includes 5 and 6) */
+#define KOTHARE_PHASE_SOLVES 5      /* its Newton solves with their refinement (two per step) */
+#define KOTHARE_PHASE_STEP_LENGTH 6 /* its step lengths (smallest eigenvalues, two per step) */
+#define KOTHARE_PHASE_SOLVE 7       /* kothare_solve, all of it */
+#ifdef KOTHARE_PHASE_TIMES
+double kothare_phase_clock(void);
+void kothare_phase_times(double seconds[KOTHARE_NPHASES], long counts[KOTHARE_NPHASES]);
+#endif
+
 #endif
