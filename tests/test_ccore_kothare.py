@@ -3,7 +3,8 @@
 Each problem's header is generated, compiled with the system compiler (``cc -std=c99 -O2 -Wall
 -Wextra -Werror -pedantic``), loaded with ctypes and run along a closed loop next to
 :meth:`rmpc.RMPC.solve` (the ``"ipm"`` back-end): same statuses, gamma within 1e-6 relative, ``u``
-within 1e-6 (scaled by the input bound). The dense kernels are checked against numpy, the header
+within 1e-6 (scaled by the input bound) where both stop at the same iteration, and within the
+solver's tolerance (1e-4) where rounding parted their warm-start chains. The dense kernels are checked against numpy, the header
 against the Python data bit for bit, and a build with ``-fsanitize=address,undefined`` runs the
 same comparison from a C driver.
 """
@@ -81,10 +82,20 @@ def _unstable(kind: str):
     return RMPC(plant, np.eye(2), np.eye(1), u_max=1.0, input_constraint=kind)
 
 
+#: ``u`` agrees to this (times the input bound) at a state where both solvers stop at the same
+#: iteration: the C iterates follow Python's arithmetic.
+U_TRACKING = 1e-6
+#: ... and to this where rounding made one of them take another iteration (the warm-start chains
+#: part; which states, depends on the machine's rounding): two answers within the solver's
+#: tolerance, which fixes ``u`` only to about 1e-4 (a cold and a warm Python solve at one state
+#: differ by 6.5e-5). Measured here where they part: up to 2.5e-6.
+U_WITHIN_TOLERANCE = 1e-4
+
+
 def _closed_loop(ctrl, csolver: CSolver, a: np.ndarray, b: np.ndarray, x0: np.ndarray, steps: int,
                  u_scale: float) -> tuple[float, float, list[int]]:
-    """Both solvers at the states of the Python closed loop: worst gamma (relative) and u
-    (absolute, divided by ``u_scale``) differences, and the C iteration counts."""
+    """Both solvers at the states of the Python closed loop: worst gamma difference (relative),
+    the ``u`` check (see :data:`U_TRACKING`) asserted state by state, and the C iteration counts."""
     x = x0.copy()
     worst_gamma = worst_u = 0.0
     iterations = []
@@ -95,7 +106,9 @@ def _closed_loop(ctrl, csolver: CSolver, a: np.ndarray, b: np.ndarray, x0: np.nd
         assert status == STATUS_CODES["optimal"]
         u_py = sol.F @ x
         worst_gamma = max(worst_gamma, abs(gamma - sol.gamma) / abs(sol.gamma))
-        worst_u = max(worst_u, float(np.max(np.abs(u - u_py))) / u_scale)
+        du = float(np.max(np.abs(u - u_py))) / u_scale
+        assert du <= (U_TRACKING if its == sol.iterations else U_WITHIN_TOLERANCE)
+        worst_u = max(worst_u, du)
         iterations.append(its)
         x = a @ x + b @ u_py
     return worst_gamma, worst_u, iterations
@@ -105,9 +118,9 @@ def test_e1_closed_loop_agrees(tmp_path: Path) -> None:
     ctrl, plant, x0 = _paper_p_e1()
     csolver = _compile(ctrl, tmp_path)
     a, b = plant.nominal
-    worst_gamma, worst_u, iterations = _closed_loop(ctrl, csolver, a, b, x0, 30, 1.0)
+    worst_gamma, worst_u, iterations = _closed_loop(ctrl, csolver, a, b, x0, 40, 1.0)
     assert worst_gamma <= 1e-6
-    assert worst_u <= 1e-6
+    assert worst_u <= U_WITHIN_TOLERANCE
     assert max(iterations[1:]) < iterations[0]  # warm-started after the first (cold) solve
 
 
@@ -120,11 +133,11 @@ def test_kothare_examples_agree(tmp_path: Path, name: str) -> None:
     ctrl = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint)
     csolver = _compile(ctrl, tmp_path)
     a, b = pb.true_plant
-    # 30 of the suite's 40 steps: on example 2 the warm-start chains part by one iteration at
-    # step 32 (rounding), after which u differs by up to 1.7e-6 u_max (gamma by 4e-9)
-    worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, pb.x0, 30, float(pb.u_max))
+    # the suite's 40 steps: on example 2 the warm-start chains part by one iteration at step 32
+    # here (rounding), after which u differs by up to 1.7e-6 u_max (gamma by 4e-9)
+    worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, pb.x0, 40, float(pb.u_max))
     assert worst_gamma <= 1e-6
-    assert worst_u <= 1e-6
+    assert worst_u <= U_WITHIN_TOLERANCE
 
 
 @pytest.mark.parametrize("kind", ["peak", "ellipsoid"])
@@ -143,7 +156,7 @@ def test_output_bounds_agree(tmp_path: Path, kind: str) -> None:
     a, b = plant.nominal
     worst_gamma, worst_u, _ = _closed_loop(ctrl, csolver, a, b, x0, 8, 1.0)
     assert worst_gamma <= 1e-6
-    assert worst_u <= 1e-6
+    assert worst_u <= U_WITHIN_TOLERANCE
 
 
 @pytest.mark.parametrize("kind", ["peak", "ellipsoid"])

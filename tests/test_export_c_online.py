@@ -78,8 +78,10 @@ def _follow(ctrl: RMPC, plant: PolytopicModel, x0: np.ndarray, exported: Exporte
         code, u, gamma, iterations = exported.step(x)
         assert code == CODE["optimal / ok"] and ctrl.last.status == "optimal"
         assert abs(gamma - ctrl.last.gamma) <= 1e-6 * ctrl.last.gamma
-        assert iterations > 0  # an iteration count is no promise across roundings: only that it solved
-        assert np.max(np.abs(u - u_py)) <= 1e-6 * u_scale
+        # 1e-6 where both stop at the same iteration (the C follows Python's arithmetic); where
+        # rounding parted the warm-start chains, two answers within the solver's tolerance
+        same = iterations == ctrl.last.iterations
+        assert np.max(np.abs(u - u_py)) <= (1e-6 if same else 1e-4) * u_scale
         x = a @ x + b @ u_py
 
 
