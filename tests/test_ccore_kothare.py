@@ -4,9 +4,9 @@ Each problem's header is generated, compiled with the system compiler (``cc -std
 -Wextra -Werror -pedantic``), loaded with ctypes and run along a closed loop next to
 :meth:`rmpc.RMPC.solve` (the ``"ipm"`` back-end): same statuses, gamma within 1e-6 relative, ``u``
 within 1e-6 (scaled by the input bound) where both stop at the same iteration, and within the
-solver's tolerance (1e-4) where rounding parted their warm-start chains. The dense kernels are checked against numpy, the header
-against the Python data bit for bit, and a build with ``-fsanitize=address,undefined`` runs the
-same comparison from a C driver.
+solver's tolerance (1e-4) where rounding parted their warm-start chains. The dense kernels are
+checked against numpy, the header against the Python data bit for bit, and a build with
+``-fsanitize=address,undefined`` runs the same comparison from a C driver.
 """
 
 from __future__ import annotations
