@@ -110,7 +110,8 @@ class _Threshold:
     def solve(self, x):
         self.solves += 1
         ok = np.linalg.norm(x) <= self.limit
-        return SimpleNamespace(status="optimal" if ok else self.word)
+        return SimpleNamespace(status="optimal" if ok else self.word,
+                               certificate=SimpleNamespace(ok=True) if ok else None)
 
 
 @pytest.mark.parametrize("limit", [0.3, 1.0, 3.3, 40.0])
