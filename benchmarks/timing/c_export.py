@@ -23,7 +23,6 @@ can call with its own controller and states.
 from __future__ import annotations
 
 import argparse
-import json
 import shutil
 import subprocess
 import tempfile
@@ -35,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.machine import machine_info, package_versions, percentiles
-from benchmarks.timing.common import Q1, U_MAX, R, tally
+from benchmarks.timing.common import Q1, U_MAX, R, machine_line, tally, write_result
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import OfflineRMPC, export_c, simulate
 from toolkit_common.errors import InvalidArgumentError
@@ -250,12 +249,8 @@ def format_table(result: dict[str, Any]) -> str:
             f"{r['speedup_p50']:.0f}x | {size} | {r['static_bytes']} ({r['table_bytes']} tables + "
             f"{r['workspace_bytes']} workspace) | {r['same_statuses']} | {r['max_abs_diff_u']:.1e} |"
         )
-    m = result["machine"]
     lines.append("")
-    lines.append(
-        f"machine: {m['platform']}, {m['processor']}, {m['cpu_count']} CPUs (os.cpu_count), "
-        f"load average {m['load_average']} (os.getloadavg), Python {m['python']}"
-    )
+    lines.append(machine_line(result["machine"]))
     return "\n".join(lines)
 
 
@@ -270,10 +265,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if min(args.n_ellipsoids, args.steps, args.batches, args.calls) < 1 or args.steps > 100_000:
         parser.error("--n-ellipsoids, --batches and --calls must be >= 1, --steps in 1..100000")
     result = run(args.n_ellipsoids, args.steps, args.batches, args.calls)
-    print(format_table(result))
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            json.dump(result, fh, indent=2)
+    write_result(result, format_table(result), args.out)
     return 0
 
 

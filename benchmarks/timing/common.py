@@ -36,6 +36,7 @@ __all__ = [
     "U_MAX",
     "R",
     "finite",
+    "machine_line",
     "median_int",
     "ms",
     "polytope",
@@ -44,6 +45,7 @@ __all__ = [
     "sci",
     "tally",
     "us",
+    "write_result",
 ]
 
 #: The state weight of paper P's timing problem.
@@ -139,3 +141,20 @@ def us(value: float | None) -> str:
 def sci(value: float | None) -> str:
     """Two significant digits in scientific notation, ``n/a`` for ``None``."""
     return "n/a" if value is None else f"{value:.1e}"
+
+
+def machine_line(machine: dict[str, Any]) -> str:
+    """The stand-alone scripts' last line: the machine and its load, as the run recorded them."""
+    m = machine
+    return (f"machine: {m['platform']}, {m['processor']}, {m['cpu_count']} CPUs (os.cpu_count), "
+            f"load average {m['load_average']} (os.getloadavg), Python {m['python']}")
+
+
+def write_result(result: dict[str, Any], table: str, out: str | None) -> None:
+    """Print a stand-alone script's table and, with ``out``, write its result as JSON there."""
+    import json
+
+    print(table)
+    if out:
+        with open(out, "w", encoding="utf-8") as fh:
+            json.dump(result, fh, indent=2)

@@ -21,7 +21,6 @@ the machine and its load average (the machines are shared and noisy).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 from collections.abc import Sequence
@@ -30,7 +29,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from benchmarks.core.machine import machine_info, package_versions, percentiles
-from benchmarks.timing.common import POLYTOPE_NAMES, Q1, U_MAX, R, finite, sample_key, tally
+from benchmarks.timing.common import (
+    POLYTOPE_NAMES,
+    Q1,
+    U_MAX,
+    R,
+    finite,
+    machine_line,
+    sample_key,
+    tally,
+    write_result,
+)
 from benchmarks.timing.rmpc import reference_gamma_at
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
 from rmpc import OfflineRMPC, simulate
@@ -169,12 +178,8 @@ def format_table(result: dict[str, Any]) -> str:
             f"{1e6 * r['p50_s']:.1f} | {1e6 * r['p95_s']:.1f} | {1e6 * r['max_s']:.1f} | "
             f"{1e6 * r['reported_p50_s']:.1f} | {r['status_counts']} | {r['max_rel_err']:.1e} |"
         )
-    m = result["machine"]
     lines.append("")
-    lines.append(
-        f"machine: {m['platform']}, {m['processor']}, {m['cpu_count']} CPUs (os.cpu_count), "
-        f"load average {m['load_average']} (os.getloadavg), Python {m['python']}"
-    )
+    lines.append(machine_line(result["machine"]))
     return "\n".join(lines)
 
 
@@ -190,10 +195,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.steps < 1 or args.repeats < 1 or args.n_ellipsoids < 1:
         parser.error("--steps, --repeats and --n-ellipsoids must be >= 1")
     result = run(args.steps, args.repeats, args.n_ellipsoids, args.modes)
-    print(format_table(result))
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            json.dump(result, fh, indent=2)
+    write_result(result, format_table(result), args.out)
     return 0
 
 

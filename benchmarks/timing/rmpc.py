@@ -24,7 +24,6 @@ p95 and max, with the machine and its load average: the machines are shared and 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -45,6 +44,7 @@ from benchmarks.timing.common import (
     rel_err,
     sample_key,
     tally,
+    write_result,
 )
 from lmi import KothareProblem
 from models import PAPER_P_SAMPLE_TIME, RigidSatellite
@@ -388,10 +388,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.steps < 1 or args.rebuild_steps < 1:
         parser.error("--steps and --rebuild-steps must be >= 1")
     result = run(args.steps, args.rebuild_steps)
-    print(format_table(result))
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as fh:
-            json.dump(result, fh, indent=2)
+    write_result(result, format_table(result), args.out)
     return 0
 
 
