@@ -14,7 +14,12 @@
  * Storage: a block is a RMPC_KMAX x RMPC_KMAX row-major array; a packed vector holds each
  * block's upper triangle row by row, off-diagonal entries times sqrt(2).
  */
+/* the problem fixed at generation time (an export), or given at run time (the extension) */
+#ifdef KOTHARE_RUNTIME
+#include "runtime.h"
+#else
 #include "rmpc_problem.h"
+#endif
 
 #include <math.h>
 #include <stddef.h>
@@ -56,51 +61,78 @@ enum { W_OPTIMAL, W_INFEASIBLE, W_MAX_ITER, W_NUMERICAL, W_STALL, W_INACCURATE }
 enum { STEP_OK = 0, STEP_BAD_LENGTH = 1, STEP_NOT_PD = 2, STEP_LOST_PD = 3, STEP_SINGULAR = 4,
        STEP_INACCURATE = 5 };
 
-typedef struct {
-    double x[NV];
-    double s[NB * KK];
-    double z[NB * KK];
-} point_t;
-
+/* The workspace's arrays as X-macro lists (type, name, entries): an export declares them as
+ * arrays of sizes fixed at generation time, in one static workspace; the run-time build
+ * (KOTHARE_RUNTIME) as pointers into the caller's buffer, carved by kothare_rt_init. */
+#define POINT_ARRAYS(X) X(double, x, NV) X(double, s, NB * KK) X(double, z, NB * KK)
 /* An iterate kept for later (the warm start, the best and the stalled points): x and each
  * block's upper triangle row by row, in the packed layout's order without its weights, so that
  * restoring it gives back the symmetric blocks exactly. */
+#define SAVED_ARRAYS(X) X(double, x, NV) X(double, s, SZ) X(double, z, SZ)
+#define CORE_ARRAYS(X)                                                                         \
+    X(double, dscale, NV) X(double, bw, NB)                                                    \
+    X(double, sq, NB * NV) /* squared coefficient norms per (block, variable) */               \
+    X(int, ent_row, SZ) X(int, ent_col, SZ) X(int, ent_blk, SZ) X(double, ent_w, SZ)           \
+    X(double, bound, RMPC_NBOUND) X(double, hvec, SZ) X(double, cvec, NV)                      \
+    X(double, val, RMPC_NENT) X(double, spv, RMPC_NENT) X(double, gv, RMPC_NENT)               \
+    X(double, s_chol, NB * KK) X(double, chol_new, NB * KK) X(double, kk, NB * KK)             \
+    X(double, lam, NB * KM) X(double, pt, NVP * SZP) X(double, qrh, NVP * SZP)                 \
+    X(double, tau, NV) X(double, h, NV * NV) X(double, l, NV * NV) X(double, basis, RMPC_BASIS) \
+    /* packed vectors: SZP entries, the padding past SZ always zero (read by dotv) */          \
+    X(double, r0, SZP) X(double, rd, NV) X(double, rp, SZP) X(double, sp, SZP)                 \
+    X(double, zp, SZP) X(double, gx, SZP) X(double, gtz, NV) X(double, u, SZP)                 \
+    X(double, ucor, SZP) X(double, rpt, SZP) X(double, v, SZP) X(double, dsa, SZP)             \
+    X(double, dza, SZP) X(double, dst, SZP) X(double, dzt, SZP) X(double, dzt2, SZP)           \
+    X(double, tv, SZP) X(double, yv, SZP) X(double, err, NV) X(double, err2, NV)               \
+    X(double, dx, NV) X(double, ddx, NV) X(double, wv, NV) X(double, vn, NV)                   \
+    X(double, m1, KK) X(double, m2, KK) X(double, m3, KK) X(double, m4, KK)                    \
+    X(double, ev, KM) X(double, ee, KM) X(double, e1, KM) X(double, e2, KM)                    \
+    X(double, merits, (MAXIT + 1) * 3) X(double, ray, MAXIT + 1)
+/* the certificate and the gain of an export (solve_state) */
+#define EXPORT_ARRAYS(X)                                                                       \
+    X(double, cm, CK * CK) X(double, cw, CK) X(double, ce, CK) X(double, cv, CK * CK)          \
+    X(double, qm, RMPC_NX * RMPC_NX) X(double, ym, RMPC_NU * RMPC_NX)                          \
+    X(double, qc, RMPC_NX * RMPC_NX) X(double, fm, RMPC_NU * RMPC_NX)                          \
+    X(double, gj, RMPC_NX * RMPC_NX) X(double, tmp, RMPC_NX * RMPC_NX)                         \
+    X(double, gain, RMPC_NU * RMPC_NX)
+#define NBYTES(count) ((size_t)(count) * sizeof(double))
+
+#ifdef KOTHARE_RUNTIME
+#define DECLARE(type, name, count) type *name;
+#else
+#define DECLARE(type, name, count) type name[count];
+#endif
+
 typedef struct {
-    double x[NV];
-    double s[SZ];
-    double z[SZ];
+    POINT_ARRAYS(DECLARE)
+} point_t;
+
+typedef struct {
+    SAVED_ARRAYS(DECLARE)
 } saved_t;
 
-static struct workspace {
+struct workspace {
     int laid_out;           /* the packed layout's tables filled */
     int ready;              /* equilibration fixed */
     int has_warm, has_gain;
-    double dscale[NV], bw[NB];
-    double sq[NB * NV];     /* squared coefficient norms per (block, variable) */
-    int ent_row[SZ], ent_col[SZ], ent_blk[SZ];
-    double ent_w[SZ];
-    double bound[RMPC_NBOUND];
-    double hvec[SZ], cvec[NV], val[RMPC_NENT], spv[RMPC_NENT], gv[RMPC_NENT];
+    void *home;             /* the run-time build: where the arrays were carved */
     point_t cur, nxt;
     saved_t warm, warm_next, best, stall;
-    double s_chol[NB * KK], chol_new[NB * KK];
-    double kk[NB * KK], lam[NB * KM];
-    double pt[NVP * SZP], qrh[NVP * SZP], tau[NV];
-    double h[NV * NV], l[NV * NV];
-    double basis[RMPC_BASIS];
-    /* packed vectors: SZP entries, the padding past SZ always zero (read by dotv) */
-    double r0[SZP], rd[NV], rp[SZP], sp[SZP], zp[SZP], gx[SZP], gtz[NV];
-    double u[SZP], ucor[SZP], rpt[SZP], v[SZP], dsa[SZP], dza[SZP], dst[SZP], dzt[SZP], dzt2[SZP],
-        tv[SZP], yv[SZP], err[NV], err2[NV], dx[NV], ddx[NV], wv[NV], vn[NV];
-    double m1[KK], m2[KK], m3[KK], m4[KK];
-    double ev[KM], ee[KM], e1[KM], e2[KM];
-    double merits[MAXIT + 1][3], ray[MAXIT + 1];
-    double cm[CK * CK], cw[CK], ce[CK], cv[CK * CK];
-    double qm[RMPC_NX * RMPC_NX], ym[RMPC_NU * RMPC_NX], qc[RMPC_NX * RMPC_NX],
-        fm[RMPC_NU * RMPC_NX], gj[RMPC_NX * RMPC_NX], tmp[RMPC_NX * RMPC_NX];
-    double gain[RMPC_NU * RMPC_NX];
     double info[8];
-} ws;
+    CORE_ARRAYS(DECLARE)
+#ifndef KOTHARE_RUNTIME
+    EXPORT_ARRAYS(DECLARE)
+#endif
+};
+
+#ifdef KOTHARE_RUNTIME
+/* the problem and the workspace of the call under way (set by every kothare_rt_* entry) */
+static const kothare_problem_t *rt;
+static struct workspace *ws_at;
+#define ws (*ws_at)
+#else
+static struct workspace ws;
+#endif
 
 /* ------------------------------------------------------------------ layout and data */
 
@@ -373,7 +405,7 @@ static int shift_interior(double *mats)
 static int initial_point(void)
 {
     int t, e, f, i;
-    memset(ws.h, 0, sizeof ws.h);
+    memset(ws.h, 0, NBYTES(NV * NV));
     e = 0;
     while (e < RMPC_NENT) { /* G'G from the entries of each packed row */
         int t0 = rmpc_ent_t[e], stop = e;
@@ -401,16 +433,16 @@ static int initial_point(void)
     for (t = 0; t < SZ; ++t) {
         ws.tv[t] = ws.hvec[t] - ws.gx[t];
     }
-    memset(ws.cur.s, 0, sizeof ws.cur.s);
+    memset(ws.cur.s, 0, NBYTES(NB * KK));
     unpack(ws.tv, ws.cur.s);
-    memcpy(ws.wv, ws.cvec, sizeof ws.wv);
+    memcpy(ws.wv, ws.cvec, NBYTES(NV));
     dense_forward(ws.l, NV, NV, ws.wv);
     dense_backward(ws.l, NV, NV, ws.wv);
     g_times(ws.wv, ws.tv);
     for (t = 0; t < SZ; ++t) {
         ws.tv[t] = -ws.tv[t];
     }
-    memset(ws.cur.z, 0, sizeof ws.cur.z);
+    memset(ws.cur.z, 0, NBYTES(NB * KK));
     unpack(ws.tv, ws.cur.z);
     return shift_interior(ws.cur.s) && shift_interior(ws.cur.z);
 }
@@ -761,7 +793,7 @@ static void reflect4(const double *restrict hk, double *restrict h, int k, doubl
 static int householder_qr(void)
 {
     int k, i, t;
-    memcpy(ws.qrh, ws.pt, sizeof ws.qrh);
+    memcpy(ws.qrh, ws.pt, NBYTES(NVP * SZP));
     for (k = 0; k < NV; ++k) {
         double *hk = ws.qrh + k * SZP;
         double alpha = hk[k], xnorm = sqrt(dot_from(hk, hk, k + 1)), beta, tau, sc;
@@ -804,9 +836,9 @@ static void newton_qr(const double *u, double ref_scale, double *dx, double *ds,
     for (t = 0; t < SZ; ++t) {
         ws.v[t] = u[t] + ws.rpt[t];
     }
-    memcpy(ws.wv, ws.rd, sizeof ws.wv);
+    memcpy(ws.wv, ws.rd, NBYTES(NV));
     dense_forward(ws.l, NV, NV, ws.wv); /* R' w = rd */
-    memcpy(ws.tv, ws.v, sizeof ws.tv);
+    memcpy(ws.tv, ws.v, NBYTES(SZP));
     householder_apply(ws.tv, 1);
     for (i = 0; i < NV; ++i) {
         dx[i] = -(ws.wv[i] + ws.tv[i]);
@@ -827,7 +859,7 @@ static void newton_qr(const double *u, double ref_scale, double *dx, double *ds,
         if (err_norm <= 1e-14 * ref_scale) {
             break;
         }
-        memcpy(ws.vn, ws.err, sizeof ws.vn);
+        memcpy(ws.vn, ws.err, NBYTES(NV));
         dense_forward(ws.l, NV, NV, ws.vn); /* cw */
         for (t = 0; t < SZ; ++t) {
             ws.yv[t] = t < NV ? ws.vn[t] : 0.0;
@@ -1106,12 +1138,24 @@ static int iteration(int *use_qr, double *theta, double mu, double ref_scale, do
     return code;
 }
 
-static void copy_point(point_t *dst, const point_t *src) { memcpy(dst, src, sizeof *dst); }
+static void copy_point(point_t *dst, const point_t *src)
+{
+    memcpy(dst->x, src->x, NBYTES(NV));
+    memcpy(dst->s, src->s, NBYTES(NB * KK));
+    memcpy(dst->z, src->z, NBYTES(NB * KK));
+}
+
+static void copy_saved(saved_t *dst, const saved_t *src)
+{
+    memcpy(dst->x, src->x, NBYTES(NV));
+    memcpy(dst->s, src->s, NBYTES(SZ));
+    memcpy(dst->z, src->z, NBYTES(SZ));
+}
 
 static void save_point(saved_t *dst, const point_t *src)
 {
     int t;
-    memcpy(dst->x, src->x, sizeof dst->x);
+    memcpy(dst->x, src->x, NBYTES(NV));
     for (t = 0; t < SZ; ++t) {
         int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
         dst->s[t] = src->s[at];
@@ -1123,7 +1167,7 @@ static void save_point(saved_t *dst, const point_t *src)
 static void restore_point(point_t *dst, const saved_t *src)
 {
     int t;
-    memcpy(dst->x, src->x, sizeof dst->x);
+    memcpy(dst->x, src->x, NBYTES(NV));
     for (t = 0; t < SZ; ++t) {
         int at = ws.ent_blk[t] * KK + ws.ent_row[t] * KM + ws.ent_col[t];
         int mirror = ws.ent_blk[t] * KK + ws.ent_col[t] * KM + ws.ent_row[t];
@@ -1212,16 +1256,16 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
             have_best = 0;
             break;
         }
-        ws.merits[count][0] = pres;
-        ws.merits[count][1] = dres;
-        ws.merits[count][2] = gap < rel_gap ? gap : rel_gap;
+        ws.merits[3 * count] = pres;
+        ws.merits[3 * count + 1] = dres;
+        ws.merits[3 * count + 2] = gap < rel_gap ? gap : rel_gap;
         ws.ray[count] = radius > 0.0 ? 1.0 / radius : HUGE_VAL;
         ++count;
         if (it >= STALL_WINDOW) {
             int q, last = count - 1, then = count - 1 - STALL_WINDOW;
             ray_grows = ws.ray[last] <= 0.5 * ws.ray[then];
             for (q = 0; q < 3; ++q) {
-                if (ws.merits[last][q] <= 0.5 * ws.merits[then][q]) {
+                if (ws.merits[3 * last + q] <= 0.5 * ws.merits[3 * then + q]) {
                     halved = 1;
                 }
             }
@@ -1262,7 +1306,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
             break;
         }
         copy_point(&ws.cur, &ws.nxt);
-        memcpy(ws.s_chol, ws.chol_new, sizeof ws.s_chol);
+        memcpy(ws.s_chol, ws.chol_new, NBYTES(NB * KK));
     }
     if (it > max_iter) {
         it = max_iter < 0 ? 0 : max_iter;
@@ -1275,7 +1319,7 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
         gap = stall_m[2];
     }
     if (status == W_OPTIMAL && have_next) {
-        memcpy(&ws.warm, &ws.warm_next, sizeof ws.warm);
+        copy_saved(&ws.warm, &ws.warm_next);
         ws.has_warm = 1;
     }
     if (status != W_OPTIMAL && have_best) {
@@ -1293,6 +1337,26 @@ static int run(int warm, int max_iter, int *iterations, double *pres_o, double *
     return status;
 }
 
+/* BlockLMISolver.solve at the data set_data set: a warm start if asked and kept, retried cold
+ * unless it ended optimal or infeasible (its iterations counted); the solver's word */
+static int solve_data(int warm_start, int *its, double *pres, double *dres, double *gap, double *radius)
+{
+    int word = -1, spent = 0;
+    if (warm_start && ws.has_warm) {
+        word = run(1, RMPC_WARM_MAX_ITER, its, pres, dres, gap, radius);
+        if (word != W_OPTIMAL && word != W_INFEASIBLE) {
+            spent = *its;
+            word = -1;
+        }
+    }
+    if (word < 0) {
+        word = run(0, RMPC_MAX_ITER, its, pres, dres, gap, radius);
+    }
+    *its += spent;
+    return word;
+}
+
+#ifndef KOTHARE_RUNTIME
 /* ------------------------------------------------------------------ the certificate */
 
 static double rel_min_eig(double *mat, int k)
@@ -1559,7 +1623,7 @@ static int solve_state(const double *x, double *u, double *F, double *gamma, int
 {
     const int n = RMPC_NX, m = RMPC_NU;
     double xs[RMPC_NX], scale, nrm = 1.0, pres, dres, gap, radius = 0.0, gam, s2, worst;
-    int i, a, b, word = W_NUMERICAL, its = 0, spent = 0, status;
+    int i, a, b, word, its = 0, status;
     if (!ws.laid_out) {
         layout();
         ws.laid_out = 1;
@@ -1607,19 +1671,7 @@ static int solve_state(const double *x, double *u, double *F, double *gamma, int
     }
 #endif
     set_data(xs);
-    if (RMPC_WARM_START && ws.has_warm) {
-        word = run(1, RMPC_WARM_MAX_ITER, &its, &pres, &dres, &gap, &radius);
-        if (word != W_OPTIMAL && word != W_INFEASIBLE) {
-            spent = its;
-            word = -1;
-        }
-    } else {
-        word = -1;
-    }
-    if (word < 0) {
-        word = run(0, RMPC_MAX_ITER, &its, &pres, &dres, &gap, &radius);
-    }
-    its += spent;
+    word = solve_data(RMPC_WARM_START, &its, &pres, &dres, &gap, &radius);
     if (iterations != NULL) {
         *iterations = its;
     }
@@ -1712,3 +1764,98 @@ static int solve_state(const double *x, double *u, double *F, double *gamma, int
     apply_gain(x, u, F);
     return status;
 }
+#endif /* KOTHARE_RUNTIME */
+
+#ifdef KOTHARE_RUNTIME
+/* ------------------------------------------------------------------ the run-time calls */
+
+#define ALIGNED(bytes) (((bytes) + 15u) & ~(size_t)15u)
+#define CARVE(type, name, count)                                                               \
+    if (base != NULL) {                                                                        \
+        owner->name = (type *)(void *)(base + at);                                             \
+    }                                                                                          \
+    at += ALIGNED((size_t)(count) * sizeof(type));
+
+static size_t carve_point(point_t *owner, unsigned char *base, size_t at)
+{
+    POINT_ARRAYS(CARVE)
+    return at;
+}
+
+static size_t carve_saved(saved_t *owner, unsigned char *base, size_t at)
+{
+    SAVED_ARRAYS(CARVE)
+    return at;
+}
+
+/* the arrays of the workspace at base (base NULL: only the bytes counted), after the struct */
+static size_t carve(struct workspace *owner, unsigned char *base)
+{
+    size_t at = ALIGNED(sizeof(struct workspace));
+    at = carve_point(&owner->cur, base, at);
+    at = carve_point(&owner->nxt, base, at);
+    at = carve_saved(&owner->warm, base, at);
+    at = carve_saved(&owner->warm_next, base, at);
+    at = carve_saved(&owner->best, base, at);
+    at = carve_saved(&owner->stall, base, at);
+    CORE_ARRAYS(CARVE)
+    return at;
+}
+
+/* every run-time call starts here: the problem and workspace of this call; a workspace whose
+ * bytes were copied elsewhere (its pointers still into the old place) is carved again there */
+static void enter(const kothare_problem_t *problem, void *work)
+{
+    rt = problem;
+    ws_at = (struct workspace *)work;
+    if (ws.home != work) {
+        carve(ws_at, (unsigned char *)work);
+        ws.home = work;
+    }
+}
+
+size_t kothare_rt_workspace_bytes(const kothare_problem_t *problem)
+{
+    struct workspace counting;
+    rt = problem;
+    return carve(&counting, NULL);
+}
+
+void kothare_rt_init(const kothare_problem_t *problem, void *work)
+{
+    memset(work, 0, kothare_rt_workspace_bytes(problem));
+    enter(problem, work);
+    layout();
+    ws.laid_out = 1;
+}
+
+void kothare_rt_reset_warm_start(const kothare_problem_t *problem, void *work)
+{
+    enter(problem, work);
+    ws.has_warm = 0;
+}
+
+int kothare_rt_solve(const kothare_problem_t *problem, void *work, const double *xs, const double *bounds,
+                     int warm_start, double *x, double *z, double *weights, double info[5])
+{
+    int i, its = 0, word;
+    double pres = HUGE_VAL, dres = HUGE_VAL, gap = HUGE_VAL, radius = 0.0;
+    enter(problem, work);
+    for (i = 0; i < RMPC_NBOUND; ++i) {
+        ws.bound[i] = bounds[i];
+    }
+    set_data(xs);
+    word = solve_data(warm_start, &its, &pres, &dres, &gap, &radius);
+    for (i = 0; i < NV; ++i) {
+        x[i] = ws.cur.x[i] * ws.dscale[i];
+    }
+    memcpy(z, ws.cur.z, NBYTES(NB * KK));
+    memcpy(weights, ws.bw, NBYTES(NB));
+    info[0] = pres;
+    info[1] = dres;
+    info[2] = gap;
+    info[3] = radius;
+    info[4] = its;
+    return word;
+}
+#endif /* KOTHARE_RUNTIME */
