@@ -19,6 +19,7 @@ import ctypes
 import math
 import re
 import shutil
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -28,8 +29,8 @@ import numpy as np
 from toolkit_common.errors import InvalidArgumentError
 
 __all__ = [
-    "LIMITS", "SOURCES", "STATUS_CODES", "c_double", "check_controller", "problem_header",
-    "solver_source", "write_solver",
+    "CORE_DOUBLE_TABLES", "CORE_INT_TABLES", "LIMITS", "SOURCES", "STATUS_CODES", "CoreTables", "c_double",
+    "check_controller", "core_tables", "problem_header", "solver_source", "write_solver",
 ]
 
 #: The C sources the header goes with (package data of :mod:`lmi.ccore`).
@@ -118,43 +119,49 @@ def _backend(problem: Any) -> Any:
     return backend
 
 
-def problem_header(problem: Any) -> str:
-    """The text of ``rmpc_problem.h`` for ``problem``.
+#: The integer and real tables of the interior-point method (``runtime.h``'s ``kothare_problem_t``
+#: fields and the export's ``rmpc_*`` arrays of the same names; ``cnst`` is ``rmpc_const``).
+CORE_INT_TABLES = ("order", "offset", "copies", "ent_off", "ent_var", "ent_pos", "ent_t", "ent_bound",
+                   "pos_off", "pos_row", "pos_col")
+CORE_DOUBLE_TABLES = ("cnst", "ent_val", "c")
 
-    Parameters
+
+@dataclass(frozen=True)
+class CoreTables:
+    """What the C core's interior-point method reads of one problem (:func:`core_tables`).
+
+    Attributes
     ----------
-    problem : KothareProblem, RMPC or IPMKothare
-        A Kothare problem solved by the ``"ipm"`` back-end (with an :class:`rmpc.RMPC` of
-        Kothare's form, its problem; the state is the deviation ``x - x_ref``, here ``x``).
-
-    Returns
-    -------
-    str
-
-    Raises
-    ------
-    InvalidArgumentError
-        Naming ``problem``: another back-end or form, the nesting block of the off-line design,
-        a rebalanced coordinate change, or sizes beyond :data:`LIMITS`.
+    sizes : dict
+        ``nv, nb, kmax, size, nent, basis, nbound, degree, max_iter, warm_max_iter``.
+    reals : dict
+        ``tol_feas, tol_gap_abs, tol_gap_rel, warm_gap, warm_feas, inf_radius, qr_switch``.
+    tables : dict
+        :data:`CORE_INT_TABLES` (int arrays) and :data:`CORE_DOUBLE_TABLES` (float arrays).
+    n_ub, n_yb : int
+        Input and output bounds (the bound vector is ``[u_max, y_max]``).
     """
-    backend = _backend(problem)
-    cert_tol = float(getattr(getattr(problem, "problem", problem), "certificate_tol", 1e-7))
-    data = backend.original_data
+
+    sizes: dict[str, int]
+    reals: dict[str, float]
+    tables: dict[str, np.ndarray]
+    n_ub: int
+    n_yb: int
+
+
+def core_tables(backend: Any) -> CoreTables:
+    """The C core's data of an :class:`~lmi.backends.ipm.IPMKothare` in its current coordinates.
+
+    The coefficient entries are the non-zero upper-triangle entries of each block, ordered by
+    block, then packed position (row by row), then variable; an entry's bound index (``-1``: none)
+    picks the bound that divides it at each solve, as ``IPMKothare._update_blocks`` scales it.
+    One computation for the export's header (:func:`problem_header`) and the run-time core
+    (:mod:`lmi.ccore.runtime`).
+    """
+    data = backend.data
     solver = backend._solver
-    conic = backend.conic
     blocks = backend._base_blocks
-    n, m, nv = data.n, data.m, solver.n
     orders = [c.shape[0] for c, _ in blocks]
-    kmax = max(orders)
-    p_rows = data.Q1h.shape[0]
-    cert_k = 2 * n + p_rows + m
-    for label, value, limit in (("variables", nv, LIMITS["variables"]),
-                                ("order", max(kmax, cert_k), LIMITS["order"]),
-                                ("blocks", len(blocks), LIMITS["blocks"])):
-        if value > limit:
-            raise InvalidArgumentError("problem", f"at most {limit} {label} for the C core", f"{value}")
-    if orders[0] != n + 1 or np.any(blocks[0][0] != 0.0):
-        raise InvalidArgumentError("problem", "the state LMI as its first block", f"order {orders[0]}")
     n_ub = int(data.u_max.size)
     n_yb = int(data.y_max.size)
     # bound index of every entry: -1 none, else into [u bounds, y bounds]
@@ -196,7 +203,69 @@ def problem_header(problem: Any) -> str:
             ent_t.append(offsets[j] + a * k - (a * (a - 1)) // 2 + (b - a))
     max_pos_size = max((pos_off[j + 1] - pos_off[j]) * (offsets[j + 1] - offsets[j])
                        for j in range(len(blocks)))
-    copies = solver._copies()
+    opts = backend._solver_options
+    sizes = {
+        "nv": int(solver.n), "nb": len(blocks), "kmax": max(orders), "size": offsets[-1],
+        "nent": len(ent_var), "basis": max_pos_size, "nbound": max(1, n_ub + n_yb),
+        "degree": int(sum(orders)), "max_iter": int(opts["max_iter"]),
+        "warm_max_iter": int(opts["warm_max_iter"]),
+    }
+    reals = {
+        "tol_feas": solver.tol_feas, "tol_gap_abs": solver.tol_gap_abs, "tol_gap_rel": solver.tol_gap_rel,
+        "warm_gap": solver.warm_gap, "warm_feas": solver.warm_feas,
+        "inf_radius": solver.infeasibility_radius, "qr_switch": solver.qr_switch(),
+    }
+    ints = {"order": orders, "offset": offsets, "copies": solver._copies(), "ent_off": ent_off,
+            "ent_var": ent_var, "ent_pos": ent_pos, "ent_t": ent_t, "ent_bound": ent_bound,
+            "pos_off": pos_off, "pos_row": pos_row, "pos_col": pos_col}
+    tables = {name: np.asarray(values, dtype=np.int64) for name, values in ints.items()}
+    tables["cnst"] = np.asarray(const_vals, dtype=float)
+    tables["ent_val"] = np.asarray(ent_val, dtype=float)
+    tables["c"] = np.asarray(backend.conic.objective, dtype=float)
+    return CoreTables(sizes, {k: float(v) for k, v in reals.items()}, tables, n_ub, n_yb)
+
+
+def problem_header(problem: Any) -> str:
+    """The text of ``rmpc_problem.h`` for ``problem``.
+
+    Parameters
+    ----------
+    problem : KothareProblem, RMPC or IPMKothare
+        A Kothare problem solved by the ``"ipm"`` back-end (with an :class:`rmpc.RMPC` of
+        Kothare's form, its problem; the state is the deviation ``x - x_ref``, here ``x``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``problem``: another back-end or form, the nesting block of the off-line design,
+        a rebalanced coordinate change, or sizes beyond :data:`LIMITS`.
+    """
+    backend = _backend(problem)
+    cert_tol = float(getattr(getattr(problem, "problem", problem), "certificate_tol", 1e-7))
+    data = backend.original_data
+    solver = backend._solver
+    conic = backend.conic
+    blocks = backend._base_blocks
+    n, m, nv = data.n, data.m, solver.n
+    orders = [c.shape[0] for c, _ in blocks]
+    kmax = max(orders)
+    p_rows = data.Q1h.shape[0]
+    cert_k = 2 * n + p_rows + m
+    for label, value, limit in (("variables", nv, LIMITS["variables"]),
+                                ("order", max(kmax, cert_k), LIMITS["order"]),
+                                ("blocks", len(blocks), LIMITS["blocks"])):
+        if value > limit:
+            raise InvalidArgumentError("problem", f"at most {limit} {label} for the C core", f"{value}")
+    if orders[0] != n + 1 or np.any(blocks[0][0] != 0.0):
+        raise InvalidArgumentError("problem", "the state LMI as its first block", f"order {orders[0]}")
+    core = core_tables(backend)
+    n_ub, n_yb = core.n_ub, core.n_yb
+    tab = core.tables
+    offsets, ent_var, pos_row = tab["offset"], tab["ent_var"], tab["pos_row"]
 
     def affine_map(aff: Any) -> tuple[list[int], list[int], list[float]]:
         coef = aff.coef  # (nv + 1, r, c)
@@ -223,8 +292,8 @@ def problem_header(problem: Any) -> str:
     opts = backend._solver_options
     macros = {
         "RMPC_NX": n, "RMPC_NU": m, "RMPC_NV": nv, "RMPC_NB": len(blocks), "RMPC_KMAX": kmax,
-        "RMPC_SIZE": offsets[-1], "RMPC_NENT": len(ent_var), "RMPC_NPOS": len(pos_row),
-        "RMPC_BASIS": max_pos_size, "RMPC_NUB": n_ub, "RMPC_NYB": n_yb,
+        "RMPC_SIZE": int(offsets[-1]), "RMPC_NENT": len(ent_var), "RMPC_NPOS": len(pos_row),
+        "RMPC_BASIS": core.sizes["basis"], "RMPC_NUB": n_ub, "RMPC_NYB": n_yb,
         "RMPC_NBOUND": max(1, n_ub + n_yb), "RMPC_NQMAP": len(q_var), "RMPC_NYMAP": len(y_var),
         "RMPC_NVERT": data.n_vertices, "RMPC_P1": p_rows, "RMPC_POUT": p_out, "RMPC_CERT_K": cert_k,
         "RMPC_INPUT_KIND": kind, "RMPC_SCALED": int(scaled), "RMPC_DEGREE": int(sum(orders)),
@@ -232,10 +301,8 @@ def problem_header(problem: Any) -> str:
         "RMPC_WARM_START": int(backend._warm_start),
     }
     reals = {
-        "RMPC_TOL_FEAS": solver.tol_feas, "RMPC_TOL_GAP_ABS": solver.tol_gap_abs,
-        "RMPC_TOL_GAP_REL": solver.tol_gap_rel, "RMPC_WARM_GAP": solver.warm_gap,
-        "RMPC_WARM_FEAS": solver.warm_feas, "RMPC_INF_RADIUS": solver.infeasibility_radius,
-        "RMPC_QR_SWITCH": solver.qr_switch(), "RMPC_GAMMA_DIV": gamma_div, "RMPC_DT": float(data.dt),
+        **{f"RMPC_{key.upper()}": value for key, value in core.reals.items()},
+        "RMPC_GAMMA_DIV": gamma_div, "RMPC_DT": float(data.dt),
         "RMPC_CERT_TOL": cert_tol,
     }
     out = [
@@ -245,20 +312,10 @@ def problem_header(problem: Any) -> str:
     out += [f"#define {key} {value}\n" for key, value in macros.items()]
     out += [f"#define {key} ({_lit(value)})\n" for key, value in reals.items()]
     out.append("\n")
-    out.append(_ints("rmpc_order", orders))
-    out.append(_ints("rmpc_offset", offsets))
-    out.append(_ints("rmpc_copies", copies))
-    out.append(_doubles("rmpc_const", const_vals))
-    out.append(_ints("rmpc_ent_off", ent_off))
-    out.append(_ints("rmpc_ent_var", ent_var))
-    out.append(_ints("rmpc_ent_pos", ent_pos))
-    out.append(_ints("rmpc_ent_t", ent_t))
-    out.append(_ints("rmpc_ent_bound", ent_bound))
-    out.append(_doubles("rmpc_ent_val", ent_val))
-    out.append(_ints("rmpc_pos_off", pos_off))
-    out.append(_ints("rmpc_pos_row", pos_row))
-    out.append(_ints("rmpc_pos_col", pos_col))
-    out.append(_doubles("rmpc_c", conic.objective))
+    for name in CORE_INT_TABLES:
+        out.append(_ints(f"rmpc_{name}", tab[name]))
+    for name in CORE_DOUBLE_TABLES:
+        out.append(_doubles(f"rmpc_{'const' if name == 'cnst' else name}", tab[name]))
     out.append("#if RMPC_SCALED /* used only then: an unused table is a warning in one translation unit */\n"
                + _doubles("rmpc_t", t) + "#endif\n")
     out.append(_doubles("rmpc_bound", np.concatenate([data.u_max, data.y_max]) if n_ub + n_yb else [1.0]))
