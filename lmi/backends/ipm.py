@@ -28,17 +28,20 @@ from lmi.affine import smat_matrix, svec_indices, svec_matrix
 from lmi.backends.base import KothareBackend, RawResult
 from lmi.backends.clarabel import ClarabelKothare
 from lmi.backends.conic import KothareConic
+from lmi.ccore.generate import LIMITS
+from lmi.ccore.runtime import CoreSolver, core_library, core_status
 from lmi.data import KothareData
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
-from lmi.ipm.solver import INFEASIBILITY_RADIUS
+from lmi.ipm.blocks import DIRECT_MIN_VARIABLES
+from lmi.ipm.solver import INFEASIBILITY_RADIUS, SOLVER_STATUS_MAP
 from lmi.kothare_factors import VariableLayout, cost_block_factors
 from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
 from lmi.status import INACCURATE, INFEASIBLE, NUMERICAL_ERROR, OPTIMAL
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 
-__all__ = ["DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
+__all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
 
 #: A failed cold solve is retried in coordinates balanced on its last ``Q`` (option
 #: ``rebalance``) only if its relative primal and dual residuals came below this.
@@ -97,7 +100,19 @@ DEFAULT_IPM_OPTIONS: dict[str, Any] = {
     "phase_one": True,
     "rebalance": True,
     "infeasibility_radius": INFEASIBILITY_RADIUS,
+    "core": "auto",
 }
+
+#: Values of the ``core`` setting: which implementation runs the interior-point iterations of an
+#: on-line solve. ``"c"``: the C core (:mod:`lmi.ccore.runtime`, the extension ``pip install .``
+#: builds from the source every exported controller compiles); ``"numba"``: the numba kernels of
+#: :class:`lmi.ipm.BlockLMISolver`; ``"auto"``: the C core when it is built and carries the
+#: problem (the on-line problem, sizes within :data:`lmi.ccore.generate.LIMITS`), else numba.
+#: Phase one, the rebalanced retries and the off-line design's nested problems run numba.
+#: Measured on paper P's satellite (``python -m benchmarks.timing.ccore``): the C core's warm
+#: solve is faster than the numba path at 2, 4 and 8 vertices, and needs no compilation on first
+#: use (numba's took 30-50 s after an install).
+CORE_CHOICES = ("auto", "c", "numba")
 
 
 def _check_options(options: dict[str, Any]) -> dict[str, Any]:
@@ -123,6 +138,11 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     for key in ("warm_start", "fallback", "state_scaling", "phase_one", "rebalance"):
         if not isinstance(merged[key], bool):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
+    if merged["core"] not in CORE_CHOICES:
+        raise InvalidArgumentError("solver_options['core']", f"one of {CORE_CHOICES}", repr(merged["core"]))
+    if merged["core"] == "c" and core_library() is None:
+        raise InvalidArgumentError("solver_options['core']", "'auto' or 'numba' (no C core here)",
+                                   f"'c': {core_status()}")
     return merged
 
 
@@ -169,6 +189,7 @@ class IPMKothare(KothareBackend):
         self._fallback = merged.pop("fallback")
         self._phase_one = merged.pop("phase_one")
         self._rebalance = merged.pop("rebalance")
+        self._core_choice = merged.pop("core")
         self._solver_options = merged
         self._blas = SingleThreadBlas()
         self._initial_scaling = t
@@ -183,6 +204,8 @@ class IPMKothare(KothareBackend):
         """
         if np.array_equal(self._t, self._initial_scaling):
             self._solver.reset_warm_start()
+            if self._core is not None:
+                self._core.reset_warm_start()
         else:
             self._build(self._initial_scaling)
 
@@ -226,8 +249,48 @@ class IPMKothare(KothareBackend):
                 parts.append((mask, idx, kind))
             self._scaled_blocks.append((j, parts))
         self._nest_block = len(blocks) - 1 if self.nesting else None
+        use_core = self._core_choice != "numba" and self._core_carries(blocks, t)
         self._solver = BlockLMISolver(conic.objective, blocks, factors=self._block_factors(len(blocks)),
-                                      **self._solver_options)
+                                      load_kernels=not use_core, **self._solver_options)
+        self._core = CoreSolver(self) if use_core else None
+
+    @property
+    def core(self) -> str:
+        """Which implementation runs this back-end's solves now: ``"c"`` or ``"numba"`` (see
+        :data:`CORE_CHOICES`)."""
+        return "c" if self._core is not None else "numba"
+
+    def _core_carries(self, blocks: list[tuple[np.ndarray, np.ndarray]], t: np.ndarray) -> bool:
+        """Whether the C core solves this problem: it is built, the problem is the on-line one
+        (the state block first, no nesting block, every variable in some block) and within
+        :data:`lmi.ccore.generate.LIMITS`; with ``core="c"`` a problem it does not carry is an
+        error. With ``core="auto"`` also: at most :data:`lmi.ipm.blocks.DIRECT_MIN_VARIABLES`
+        variables (beyond, the numba solver forms the Schur complement from the factored
+        coefficients, which the C core does not: on the 14-state flexible satellite that took a
+        warm solve from 876 ms to 21 ms, and the C core's rows path ended "inaccurate" where it
+        ends "optimal"), and the construction's coordinates (a rebalanced retry after a failed
+        solve runs numba, as it did before the C core: the failure paths are unchanged)."""
+        n = self.data.n
+        orders = [c.shape[0] for c, _ in blocks]
+        if self._core_choice == "auto" and (blocks[0][1].shape[0] > DIRECT_MIN_VARIABLES
+                                            or t is not self._initial_scaling):
+            return False
+        reasons = []
+        if core_library() is None:
+            reasons.append(core_status())
+        if self.nesting:
+            reasons.append("the nesting block of the off-line design")
+        if orders[0] != n + 1 or np.any(blocks[0][0] != 0.0):
+            reasons.append("no state block first")
+        n_var = blocks[0][1].shape[0]
+        if not all(any(np.any(coef[i] != 0.0) for _, coef in blocks) for i in range(n_var)):
+            reasons.append("a variable in no block")
+        if (n_var > LIMITS["variables"] or max(orders) > LIMITS["order"] or len(blocks) > LIMITS["blocks"]):
+            reasons.append(f"sizes beyond {LIMITS}")
+        if reasons and self._core_choice == "c":
+            raise InvalidArgumentError("solver_options['core']", "'auto' or 'numba' for this problem",
+                                       f"'c', which does not carry it: {'; '.join(reasons)}")
+        return not reasons
 
     def _block_factors(self, count: int) -> list:
         """The cost blocks' factored coefficients (:mod:`lmi.kothare_factors`), ``None`` for the
@@ -577,6 +640,8 @@ class IPMKothare(KothareBackend):
     def _solve_ipm(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray,
                    outer: np.ndarray | None = None) -> RawResult:
         start = time.perf_counter()
+        if self._core is not None and outer is None:
+            return self._solve_core(x, u_max, y_max, start)
         try:
             self._update_blocks(x, u_max, y_max, outer)
             with self._blas.limit():
@@ -599,3 +664,23 @@ class IPMKothare(KothareBackend):
             res.status, res.solver_status, self.gamma(res.x[0]), q_mat, y_mat,
             res.iterations, elapsed,
         )
+
+    def _solve_core(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray, start: float) -> RawResult:
+        """:meth:`_solve_ipm` by the C core: the same iterations, the same result. A solve that does
+        not end ``"optimal"`` also sets the Python solver's blocks at this state, for phase one."""
+        assert self._core is not None
+        res = self._core.solve(x, u_max, y_max, self._warm_start)
+        elapsed = time.perf_counter() - start
+        self._last_residual = max(res.primal_residual, res.dual_residual)
+        status = SOLVER_STATUS_MAP[res.word]
+        if status != OPTIMAL:
+            self._update_blocks(x, u_max, y_max)
+        if status == INFEASIBLE:
+            cert = self.farkas_check(res.Z, x, u_max, y_max)
+            if cert.ok:
+                return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
+                                 infeasibility=cert)
+            return RawResult(NUMERICAL_ERROR, "infeasible (unchecked)", np.nan, None, None, res.iterations,
+                             elapsed)
+        q_mat, y_mat = self.conic.variables(res.x)
+        return RawResult(status, res.word, self.gamma(res.x[0]), q_mat, y_mat, res.iterations, elapsed)

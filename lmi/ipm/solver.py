@@ -239,6 +239,11 @@ class BlockLMISolver(BlockData):
     infeasibility_radius : float
         A run ends ``"infeasible"`` when its dual iterate proves that no solution of norm below
         this exists (``inf`` switches the test off; see :meth:`solve`).
+    factors : sequence of BlockFactor or None, optional
+        Factored coefficients of some blocks (:mod:`lmi.kothare_factors`).
+    load_kernels : bool
+        Load (or compile) the kernels now, at construction (default); ``False`` leaves it to the
+        first solve (:class:`lmi.backends.ipm.IPMKothare` when the C core runs its solves).
 
     Raises
     ------
@@ -279,6 +284,7 @@ class BlockLMISolver(BlockData):
         warm_feas: float = 1e-3,
         infeasibility_radius: float = INFEASIBILITY_RADIUS,
         factors: Sequence[BlockFactor | None] | None = None,
+        load_kernels: bool = True,
     ) -> None:
         self.c = as_vector(c, "c")
         n = self.n = self.c.shape[0]
@@ -304,7 +310,8 @@ class BlockLMISolver(BlockData):
         super().__init__(n, blocks, factors)
         self._phase_one_solver: BlockLMISolver | None = None
         self._blas = SingleThreadBlas()
-        _load_kernels()
+        if load_kernels:
+            _load_kernels()
 
     def qr_switch(self) -> float:
         """The pivot ratio below which the Newton system goes from Cholesky of ``H`` to the QR of
@@ -345,6 +352,7 @@ class BlockLMISolver(BlockData):
         problems of 6-14 states, the proof came after 18-60 iterations (78 problems).
         """
         start = time.perf_counter()
+        _load_kernels()  # if the construction did not (load_kernels=False): with its notice
         empty = self.absent_variables()
         if empty.size:
             res = self._solve_without(empty)
@@ -424,6 +432,7 @@ class BlockLMISolver(BlockData):
         blocks keep their factored form when their dictionary holds the identity columns) and
         reused.
         """
+        _load_kernels()
         with self._blas.limit():
             return run_phase_one(self)
 
