@@ -25,6 +25,15 @@ from toolkit_common.errors import InvalidArgumentError
 
 CC = shutil.which("cc")
 pytestmark = pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+
+
+@pytest.fixture(autouse=True)
+def _numba_reference(monkeypatch):
+    """The Python controllers compared with the export run the numba kernels: an implementation
+    independent of the C core (which the package's own solves run by default)."""
+    from lmi.backends.ipm import DEFAULT_IPM_OPTIONS
+
+    monkeypatch.setitem(DEFAULT_IPM_OPTIONS, "core", "numba")
 FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 _D = ctypes.POINTER(ctypes.c_double)
 _HERE = Path(__file__).resolve().parents[1] / "lmi" / "ccore"
