@@ -28,13 +28,18 @@ def machine_info() -> dict[str, Any]:
 
 
 def package_versions() -> dict[str, str]:
-    """Installed versions of the numerical packages the timings depend on."""
+    """Installed versions of the numerical packages the timings depend on, and which build of the
+    interior-point method's C core runs (``lmi_ccore``: the extension, or why numba runs instead;
+    :func:`lmi.ccore.runtime.core_status`)."""
+    from lmi.ccore.runtime import core_status
+
     out = {}
     for name in _PACKAGES:
         try:
             out[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             out[name] = "not installed"
+    out["lmi_ccore"] = core_status()
     return out
 
 
