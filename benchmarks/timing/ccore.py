@@ -2,8 +2,10 @@
 
 For paper P's satellite at 2 and 8 vertices (:func:`benchmarks.timing.common.polytope`), without
 and with the input ellipsoid (``u_max`` = paper P's torque limit): the Python controller
-(:class:`rmpc.RMPC`, back-end ``"ipm"``) runs a closed loop on the nominal model and its states
-are written to a file; the C driver (``lmi/ccore/driver.c``, compiled with each set of flags)
+(:class:`rmpc.RMPC`, back-end ``"ipm"``, its iterations in the numba kernels) runs a closed loop on
+the nominal model and its states are written to a file; the same controller with the package's
+default ``core="auto"`` (the C core :mod:`lmi.ccore.runtime` calls, where built) solves at the same
+states in the same process; the C driver (``lmi/ccore/driver.c``, compiled with each set of flags)
 solves at the same states in a fresh process and times each call with ``clock_gettime`` (wall and
 thread CPU time). The first (cold) solve is left out of both. Reported: p50/p95 per solve, the
 largest gamma and ``u`` differences, the object-code size (``size`` of ``ipm.o`` + ``dense.o``)
@@ -50,7 +52,7 @@ def _stats(values: list[float]) -> dict[str, float]:
     return {"p50_ms": float(np.percentile(arr, 50)) * 1e3, "p95_ms": float(np.percentile(arr, 95)) * 1e3}
 
 
-def _controller(n_vertices: int, bound: bool) -> Any:
+def _controller(n_vertices: int, bound: bool, core: str = "numba") -> Any:
     from benchmarks.families.rigid import defaults
     from benchmarks.timing.common import polytope
     from rmpc import RMPC
@@ -59,7 +61,7 @@ def _controller(n_vertices: int, bound: bool) -> Any:
     q = np.diag(defaults.CONTROLLER_DEFAULTS["RMPC"]["Q_diag"])
     r = np.diag(defaults.CONTROLLER_DEFAULTS["RMPC"]["R_diag"])
     kw = {"u_max": defaults.U_MAX, "input_constraint": "ellipsoid"} if bound else {}
-    return RMPC(plant, q, r, **kw), plant
+    return RMPC(plant, q, r, solver_options={"core": core}, **kw), plant
 
 
 def _phases(folder: Path, solves: int) -> dict[str, Any]:
@@ -108,6 +110,16 @@ def time_case(n_vertices: int, bound: bool, steps: int, folder: Path, phases: bo
         cpu.append(c1 - c0)
         iters.append(sol.iterations)
         x = a @ x + b @ u
+    # the C core the package calls (lmi.ccore.runtime) at the same states, when it is built
+    core_ctrl, _ = _controller(n_vertices, bound, "auto")
+    core_wall, core_cpu, core_gap = [], [], 0.0
+    for x_k, g_k in zip(states, gammas, strict=True):
+        w0, c0 = time.perf_counter(), time.thread_time()
+        sol = core_ctrl.solve(x_k)
+        c1, w1 = time.thread_time(), time.perf_counter()
+        core_wall.append(w1 - w0)
+        core_cpu.append(c1 - c0)
+        core_gap = max(core_gap, abs(sol.gamma / g_k - 1.0))
     write_solver(ctrl, folder)
     with resources.as_file(resources.files("lmi.ccore") / "driver.c") as src:
         shutil.copyfile(src, folder / "driver.c")
@@ -117,6 +129,8 @@ def time_case(n_vertices: int, bound: bool, steps: int, folder: Path, phases: bo
         "variables": ctrl.problem._backend._solver.n, "steps": steps,
         "python": {"wall": _stats(wall[1:]), "cpu": _stats(cpu[1:]),
                    "iterations_p50": float(np.median(iters[1:]))},
+        "python_core": {"core": core_ctrl.problem._backend.core, "wall": _stats(core_wall[1:]),
+                        "cpu": _stats(core_cpu[1:]), "max_gamma_rel": core_gap},
         "c": {},
     }
     for label, flags in FLAG_SETS.items():
@@ -184,6 +198,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         print(f"| {case['vertices']} | {case['input_bound']} | {case['variables']} | python ipm | "
               f"{py['wall']['p50_ms']:.2f} / {py['wall']['p95_ms']:.2f} | {py['cpu']['p50_ms']:.2f} / "
               f"{py['cpu']['p95_ms']:.2f} | {py['iterations_p50']:.0f} | | | | |")
+        pc = case["python_core"]
+        print(f"| {case['vertices']} | {case['input_bound']} | {case['variables']} | "
+              f"python, core {pc['core']} | "
+              f"{pc['wall']['p50_ms']:.2f} / {pc['wall']['p95_ms']:.2f} | {pc['cpu']['p50_ms']:.2f} / "
+              f"{pc['cpu']['p95_ms']:.2f} | | {pc['max_gamma_rel']:.1e} | | | |")
         for label, c in case["c"].items():
             print(f"| {case['vertices']} | {case['input_bound']} | {case['variables']} | C {label} | "
                   f"{c['wall']['p50_ms']:.2f} / {c['wall']['p95_ms']:.2f} | {c['cpu']['p50_ms']:.2f} / "
