@@ -57,6 +57,7 @@ MODULES_WITH_EXAMPLES = (
     "lmi.ipm.solver",
     "lmi.kothare",
     "lmi.ccore.generate",
+    "lmi.ccore.runtime",
     "lmi.observer",
     "lmi.offline",
     "lmi.sdpa",
