@@ -352,9 +352,12 @@ def _timing_report() -> tuple[dict, dict]:
         {"problem": "RMPC", "backend": "clarabel", "formulation": "delta_shared", "vertices": 8},
         {"problem": "GIPC", "backend": "osqp", "formulation": "-", "vertices": 1},
         {"problem": "OfflineRMPC", "backend": "ipm", "formulation": "table", "vertices": 2},  # no samples
+        {"problem": "C", "backend": "c-export", "formulation": "delta_shared", "vertices": 2},
+        {"problem": "C", "backend": "ipm-numba", "formulation": "delta_shared", "vertices": 2},
     ]
     rng = np.random.default_rng(4)
-    keys = [f"{r['problem']}|{r['backend']}|{r['formulation']}|{r['vertices']}" for r in records[:3]]
+    keys = [f"{r['problem']}|{r['backend']}|{r['formulation']}|{r['vertices']}" for r in records if
+            r["problem"] != "OfflineRMPC"]
     samples = {key: rng.uniform(1e-3, 1e-2, 20) for key in keys}
     return {"records": records, "machine": {"platform": "test", "cpu_count": 2}}, samples
 
@@ -363,13 +366,15 @@ def test_timing_distributions_one_log_panel_per_problem_one_box_per_record():
     report, samples = _timing_report()
     fig = distributions_figure(report, samples)
     axes = visible_axes(fig)
-    assert [ax.get_title().split(":")[0] for ax in axes] == ["RMPC", "GIPC"]  # no OfflineRMPC samples
-    for ax, boxes in zip(axes, (2, 1), strict=True):
+    assert [ax.get_title().split(":")[0] for ax in axes] == ["RMPC", "GIPC", "C"]  # no OfflineRMPC samples
+    for ax, boxes in zip(axes, (2, 1, 2), strict=True):
         assert ax.get_yscale() == "log" and ax.get_ylabel() == "time per step (s)"
         assert len(ax.patches) == boxes
         assert len(ax.get_xticklabels()) == boxes
     assert [t.get_text() for t in axes[0].get_xticklabels()] == ["ipm / delta_shared / 2v",
                                                                  "clarabel / delta_shared / 8v"]
+    assert [t.get_text() for t in axes[2].get_xticklabels()] == ["c-export / delta_shared / 2v",
+                                                                 "ipm-numba / delta_shared / 2v"]
     empty = distributions_figure({"records": [], "machine": {}}, {})
     assert [t.get_text() for t in visible_axes(empty)[0].texts] == ["no timing samples"]
 

@@ -1,4 +1,5 @@
-"""The figure of the timing report: per-step time distributions, one panel per problem.
+"""The figure of the timing report: per-step time distributions, one panel per problem (the C
+section's exported controllers with the paths they were timed against included).
 
 Box plots on a log axis (the paths span microseconds to seconds): the box is the interquartile
 range, the line the median, the whiskers reach the 5th and 95th percentiles, and the dots beyond
@@ -17,7 +18,7 @@ from matplotlib.figure import Figure
 
 __all__ = ["distributions_figure", "plot_distributions"]
 
-_PROBLEMS = ("RMPC", "OfflineRMPC", "GIPC")
+_PROBLEMS = ("RMPC", "OfflineRMPC", "GIPC", "C")
 
 
 _COLOURS = {1: "#bbbbbb", 2: "#8fb8de", 4: "#f2b880", 8: "#9bd39b"}
@@ -43,8 +44,9 @@ def distributions_figure(report: dict[str, Any], samples: dict[str, np.ndarray])
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per problem with samples (RMPC, OfflineRMPC, GIPC), one box per record on a
-        log time axis; a single "no timing samples" panel when there is none.
+        One panel per problem with samples (RMPC, OfflineRMPC, GIPC, and C: the exported
+        controllers against the Python paths at the same states), one box per record on a log
+        time axis; a single "no timing samples" panel when there is none.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -79,7 +81,9 @@ def distributions_figure(report: dict[str, Any], samples: dict[str, np.ndarray])
                       rotation_mode="anchor")
         ax.set_yscale("log")
         ax.set_ylabel("time per step (s)")
-        note = "colour: vertex count (blue 2, orange 4, green 8)" if problem != "GIPC" else "nominal model"
+        note = {"GIPC": "nominal model",
+                "C": "the C export against the Python paths at the same states; colour: vertex count"
+                }.get(problem, "colour: vertex count (blue 2, orange 4, green 8)")
         ax.set_title(f"{problem}: per-step time (box: quartiles, whiskers: p5-p95; {note})", fontsize=10)
         ax.grid(True, which="both", axis="y", alpha=0.3)
     m = report.get("machine", {})
