@@ -98,16 +98,21 @@ def _ints(name: str, values: Any) -> str:
     return f"static const int {name}[{flat.size}] = {{\n    {body}\n}};\n"
 
 
+def _is_ipm_backend(obj: Any) -> bool:
+    """Whether ``obj`` holds what an :class:`~lmi.backends.ipm.IPMKothare` holds for the C core."""
+    held = ("_base_blocks", "_scaled_blocks", "conic", "_solver", "original_data", "nesting")
+    return all(hasattr(obj, name) for name in held)
+
+
 def _backend(problem: Any) -> Any:
     """The :class:`~lmi.backends.ipm.IPMKothare` of ``problem`` (a :class:`lmi.KothareProblem`,
-    an :class:`rmpc.RMPC` of Kothare's form, or the back-end itself), checked."""
-    from lmi.backends.ipm import IPMKothare
-
+    an :class:`rmpc.RMPC` of Kothare's form, or the back-end itself), checked. Recognised by what
+    it holds (:func:`_is_ipm_backend`), not imported: the back-end imports this module."""
     backend = problem
     for attr in ("problem", "_backend"):
-        if not isinstance(backend, IPMKothare) and hasattr(backend, attr):
+        if not _is_ipm_backend(backend) and hasattr(backend, attr):
             backend = getattr(backend, attr)
-    if not isinstance(backend, IPMKothare):
+    if not _is_ipm_backend(backend):
         raise InvalidArgumentError(
             "problem", "a KothareProblem with backend='ipm' (or an RMPC of Kothare's form, or IPMKothare)",
             type(problem).__name__ if backend is problem else type(backend).__name__)
