@@ -7,7 +7,10 @@ field and lists each difference. Fields that measure time or the machine (``solv
 ``p95_s``, ``step_time_max``, ``machine``, ...) differ from run to run and are left out.
 
 ``python -m benchmarks.compare BEFORE AFTER [--rtol R]`` prints the differences and exits 1 when
-there are any, 0 when there are none, 2 on bad input.
+there are any, 0 when there are none, 2 on input that is not two runs (no records, items that
+are not records, records without identifying fields, nesting deeper than :data:`MAX_DEPTH`, not
+JSON). Records that share their identity are all compared, in order, and named in a ``note:``
+line; a boolean and a number never compare equal (``true`` is not ``1``).
 
 Examples
 --------
@@ -30,7 +33,7 @@ from typing import Any
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_positive
 
-__all__ = ["compare_records", "compare_runs", "is_run_dependent", "main"]
+__all__ = ["compare_records", "compare_runs", "duplicate_identities", "is_run_dependent", "main"]
 
 #: Parts of a field name that mark a measurement of time or of the machine.
 _RUN_DEPENDENT = ("time", "machine", "versions", "load", "wall", "elapsed")
@@ -39,6 +42,8 @@ _SETTINGS = frozenset({"duration", "disturbance_start", "t_on", "t_off", "time_s
 #: Field names without one of those parts that are still measurements of the run (a ratio of
 #: two solve times).
 _RUN_FIELDS = frozenset({"cvxpy_ratio"})
+#: How deep a record may nest (the suites' records nest a handful of levels).
+MAX_DEPTH = 64
 
 
 def is_run_dependent(name: str) -> bool:
@@ -72,7 +77,10 @@ def _paired(records: Sequence[dict[str, Any]], timing: bool) -> dict[str, dict[s
     for key, record in zip(keys, records, strict=True):
         count = seen.get(key, 0)
         seen[key] = count + 1
-        out[key if keys.count(key) == 1 else f"{key} #{count + 1}"] = record
+        name = key if keys.count(key) == 1 else f"{key} #{count + 1}"
+        while name in out:  # a key that happens to read like a numbered repeat: never merge two
+            name += " (again)"
+        out[name] = record
     return out
 
 
@@ -94,6 +102,8 @@ def _walk(a: Any, b: Any, path: str, rtol: float, out: list[str]) -> None:
             return
         for i, (x, y) in enumerate(zip(a, b, strict=True)):
             _walk(x, y, f"{path}[{i}]", rtol, out)
+    elif isinstance(a, bool) != isinstance(b, bool):  # JSON's true is not 1
+        out.append(f"{path}: {json.dumps(a)[:100]} -> {json.dumps(b)[:100]}")
     elif _is_number(a) and _is_number(b):
         same = a == b or (math.isnan(a) and math.isnan(b))
         if not same and not (rtol > 0.0 and abs(a - b) <= rtol * max(abs(a), abs(b))):
@@ -125,6 +135,8 @@ def compare_records(
         The records are ``rmpc timing``'s.
     """
     rtol = check_positive(rtol, "rtol", allow_zero=True)
+    for name, records in (("before", before), ("after", after)):
+        _check_records(records, name, timing)
     pairs_a = _paired(before, timing)
     pairs_b = _paired(after, timing)
     out: list[str] = []
@@ -140,17 +152,81 @@ def compare_records(
     return out
 
 
+def _check_records(records: Any, name: str, timing: bool) -> None:
+    """Refuse what is not the records of a run: not a list, an item that is not an object, nesting
+    deeper than :data:`MAX_DEPTH`, a suite record without identifying fields."""
+    if isinstance(records, str | bytes) or not isinstance(records, Sequence):
+        raise InvalidArgumentError(name, "a list of records (objects)", type(records).__name__)
+    for i, record in enumerate(records):
+        if not isinstance(record, dict):
+            raise InvalidArgumentError(
+                name, "a list of records (objects)", f"item {i}: {type(record).__name__} {str(record)[:40]!r}"
+            )
+        depth = _depth(record)
+        if depth > MAX_DEPTH:
+            raise InvalidArgumentError(
+                name, f"records nested at most {MAX_DEPTH} levels deep", f"record {i} nested deeper"
+            )
+        if not timing and not _record_key(record, i, timing):
+            raise InvalidArgumentError(
+                name,
+                "records with identifying fields (experiment and label, case_id, or problem and method)",
+                f"record {i} with none of them (keys: {', '.join(sorted(map(str, record))[:8]) or 'none'})",
+            )
+
+
+def _depth(value: Any) -> int:
+    """How deep ``value`` nests (a number: 0), without recursion; stops counting past the limit."""
+    deepest, stack = 0, [(value, 0)]
+    while stack:
+        item, level = stack.pop()
+        deepest = max(deepest, level)
+        if level > MAX_DEPTH:
+            break
+        if isinstance(item, dict):
+            stack.extend((v, level + 1) for v in item.values())
+        elif isinstance(item, list):
+            stack.extend((v, level + 1) for v in item)
+    return deepest
+
+
+def duplicate_identities(records: Sequence[dict[str, Any]], timing: bool = False) -> dict[str, int]:
+    """The identities (the pairing keys) that more than one record shares, with their counts.
+
+    Such records are still all compared, in their order (the first against the first).
+    """
+    counts: dict[str, int] = {}
+    for i, record in enumerate(records):
+        key = _record_key(record, i, timing)
+        counts[key] = counts.get(key, 0) + 1
+    return {k: n for k, n in counts.items() if n > 1}
+
+
 def _load(folder: Path) -> tuple[list[dict[str, Any]], bool]:
+    if not folder.is_dir():
+        raise InvalidArgumentError(
+            str(folder), "a run's output folder (with results.json or timing.json)",
+            "a file" if folder.exists() else "nothing there",
+        )
     for name, timing in (("results.json", False), ("timing.json", True)):
         path = folder / name
-        if path.is_file():
+        if path.exists():
             try:
-                data = json.loads(path.read_text())
-            except (OSError, ValueError) as err:
-                raise InvalidArgumentError(str(path), "a readable JSON file", str(err)) from None
-            records = data.get("records", []) if isinstance(data, dict) else data
-            if not isinstance(records, list):
-                raise InvalidArgumentError(str(path), "a list of records", type(records).__name__)
+                data = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError, RecursionError) as err:
+                why = "nested too deeply to read" if isinstance(err, RecursionError) else str(err)[:200]
+                raise InvalidArgumentError(
+                    str(path), "a readable JSON file of a run's records", why
+                ) from None
+            if isinstance(data, dict) and not isinstance(data.get("records"), list):
+                raise InvalidArgumentError(
+                    str(path), "a list of records or an object with a list 'records'",
+                    "an object without it",
+                )
+            records = data["records"] if isinstance(data, dict) else data
+            _check_records(records, str(path), timing)
+            if not records:
+                raise InvalidArgumentError(str(path), "the records of a run (one or more)", "no records")
             return records, timing
     raise InvalidArgumentError(str(folder), "a folder with results.json or timing.json", "neither")
 
@@ -171,17 +247,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m benchmarks.compare",
         description="Compare two output folders of a suite (or of rmpc timing) record by record, "
-                    "field by field, leaving out the fields that measure time or the machine.",
+                    "field by field, leaving out the fields that measure time or the machine. Records "
+                    "that share their identity (experiment and label, case_id, or problem and method) "
+                    "are all compared, in order, and named in a 'note:' line; true and 1 differ. "
+                    "Exit status: 0 the same, 1 different, 2 an input that is not a run (no folder, "
+                    "no results.json or timing.json, not JSON, no records, items that are not records, "
+                    f"records without identifying fields, nesting deeper than {MAX_DEPTH} levels).",
     )
     parser.add_argument("before")
     parser.add_argument("after")
     parser.add_argument("--rtol", type=float, default=0.0, help="relative tolerance on numbers (default 0)")
     args = parser.parse_args(argv)
     try:
-        lines = compare_runs(args.before, args.after, args.rtol)
+        records_a, timing_a = _load(Path(args.before))
+        records_b, timing_b = _load(Path(args.after))
+        if timing_a != timing_b:
+            raise InvalidArgumentError(
+                "after", "the same kind of output as before", "a suite and a timing run"
+            )
+        lines = compare_records(records_a, records_b, args.rtol, timing=timing_a)
     except InvalidArgumentError as err:
         print(f"python -m benchmarks.compare: {err}", file=sys.stderr)
         return 2
+    for folder, records, timing in ((args.before, records_a, timing_a), (args.after, records_b, timing_b)):
+        for key, n in duplicate_identities(records, timing).items():
+            print(f"note: {n} records of {folder} share the identity {key!r}; all are compared, in order")
     for line in lines:
         print(line)
     print(f"{len(lines)} difference{'s' if len(lines) != 1 else ''}")

@@ -64,7 +64,7 @@ def test_timing_records_pair_by_problem_and_a_mixed_pair_is_an_error(tmp_path) -
     assert compare_runs(tmp_path / "t1", tmp_path / "t2") == [
         "RMPC | delta_shared | ipm | 2 | #0: max_rel_err: 1e-08 -> 2e-08"]
     (tmp_path / "s").mkdir()
-    (tmp_path / "s" / "results.json").write_text("[]")
+    (tmp_path / "s" / "results.json").write_text('[{"experiment": "E1", "label": "RMPC"}]')
     with pytest.raises(ValueError, match="after"):
         compare_runs(tmp_path / "t1", tmp_path / "s")
 

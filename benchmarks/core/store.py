@@ -34,9 +34,19 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from benchmarks.core.schema import (
+    ANY_DICT,
+    NUMBER,
+    STRING,
+    Check,
+    dict_of,
+    fields,
+    first_problem,
+    optional,
+)
 from toolkit_common.errors import StoreError
 
-__all__ = ["STORE_NAME", "CaseStore"]
+__all__ = ["RECORD_SCHEMA", "STORE_NAME", "CaseStore"]
 
 #: File name of the store inside a sweep's output directory.
 STORE_NAME = "sweep.sqlite"
@@ -68,6 +78,41 @@ _COLUMNS = {
     "cases": ("case_id", "position", "scenario", "status", "record", "error", "run", "finished_at"),
     "meta": ("key", "value"),
 }
+_NUM = optional(NUMBER)
+_PER_AXIS = dict_of(_NUM)
+
+#: A stored record of a finished case: every field the sweep's report reads, with its type.
+RECORD_SCHEMA: Check = fields(
+    {
+        "experiment": STRING,
+        "case_id": STRING,
+        "label": STRING,
+        "controller": STRING,
+        "plant": STRING,
+        "saturation": STRING,
+        "status": STRING,
+        "settings": ANY_DICT,
+        "metrics": fields(
+            {},
+            {
+                **{
+                    k: _PER_AXIS
+                    for k in ("sum_abs_err", "final_abs_err", "iae", "settling_time", "overshoot")
+                },
+                **{
+                    k: _NUM
+                    for k in (
+                        "max_abs_u", "saturated_fraction", "constraint_violation", "solve_time_solves_p50",
+                        "solve_time_solves_p95", "solve_time_solves_max", "n_solves", "step_time_p95",
+                        "fallback_count", "failure_count",
+                    )
+                },
+            },
+        ),
+    }
+)
+_ERROR_RECORD: Check = optional(fields({}, {"traceback": STRING}))
+
 _EXPECTED = "the SQLite store of a sweep"
 _REMEDY = "move it away or choose another --out"
 
@@ -229,19 +274,45 @@ class CaseStore:
         sql = "SELECT case_id FROM cases" + ("" if include_errors else " WHERE status = 'done'")
         return {row[0] for row in self._db.execute(sql)}
 
-    def rows(self) -> list[dict[str, Any]]:
+    def unusable(self, scenarios: dict[str, dict[str, Any]]) -> dict[str, str]:
+        """The stored cases among ``scenarios`` (case id -> the case's scenario as a dict) that
+        cannot be trusted, each with why: a column that is not JSON, a row that does not fit
+        :data:`RECORD_SCHEMA`, or another case's scenario or record under this case's id.
+
+        A sweep measures these cases again (a new row replaces the old one).
+        """
+        with self._sqlite_errors():
+            raw = list(self._db.execute("SELECT case_id, scenario, status, record, error FROM cases"))
+        out = {}
+        for cid, scen, status, record, error in raw:
+            if cid in scenarios:
+                why = _row_problem(cid, scenarios[cid], scen, status, record, error)
+                if why is not None:
+                    out[cid] = why
+        return out
+
+    def rows(self, scenarios: dict[str, dict[str, Any]] | None = None) -> list[dict[str, Any]]:
         """Every stored case in sweep order: ``case_id, position, scenario, status, record,
-        error, run, finished_at`` (JSON columns decoded)."""
+        error, run, finished_at`` (JSON columns decoded).
+
+        With ``scenarios`` (case id -> scenario dict): only the cases among them that
+        :meth:`unusable` does not refuse. Without: every row, and a column that is not JSON is a
+        :class:`StoreError`.
+        """
         cur = self._db.execute(
             "SELECT case_id, position, scenario, status, record, error, run, finished_at FROM cases"
             " ORDER BY position, case_id"
         )
         out = []
         for cid, pos, scen, status, record, error, run, fin in cur:
+            if scenarios is not None and (
+                cid not in scenarios or _row_problem(cid, scenarios[cid], scen, status, record, error)
+            ):
+                continue
             try:
                 scenario = json.loads(scen)
                 decoded = None if record is None else json.loads(record)
-            except (TypeError, json.JSONDecodeError) as err:
+            except (TypeError, ValueError, RecursionError) as err:
                 raise StoreError(
                     str(self.path), "cases stored as JSON",
                     f"case {cid!r} holding text that is not JSON ({err}); the store is damaged: move it away "
@@ -266,3 +337,28 @@ class CaseStore:
         return {
             status: n for status, n in self._db.execute("SELECT status, COUNT(*) FROM cases GROUP BY status")
         }
+
+
+def _row_problem(
+    cid: str, expected: dict[str, Any], scen: Any, status: Any, record: Any, error: Any
+) -> str | None:
+    """Why the stored row of case ``cid`` cannot be trusted (``None``: it can)."""
+    try:
+        scenario = json.loads(scen)
+        decoded = None if record is None else json.loads(record)
+    except (TypeError, ValueError, RecursionError) as err:
+        return f"a column that is not JSON ({str(err)[:80]})"
+    if scenario != json.loads(json.dumps(expected, sort_keys=True)):
+        return "the scenario stored under this id is another case's"
+    if status == "done":
+        problem = first_problem(decoded, RECORD_SCHEMA, "record")
+        if problem is not None:
+            return problem
+        if decoded["case_id"] != cid:
+            return f"the record of another case (record.case_id {decoded['case_id']!r})"
+        return None
+    if status == "error":
+        if not isinstance(error, str):
+            return "an error row without its message"
+        return first_problem(decoded, _ERROR_RECORD, "record")
+    return f"status {status!r}, not 'done' or 'error'"

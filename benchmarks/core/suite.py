@@ -55,7 +55,8 @@ class SuiteCase:
 
 @dataclass
 class SuiteOutcome:
-    """What a suite run did: records, failures, files, wall time, interruption."""
+    """What a suite run did: records, failures, files, wall time, interruption, and ``notes``
+    (what the run did not take as given: a stored case it measured again, one it could not store)."""
 
     records: list[dict[str, Any]] = field(default_factory=list)
     failures: list[dict[str, Any]] = field(default_factory=list)
@@ -63,6 +64,7 @@ class SuiteOutcome:
     wall_time_s: float = 0.0
     execution: ExecOutcome | None = None
     executor: str = ""
+    notes: list[str] = field(default_factory=list)
 
 
 def chosen_experiments(known: Collection[str], experiments: Sequence[str] | None) -> list[str]:
@@ -226,5 +228,7 @@ def write_run_info(
         "versions": package_versions(),
         "failures": outcome.failures,
     }
+    if outcome.notes:
+        info["notes"] = list(outcome.notes)
     (out / "run.json").write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
     return info

@@ -21,6 +21,7 @@ from benchmarks.core.execute import ExecOutcome, Task, execute
 from benchmarks.core.executors import make_executor_and_out
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.core.progress import CaseProgress
+from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.store import STORE_NAME, CaseStore
 from benchmarks.core.sweep_spec import (
@@ -119,8 +120,12 @@ def run_sweep(
         if store is not None:
             store.close()
         raise
+    scenarios = {sc.case_id: sc.to_dict() for sc in cases}
     with store:
         finished = store.finished_ids(include_errors=not retry_errors)
+        for cid, why in store.unusable(scenarios).items():  # never trust a damaged or foreign row
+            finished.discard(cid)
+            print(f"sweep {spec.name}: stored case {cid} not used ({why}); measured again", file=sys.stderr)
         todo = [sc for sc in cases if sc.case_id not in finished]
         outcome = SweepOutcome(name=spec.name, total=len(cases), skipped=len(cases) - len(todo))
         if todo:
@@ -154,13 +159,15 @@ def run_sweep(
 
                 outcome.execution = execute(tasks, executor, on_result)
         outcome.wall_time_s = time.perf_counter() - start
-        rows = [r for r in store.rows() if r["case_id"] in position]
+        rows = store.rows(scenarios)
         extra = len(store.finished_ids()) - len(rows)
     if not todo:
         executor.close()
     outcome.stored_errors = sum(1 for r in rows if r["status"] == "error")
     where = executor.description if todo else "nothing to run"
-    outcome.files = _write(out, spec, cases, rows, extra, outcome, where)
+    with staged_reports(out) as stage:  # every report file, or none of them, is new
+        files = _write(stage, spec, cases, rows, extra, outcome, where)
+    outcome.files = published_paths(files, stage, out)
     return outcome
 
 

@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
@@ -211,7 +212,9 @@ def run_faults(
     """
     cases = fault_cases(time_scale, experiments)
     outcome, runs = run_suite_cases(cases, out, "rmpc bench faults", workers, scheduler, progress, _cost)
-    outcome.files = _write(Path(out), cases, runs, outcome, workers, scheduler, time_scale)
+    with staged_reports(Path(out)) as stage:  # every report file, or none of them, is new
+        files = _write(stage, cases, runs, outcome, workers, scheduler, time_scale)
+    outcome.files = published_paths(files, stage, Path(out))
     return outcome
 
 

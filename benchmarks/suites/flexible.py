@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
@@ -194,7 +195,9 @@ def run_flexible(
     """
     cases = flexible_cases(time_scale, experiments)
     outcome, runs = run_suite_cases(cases, out, "rmpc bench flexible", workers, scheduler, progress, _cost)
-    outcome.files = _write(Path(out), cases, runs, outcome, workers, scheduler, time_scale)
+    with staged_reports(Path(out)) as stage:  # every report file, or none of them, is new
+        files = _write(stage, cases, runs, outcome, workers, scheduler, time_scale)
+    outcome.files = published_paths(files, stage, Path(out))
     return outcome
 
 

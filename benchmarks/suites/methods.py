@@ -17,14 +17,15 @@ Every problem of :mod:`benchmarks.suites.methods_problems` is solved by every fo
 - ``status_counts`` of the closed-loop steps and ``skip_reason`` where a method does not apply.
 
 Each finished record is stored in ``DIR/cases/`` at once; running the same command again skips
-them (``fresh=True`` starts over), so an interrupted run resumes. :func:`run_methods` writes
-``results.json``, ``results.md``, ``results.csv``, ``run.json`` and ``figures/*.png`` through
-:mod:`benchmarks.suites.methods_report`.
+them (``fresh=True`` starts over), so an interrupted run resumes. A stored case is taken only when
+it fits the schema of :mod:`benchmarks.suites.methods_store` and is the case asked for; any other
+is measured again and named in the run's notes. :func:`run_methods` writes ``results.json``,
+``results.md``, ``results.csv``, ``run.json`` and ``figures/*.png`` through
+:mod:`benchmarks.suites.methods_report`, all of them or none (:mod:`benchmarks.core.publish`).
 """
 
 from __future__ import annotations
 
-import json
 import time
 import warnings
 from collections.abc import Sequence
@@ -37,9 +38,11 @@ import numpy as np
 from benchmarks.core.execute import ExecOutcome
 from benchmarks.core.jsonable import json_safe
 from benchmarks.core.progress import CaseProgress
+from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.suite import SuiteOutcome
 from benchmarks.suites.methods_problems import PROBLEMS, SHORT_PROBLEMS, MethodsProblem, build_problem
 from benchmarks.suites.methods_report import write_methods_report
+from benchmarks.suites.methods_store import case_path, load_case, store_case
 from rmpc.analysis import TimeBudgetExceeded, boundary_along
 from toolkit_common.errors import ConfigError
 
@@ -471,32 +474,6 @@ def _chosen(known: Sequence[str], asked: Sequence[str] | None, arg: str) -> list
     return chosen
 
 
-def _case_path(out: Path, problem: str, method: str) -> Path:
-    return out / "cases" / f"{problem}__{method}.json"
-
-
-def _load_case(path: Path, settings: MethodsSettings) -> dict[str, Any] | None:
-    """The stored case at ``path`` if it was measured with the same settings and record layout."""
-    try:
-        stored = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    rec = stored.get("record") if isinstance(stored, dict) else None
-    if not isinstance(rec, dict) or stored.get("settings") != json_safe(settings.as_dict()):
-        return None
-    if rec.get("settings", {}).get("record_version") != RECORD_VERSION:
-        return None
-    return stored
-
-
-def _store_case(path: Path, settings: MethodsSettings, rec: dict[str, Any], extra: dict[str, Any]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    payload = {"settings": settings.as_dict(), "record": rec, "extra": extra}
-    tmp.write_text(json.dumps(json_safe(payload), allow_nan=False) + "\n", encoding="utf-8")
-    tmp.replace(path)  # atomic: an interrupt leaves the old file or the new one
-
-
 def run_methods(
     out: str | Path,
     short: bool = False,
@@ -539,17 +516,22 @@ def run_methods(
     failures: list[dict[str, Any]] = []
     keys = [(p, m) for p in chosen_p for m in chosen_m]
     resumed = 0
+    notes: list[str] = []
     with CaseProgress(len(keys), "rmpc bench methods", progress) as bar:
         built: dict[str, MethodsProblem] = {}
         try:
             for p, m in keys:
-                path = _case_path(out, p, m)
-                stored = None if fresh else _load_case(path, settings)
+                path = case_path(out, p, m)
+                stored, why = (None, None) if fresh else load_case(
+                    path, settings.as_dict(), p, m, RECORD_VERSION
+                )
                 if stored is not None:
                     results[(p, m)] = stored
                     resumed += 1
                     bar.advance(f"{p}/{m} (stored)")
                     continue
+                if why is not None:
+                    notes.append(f"cases/{path.name}: not used ({why}); measured again")
                 try:
                     if p not in built:
                         built[p] = build_problem(p)
@@ -560,10 +542,12 @@ def run_methods(
                     )
                     bar.advance(f"{p}/{m}", ok=False)
                     continue
-                _store_case(path, settings, rec, extra)
+                unstored = store_case(path, settings.as_dict(), rec, extra)
+                if unstored is not None:
+                    notes.append(f"cases/{path.name}: not stored ({unstored}); a later run measures it again")
                 results[(p, m)] = json_safe({"record": rec, "extra": extra})
                 execution.finished.append(f"{p}__{m}")
-                bar.advance(f"{p}/{m}")
+                bar.advance(f"{p}/{m}" + (f" (stored case not used: {why}; measured again)" if why else ""))
         except KeyboardInterrupt:
             execution.interrupted = True
             execution.unfinished = [f"{p}__{m}" for p, m in keys if (p, m) not in results]
@@ -573,7 +557,10 @@ def run_methods(
         wall_time_s=time.perf_counter() - start,
         execution=execution,
         executor="this process (one case at a time, for clean timings)",
+        notes=notes,
     )
     extras = {k: results[k].get("extra", {}) for k in keys if k in results}
-    outcome.files = write_methods_report(out, outcome, extras, settings, len(keys), resumed, short)
+    with staged_reports(out) as stage:  # every report file, or none of them, is new
+        files = write_methods_report(stage, outcome, extras, settings, len(keys), resumed, short)
+    outcome.files = published_paths(files, stage, out)
     return outcome

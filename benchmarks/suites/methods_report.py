@@ -304,6 +304,11 @@ def write_methods_report(
             if resumed
             else []
         ),
+        *(
+            ["", "Stored cases the run did not take as they were:", "", *(f"- {n}" for n in outcome.notes)]
+            if outcome.notes
+            else []
+        ),
         "",
         "Per problem and method: the status and `gamma` of the solve at the start state `x0`; the "
         "feasible region as the largest certified multiple `t` of fixed directions (scaled to the "

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.suite import (
     SuiteCase,
@@ -194,7 +195,9 @@ def run_paper(
     cases = paper_cases(duration_scale, experiments)
     outcome, runs = run_suite_cases(cases, out, "rmpc bench paper", workers, scheduler, progress, _cost)
     out = Path(out)
-    outcome.files = _write(out, cases, runs, outcome, workers, scheduler, duration_scale)
+    with staged_reports(out) as stage:  # every report file, or none of them, is new
+        files = _write(stage, cases, runs, outcome, workers, scheduler, duration_scale)
+    outcome.files = published_paths(files, stage, out)
     return outcome
 
 
