@@ -90,6 +90,15 @@ def test_more_variables_than_entries_and_degenerate_blocks(seed):
             assert _lowest(_slacks(one.x, blocks)) > 0.0
     if seed == 0:
         eye = np.eye(2)
+        # four copies of t in min t s.t. t I - M >= 0 (3 entries): bounded in the span (sum t_i = 3,
+        # the largest eigenvalue of M), unbounded as soon as c weighs the copies differently
+        m = np.array([[2.0, 1.0], [1.0, 2.0]])
+        copies = [(-m, -np.stack([eye] * 4))]
+        res = BlockLMISolver(np.ones(4), copies).solve()
+        assert res.status == "optimal" and res.x.sum() == pytest.approx(3.0, rel=1e-7)
+        res = BlockLMISolver([1.0, 2.0, 1.0, 1.0], copies).solve()
+        assert res.status == "unbounded" and _lowest(_slacks(res.x, copies)) >= -1e-7
+        assert float(res.x @ [1.0, 2.0, 1.0, 1.0]) <= -1e8
         # a variable in no block with a cost: unbounded; 1x1 blocks: -1 <= x1 - x2 <= 1 ...
         res = BlockLMISolver([1.0, 1.0], [(eye, np.stack([np.zeros((2, 2)), -eye]))]).solve()
         assert res.status == "unbounded" and _lowest(_slacks(res.x, [(eye, np.stack([0 * eye, -eye]))])) >= 0
