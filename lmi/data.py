@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import (
     as_matrix,
+    as_real_array,
     as_vector,
     check_choice,
     check_pd,
@@ -143,8 +144,8 @@ def build_kothare_data(
 
     ``A`` is ``(N, n, n)`` (or one ``(n, n)``), ``B`` is ``(N, n, m)`` (or ``(n, m)``).
     """
-    a = np.asarray(A, dtype=float) if not isinstance(A, str) else None
-    b = np.asarray(B, dtype=float) if not isinstance(B, str) else None
+    a = as_real_array(A, "A", "an (N, n, n) stack or one (n, n) matrix") if not isinstance(A, str) else None
+    b = as_real_array(B, "B", "an (N, n, m) stack or one (n, m) matrix") if not isinstance(B, str) else None
     if a is None or a.ndim not in (2, 3):
         raise InvalidArgumentError("A", "an (N, n, n) stack or one (n, n) matrix", repr(A))
     if b is None or b.ndim not in (2, 3):

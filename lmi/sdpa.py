@@ -29,16 +29,17 @@ A file compressed with gzip is read as it is (recognised by its first bytes, not
 from __future__ import annotations
 
 import gzip
+import io
 import math
 import os
 import re
-from pathlib import Path
 
 import numpy as np
 
-from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import check_count
 
-__all__ = ["SDPAFormatError", "read_sdpa"]
+__all__ = ["MAX_SDPA_BYTES", "SDPAFormatError", "read_sdpa"]
 
 _SEPARATORS = re.compile(r"[\s,{}()]+")
 
@@ -61,8 +62,17 @@ class SDPAFormatError(InvalidArgumentError):
         super().__init__(where, expected, found)
 
 
+#: The default ``max_bytes`` of :func:`read_sdpa`: the most memory the dense data it returns may
+#: take (``8 (m + 1) sum_j k_j^2`` bytes for ``m`` variables and blocks of order ``k_j``; a
+#: diagonal block read split counts ``k_j`` blocks of order 1), and the most a compressed file may
+#: expand to. Checked from the header, before anything is allocated: a 22-byte file declaring a
+#: 30000 x 30000 block asked for 2 x 7.2 GB. SDPLIB's control4 takes 21 MB, its largest
+#: problems (``equalG51``, ``maxG60``, ...) many gigabytes, beyond what the dense solver handles.
+MAX_SDPA_BYTES = 2 * 2**30
+
+
 def read_sdpa(
-    path: str | os.PathLike[str], *, split_diagonal: bool = False
+    path: str | os.PathLike[str], *, split_diagonal: bool = False, max_bytes: int = MAX_SDPA_BYTES
 ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
     """Read an SDPA sparse file as ``(c, blocks)`` for :class:`lmi.ipm.BlockLMISolver`.
 
@@ -75,6 +85,10 @@ def read_sdpa(
         solver pads every block to the largest order, so a long diagonal block is cheaper split).
         By default it is one block of order ``d`` with diagonal ``C_j`` and ``A_ij``, and
         ``blocks[j]`` is the file's block ``j + 1``.
+    max_bytes : int
+        The most memory the returned arrays may take, and the most a compressed file may expand
+        to (:data:`MAX_SDPA_BYTES`, 2 GiB); a file that declares more is refused before anything
+        is allocated.
 
     Returns
     -------
@@ -89,7 +103,10 @@ def read_sdpa(
     SDPAFormatError
         For a malformed file: a missing or non-numeric header, a block size of zero, a value
         that is not finite, an entry with the wrong number of fields, out of range, off the
-        diagonal of a diagonal block, or given twice. The message names the file and the line.
+        diagonal of a diagonal block, or given twice; or one whose sizes need more than
+        ``max_bytes``. The message names the file and the line.
+    ArgumentTypeError
+        When ``path`` is not a path (``str`` or path-like) or ``max_bytes`` not an integer.
     OSError
         When the file cannot be read.
 
@@ -123,19 +140,32 @@ def read_sdpa(
     """
     if not isinstance(split_diagonal, bool):
         raise InvalidArgumentError("split_diagonal", "True or False", repr(split_diagonal))
+    limit = check_count(max_bytes, "max_bytes", expected="a number of bytes (an integer >= 1)")
+    if not isinstance(path, str | os.PathLike):
+        found = f"{type(path).__name__} {path!r}"[:80]
+        raise ArgumentTypeError("path", "a file path (str or os.PathLike)", found)
     name = os.fspath(path)
-    raw = Path(name).read_bytes()
+    if not isinstance(name, str):
+        raise ArgumentTypeError("path", "a file path (str or os.PathLike of str)", type(name).__name__)
+    with open(name, "rb") as handle:
+        raw = handle.read(limit + 1)
+    if len(raw) > limit:
+        raise SDPAFormatError(name, None, f"a file of at most max_bytes = {limit} bytes", "a larger file")
     if raw[:2] == b"\x1f\x8b":
         try:
-            raw = gzip.decompress(raw)
+            with gzip.GzipFile(fileobj=io.BytesIO(raw)) as stream:
+                raw = stream.read(limit + 1)
         except (OSError, EOFError) as err:
             raise SDPAFormatError(name, None, "a complete gzip stream", repr(err)) from None
+        if len(raw) > limit:
+            raise SDPAFormatError(name, None, f"a file that expands to at most max_bytes = {limit} bytes",
+                                  "a compressed file that expands to more")
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError as err:
         raise SDPAFormatError(name, _text_line(raw, err.start), "ASCII text",
                               f"byte {raw[err.start]:#04x}") from None
-    return _parse(name, text.splitlines(), split_diagonal)
+    return _parse(name, text.splitlines(), split_diagonal, limit)
 
 
 def _text_line(raw: bytes, offset: int) -> int:
@@ -143,7 +173,7 @@ def _text_line(raw: bytes, offset: int) -> int:
     return raw.count(b"\n", 0, offset) + 1
 
 
-def _parse(name: str, lines: list[str], split_diagonal: bool) -> tuple[np.ndarray, list]:
+def _parse(name: str, lines: list[str], split_diagonal: bool, limit: int) -> tuple[np.ndarray, list]:
     numbered = [(k + 1, line) for k, line in enumerate(lines)]
     pos = 0
     while pos < len(numbered) and (not numbered[pos][1].strip() or numbered[pos][1].lstrip()[0] in "\"*"):
@@ -168,6 +198,13 @@ def _parse(name: str, lines: list[str], split_diagonal: bool) -> tuple[np.ndarra
     sizes = [_integer(name, line_sz, t, "a block size (non-zero integer)") for t in tok[:nblocks]]
     if 0 in sizes:
         raise SDPAFormatError(name, line_sz, "non-zero block sizes", f"size 0 for block {sizes.index(0) + 1}")
+    # the dense arrays to be allocated, from the header alone (Python integers: no overflow)
+    need = 8 * (m + 1) * sum(-k if k < 0 and split_diagonal else k * k for k in sizes)
+    if need > limit:
+        raise SDPAFormatError(
+            name, line_sz, f"sizes whose dense data fit in max_bytes = {limit} bytes (pass a larger "
+            "max_bytes to lift it)", f"m = {m} and blocks of orders up to {max(abs(k) for k in sizes)}: "
+            f"{need} bytes")
     # c: m numbers, on one line or wrapped over several
     c_vals: list[float] = []
     index = 3

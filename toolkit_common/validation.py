@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Iterable
-from numbers import Real
+from numbers import Integral, Real
 from typing import Any, Literal, TypeVar
 
 import numpy as np
@@ -35,6 +35,7 @@ __all__ = [
     "as_matrix",
     "as_optional_limits",
     "as_positive_values",
+    "as_real_array",
     "as_square_matrix",
     "as_vector",
     "check_bool",
@@ -45,6 +46,8 @@ __all__ = [
     "check_psd",
     "check_real",
     "check_symmetric",
+    "is_integer",
+    "is_real",
     "renamed_arguments",
 ]
 
@@ -85,6 +88,26 @@ def _to_float_array(
         return np.array(raw, dtype=float) if copy else np.asarray(raw, dtype=float)
     except (TypeError, ValueError) as err:
         raise ArgumentTypeError(name, expected, f"{type(value).__name__} ({err})") from None
+
+
+def as_real_array(value: Any, name: str, expected: str = "a numeric array") -> np.ndarray:
+    """``value`` as a float array of any shape, without copying when it already is one.
+
+    Unlike ``np.asarray(value, dtype=float)``, a complex value is refused (numpy would drop its
+    imaginary part with a warning) and a string, ``None`` or a non-numeric value is an error
+    naming ``name`` and saying what was found; NaN and inf pass (check them where they matter).
+
+    Examples
+    --------
+    >>> from toolkit_common.validation import as_real_array
+    >>> as_real_array([[1, 2]], "C").dtype
+    dtype('float64')
+    >>> as_real_array([1.0, 2.0 + 1.0j], "C")
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.ArgumentTypeError: C: expected real values, but found complex (2+1j) at index (1,)
+    """
+    return _to_float_array(value, name, expected)
 
 
 def _check_finite(arr: np.ndarray, name: str) -> None:
@@ -204,9 +227,29 @@ def check_pd(mat: np.ndarray, name: str) -> np.ndarray:
     return sym
 
 
+def is_integer(value: Any) -> bool:
+    """Whether ``value`` is an integer: a Python ``int`` or a NumPy integer (``np.int64(10)``, as
+    indexing and ``len`` of arrays give them), not a ``bool``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from toolkit_common.validation import is_integer
+    >>> is_integer(10), is_integer(np.int64(10)), is_integer(True), is_integer(10.0)
+    (True, True, False, False)
+    """
+    return isinstance(value, Integral) and not isinstance(value, bool | np.bool_)
+
+
+def is_real(value: Any) -> bool:
+    """Whether ``value`` is a real number: a Python ``int`` or ``float`` or a NumPy integer or
+    floating scalar, not a ``bool`` (NaN and inf included: check them where they matter)."""
+    return isinstance(value, Real | np.floating | np.integer) and not isinstance(value, bool | np.bool_)
+
+
 def check_real(value: Any, name: str) -> float:
     """Return ``value`` as a finite float."""
-    if isinstance(value, bool) or not isinstance(value, Real | np.floating | np.integer):
+    if not is_real(value):
         found = "None" if value is None else f"{type(value).__name__} {value!r}"
         raise ArgumentTypeError(name, "a real number", found)
     out = float(value)
@@ -273,7 +316,7 @@ def check_count(value: Any, name: str, *, limit: int | None = None, limit_name: 
     ...     print(err)
     n_axes: expected at most max_axes = 1000 axes (pass a larger max_axes to lift it), but found 5000
     """
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+    if not is_integer(value) or value < 1:
         raise InvalidArgumentError(name, expected, repr(value))
     if limit is not None and value > limit:
         raise InvalidArgumentError(

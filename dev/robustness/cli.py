@@ -13,6 +13,7 @@ from dev.robustness.api_cases import api_probes
 from dev.robustness.cli_cases import cli_probes
 from dev.robustness.probe import Probe
 from dev.robustness.runner import run_probes
+from dev.robustness.solver_cases import solver_probes
 from dev.robustness.store_cases import store_probes
 from dev.robustness.verdicts import VERDICTS, Outcome
 
@@ -59,7 +60,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     probes = [
         p
-        for p in api_probes() + cli_probes() + store_probes()
+        for p in api_probes() + solver_probes() + cli_probes() + store_probes()
         if (args.only in (None, p.group)) and (args.match is None or args.match in p.id)
     ]
     os.makedirs(args.out, exist_ok=True)

@@ -40,6 +40,7 @@ from lmi.scaling import MIN_SPREAD, scale_data, state_scaling
 from lmi.status import INACCURATE, INFEASIBLE, NUMERICAL_ERROR, OPTIMAL
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
 
@@ -125,16 +126,18 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
     merged = {**DEFAULT_IPM_OPTIONS, **options}
     for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel"):
         value = merged[key]
-        if isinstance(value, bool) or not (isinstance(value, float | int) and value > 0):
+        if not (is_real(value) and value > 0):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(value))
+        merged[key] = float(value)
     radius = merged["infeasibility_radius"]
-    if isinstance(radius, bool) or not (isinstance(radius, float | int) and radius > 0):
+    if not (is_real(radius) and radius > 0):
         raise InvalidArgumentError("solver_options['infeasibility_radius']", "a number > 0 (inf: no test)",
                                    repr(radius))
     for key in ("max_iter", "warm_max_iter"):
         value = merged[key]
-        if isinstance(value, bool) or not (isinstance(value, int) and value > 0):
+        if not (is_integer(value) and value > 0):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
+        merged[key] = int(value)
     for key in ("warm_start", "fallback", "state_scaling", "phase_one", "rebalance"):
         if not isinstance(merged[key], bool):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))

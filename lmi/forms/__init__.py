@@ -5,9 +5,18 @@
 cost, a free first move, saturation-aware gains, soft bounds and bounded disturbances.
 """
 
-from lmi.forms.options import COSTS, LYAPUNOV_FORMS, SATURATIONS, Disturbance, FormOptions, form_options
+from lmi.forms.options import (
+    COSTS,
+    LYAPUNOV_FORMS,
+    MAX_SOFT_WEIGHT,
+    SATURATIONS,
+    Disturbance,
+    FormOptions,
+    form_options,
+)
 from lmi.forms.problem import FormProblem
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "SATURATIONS", "Disturbance", "FormOptions", "FormProblem", "form_options",
+    "COSTS", "LYAPUNOV_FORMS", "MAX_SOFT_WEIGHT", "SATURATIONS", "Disturbance", "FormOptions", "FormProblem",
+    "form_options",
 ]

@@ -16,8 +16,11 @@ from typing import Any, Literal
 import numpy as np
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
+from toolkit_common.validation import as_real_array
 
-__all__ = ["COSTS", "LYAPUNOV_FORMS", "SATURATIONS", "Disturbance", "FormOptions", "form_options"]
+__all__ = [
+    "COSTS", "LYAPUNOV_FORMS", "MAX_SOFT_WEIGHT", "SATURATIONS", "Disturbance", "FormOptions", "form_options",
+]
 
 #: ``"common"``: one quadratic Lyapunov function (Kothare 1996); ``"vertex"``: one ``Q_j`` per
 #: vertex and a slack ``G`` (uncertainty constant in time); ``"vertex_pairs"``: every vertex pair
@@ -71,6 +74,21 @@ def _choice(value: Any, allowed: tuple, name: str) -> Any:
     return value
 
 
+#: The largest weight of a soft bound (``soft={"u": w_u, "y": w_y}``); a larger one is refused.
+#: The objective ``gamma + w s`` then spans ``w`` from its smallest to its largest coefficient,
+#: and the solvers lose the cost bound beside the penalty. Measured on Kothare's examples 1 and 2,
+#: MUP's demo system, paper P's satellite (2 vertices) and paper W's at ``x0`` and ``4 x0``, each
+#: form with one Lyapunov function and with one per vertex: weights 1e3 to 1e9 gave certified
+#: ``"optimal"`` answers on all of them (where the hard problem is feasible, the same gamma at
+#: every weight from 1e6 on, with slacks of 1e-9 or less). The first failure came at 1e10, on
+#: paper W's satellite with one Lyapunov function per vertex (``"max_iterations"``, then phase
+#: one's point, ``"inaccurate"``, gamma 7 times the optimum); on the others from 1e15 (phase one's
+#: point, gamma 5 to 80 times the optimum; Kothare's example 2 from 1e20), where Clarabel, the
+#: fallback, called several of them unbounded, and at 1e200 the kernels divided by zero. 1e8 keeps
+#: a factor of 100 from the first failure.
+MAX_SOFT_WEIGHT = 1e8
+
+
 def _soft(soft: Any, has_input: bool, has_output: bool) -> dict[str, float] | None:
     if soft is None:
         return None
@@ -87,6 +105,10 @@ def _soft(soft: Any, has_input: bool, has_output: bool) -> dict[str, float] | No
             raise ArgumentTypeError(f"soft[{key!r}]", "a number > 0", type(weight).__name__)
         if not (np.isfinite(weight) and weight > 0.0):
             raise InvalidArgumentError(f"soft[{key!r}]", "a finite weight > 0", repr(weight))
+        if weight > MAX_SOFT_WEIGHT:
+            raise InvalidArgumentError(
+                f"soft[{key!r}]", f"a weight <= MAX_SOFT_WEIGHT = {MAX_SOFT_WEIGHT:g} (beyond it the solvers "
+                "cannot resolve the cost bound next to the penalty; see the page on the forms)", repr(weight))
         if key == "u" and not has_input:
             expected = 'no "u" weight without an input bound (u_max)'
             raise InvalidArgumentError("soft", expected, repr(dict(soft)))
@@ -106,10 +128,7 @@ def _disturbance(disturbance: Any, n: int) -> Disturbance | None:
     if not isinstance(disturbance, tuple | list) or len(disturbance) not in (2, 3):
         expected = "None, (E, w_max) or (E, w_max, lam)"
         raise ArgumentTypeError("disturbance", expected, type(disturbance).__name__)
-    try:
-        e_mat = np.asarray(disturbance[0], dtype=float)
-    except (TypeError, ValueError) as err:
-        raise InvalidArgumentError("disturbance E", "a numeric (n, q) matrix", repr(disturbance[0])) from err
+    e_mat = np.array(as_real_array(disturbance[0], "disturbance E", "a numeric (n, q) matrix"))
     if e_mat.ndim == 1:
         e_mat = e_mat[:, None]
     if e_mat.ndim != 2 or e_mat.shape[0] != n or e_mat.shape[1] < 1:
@@ -154,7 +173,10 @@ def form_options(
     """
     _choice(lyapunov, LYAPUNOV_FORMS, "lyapunov")
     _choice(cost, COSTS, "cost")
-    if isinstance(free_moves, bool) or free_moves not in (0, 1):
+    if isinstance(free_moves, bool | np.bool_) or not isinstance(free_moves, int | np.integer):
+        found = f"{type(free_moves).__name__} {free_moves!r}"
+        raise ArgumentTypeError("free_moves", "the integer 0 or 1", found)
+    if free_moves not in (0, 1):
         raise InvalidArgumentError("free_moves", "0 or 1", repr(free_moves))
     _choice(saturation, SATURATIONS, "saturation")
     soft_weights = _soft(soft, input_constraint is not None, has_output)

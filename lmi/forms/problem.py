@@ -40,6 +40,7 @@ from lmi.status import (
     NUMERICAL_ERROR,
     OPTIMAL,
     SOLVER_ERROR,
+    UNBOUNDED,
     UNCERTIFIED,
 )
 from lmi.threads import SingleThreadBlas
@@ -488,6 +489,8 @@ class FormProblem:
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
         word = res.solver_status or res.status
+        if res.status == UNBOUNDED:
+            return _not_unbounded(_Solved(res.status, word, res.x, res.iterations, res.solve_time))
         if res.status == INFEASIBLE:  # the run's own Farkas ray
             proof = self._check_ray(fd, res.Z)
             status = INFEASIBLE if proof.ok else NUMERICAL_ERROR
@@ -550,7 +553,7 @@ class FormProblem:
         raw = str(sol.status)
         status = CLARABEL_STATUS_MAP.get(raw, SOLVER_ERROR)
         z = None if status == INFEASIBLE else np.asarray(sol.x)
-        return _Solved(status, raw, z, int(sol.iterations), time.perf_counter() - start)
+        return _not_unbounded(_Solved(status, raw, z, int(sol.iterations), time.perf_counter() - start))
 
     def _solve_cvxpy(self, fd: FormData, keep: bool = True) -> _Solved:
         import cvxpy as cp
@@ -580,14 +583,16 @@ class FormProblem:
         try:
             with self._blas.limit():
                 problem.solve(solver="CLARABEL", **self._settings)
-        except Exception as err:  # cvxpy.error.SolverError and the solver's own errors
+        except BaseException as err:  # cvxpy.error.SolverError, the solver's own errors and panics
+            if isinstance(err, KeyboardInterrupt | SystemExit):
+                raise
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         status = CVXPY_STATUS_MAP.get(str(problem.status), SOLVER_ERROR)
         zval = None if z.value is None else np.asarray(z.value, dtype=float)
         stats = problem.solver_stats
         its = None if stats is None or stats.num_iters is None else int(stats.num_iters)
-        return _Solved(status, str(problem.status), zval, its, elapsed)
+        return _not_unbounded(_Solved(status, str(problem.status), zval, its, elapsed))
 
     # -- the answer ------------------------------------------------------------------------------
     def _finish(self, solved: _Solved, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray,
@@ -625,6 +630,14 @@ class FormProblem:
                       self._form_data(xs, us, ys, w_max, lam, t=np.ones(self.data.n)))
         margins = check.margins()
         opts = self.options
+        for key, bounds in (("u", us), ("y", ys)):
+            if key in (opts.soft or {}):
+                # a slack is >= 0 (its diagonal entry of the state block is certified with that
+                # block, relative to the block's size); here also against the squared bound it
+                # softens: a negative slack tightens that bound, and lowers the objective by w |s|
+                slack_n = float(values[f"s_{key}"][0, 0])
+                square = float(np.min(np.asarray(bounds) ** 2))
+                margins[f"slack_{key}"] = slack_n / max(square, abs(slack_n), np.finfo(float).tiny)
         g_mat = values["G"] if opts.vertex_lyapunov else values["Q"]
         try:
             g_inv = np.linalg.inv(g_mat)
@@ -669,6 +682,20 @@ class FormProblem:
             else:
                 out[name] = val
         return out
+
+
+def _not_unbounded(solved: _Solved) -> _Solved:
+    """A solver's ``"unbounded"`` made a ``"numerical_error"``: no form is unbounded. Its objective,
+    ``gamma`` (+ ``s0``) + ``w_u s_u + w_y s_y`` (:func:`lmi.forms.lmis.objective`), is ``>= 0``
+    at every feasible point: ``gamma`` is a diagonal entry of the cost blocks (``gamma I``), ``s0``
+    of the free move's stage block exceeds the stage cost ``>= 0``, each slack ``s_u, s_y`` is a
+    diagonal entry of the state block (:func:`lmi.forms.lmis._with_slacks`) and the weights are
+    ``> 0``. A solver that says otherwise has lost the problem to rounding: measured with Clarabel
+    at soft weights of 1e15 (``"DualInfeasible"``, gamma 1.9e-12 and a slack of -7.7e-14)."""
+    if solved.status != UNBOUNDED:
+        return solved
+    word = f"{solved.solver_status} (not believed: the form's objective is >= 0 on its feasible set)"
+    return _Solved(NUMERICAL_ERROR, word, solved.z, solved.iterations, solved.solve_time)
 
 
 def _solver_key(backend: str, fd: FormData) -> tuple:

@@ -26,10 +26,11 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import as_real_array
 
 __all__ = [
     "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES", "BlockData", "BlockFactor",
-    "PackedLayout", "block_weights", "check_block", "check_factor", "concatenate_factors",
+    "PackedLayout", "block_pairs", "block_weights", "check_block", "check_factor", "concatenate_factors",
     "concatenate_sparse", "entry_weight", "factor_groups",
 ]
 
@@ -131,7 +132,7 @@ class BlockData:
         self.n = n
         self._dscale: np.ndarray | None = None
         self.block_weights: np.ndarray | None = None
-        checked = [check_block(j, const, coef, n) for j, (const, coef) in enumerate(blocks)]
+        checked = [check_block(j, const, coef, n) for j, (const, coef) in enumerate(block_pairs(blocks))]
         orders = [const.shape[0] for const, _ in checked]
         self.block_orders = orders
         self.degree = sum(orders)
@@ -390,13 +391,13 @@ def check_factor(j: int, factor: Any, coef: np.ndarray | None, n: int) -> BlockF
         dmat, var, p, q, val = factor
     except (TypeError, ValueError):
         raise InvalidArgumentError(name, "a tuple (D, var, p, q, value)", repr(type(factor))) from None
-    dmat = np.asarray(dmat, dtype=float)
+    dmat = as_real_array(dmat, f"{name} D")
     k = coef.shape[1]
     if dmat.ndim != 2 or dmat.shape[0] != k or dmat.shape[1] == 0 or not np.all(np.isfinite(dmat)):
         raise InvalidArgumentError(f"{name} D", f"a finite ({k}, d) matrix", f"shape {dmat.shape}")
     d = dmat.shape[1]
-    var, p, q = (np.asarray(a, dtype=np.int64).ravel() for a in (var, p, q))
-    val = np.asarray(val, dtype=float).ravel()
+    var, p, q = (_indices(a, f"{name} {label}") for a, label in ((var, "var"), (p, "p"), (q, "q")))
+    val = as_real_array(val, f"{name} value").ravel()
     if not (var.shape == p.shape == q.shape == val.shape):
         raise InvalidArgumentError(f"{name} entries", "var, p, q and value of equal length",
                                    f"lengths {var.size}, {p.size}, {q.size}, {val.size}")
@@ -431,12 +432,28 @@ def concatenate_sparse(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray,
     )
 
 
+def block_pairs(blocks: Any) -> list[tuple[Any, Any]]:
+    """``blocks`` as a non-empty list of ``(C_j, A_j)`` pairs; anything else is an error naming
+    ``blocks`` (or the entry that is not a pair)."""
+    if isinstance(blocks, str | bytes | np.ndarray) or not isinstance(blocks, Sequence):
+        raise InvalidArgumentError("blocks", "a sequence of (C_j, A_j) pairs", type(blocks).__name__)
+    if len(blocks) == 0:
+        raise InvalidArgumentError("blocks", "at least one (C_j, A_j) pair", "none")
+    pairs = []
+    for j, pair in enumerate(blocks):
+        if isinstance(pair, str | bytes) or not isinstance(pair, Sequence) or len(pair) != 2:
+            found = f"{len(pair)} items" if isinstance(pair, Sequence) else type(pair).__name__
+            raise InvalidArgumentError(f"blocks[{j}]", "a pair (C_j, A_j)", found)
+        pairs.append((pair[0], pair[1]))
+    return pairs
+
+
 def check_block(
     j: int, const: Any, coef: Any, n: int, order: int | None = None
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Validate block ``j``: ``C_j`` ``(k, k)`` and ``A_j`` ``(n, k, k)``, finite and symmetric."""
     name = f"blocks[{j}]"
-    c_mat = np.asarray(const, dtype=float)
+    c_mat = as_real_array(const, f"{name} C", "a square (k, k) matrix")
     if c_mat.ndim != 2 or c_mat.shape[0] != c_mat.shape[1] or c_mat.shape[0] == 0:
         raise InvalidArgumentError(f"{name} C", "a square (k, k) matrix", f"shape {c_mat.shape}")
     k = c_mat.shape[0]
@@ -445,7 +462,7 @@ def check_block(
     arrays = [("C", c_mat)]
     a_mat = None
     if coef is not None:
-        a_mat = np.asarray(coef, dtype=float)
+        a_mat = as_real_array(coef, f"{name} A", f"an ({n}, {k}, {k}) array")
         if a_mat.shape != (n, k, k):
             raise InvalidArgumentError(f"{name} A", f"shape ({n}, {k}, {k})", f"shape {a_mat.shape}")
         arrays.append(("A", a_mat))
@@ -456,3 +473,11 @@ def check_block(
         if asym > 1e-12 * max(1.0, float(np.max(np.abs(arr), initial=0.0))):
             raise InvalidArgumentError(f"{name} {label}", "symmetric matrices", f"asymmetry {asym:.1e}")
     return c_mat, a_mat
+
+
+def _indices(value: Any, name: str) -> np.ndarray:
+    """``value`` as a flat array of integer indices (integral floats too), naming ``name``."""
+    arr = as_real_array(value, name, "integer indices").ravel()
+    if not np.all(np.isfinite(arr) & (arr == np.round(arr))):
+        raise InvalidArgumentError(name, "integer indices", "a value that is not an integer")
+    return arr.astype(np.int64)

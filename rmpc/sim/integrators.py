@@ -48,7 +48,7 @@ import numpy as np
 
 from models.attitude.quaternion import quat_multiply
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
-from toolkit_common.validation import check_choice, check_positive
+from toolkit_common.validation import check_choice, check_positive, is_integer
 
 __all__ = [
     "DOP853",
@@ -298,9 +298,9 @@ class Newmark(Integrator):
         if self.beta > 0.5 or not 0.0 < self.gamma <= 1.0:
             raise InvalidArgumentError("beta", "0 < beta <= 1/2 and 0 < gamma <= 1", f"{beta}, {gamma}")
         self.tol = check_positive(tol, "tol")
-        if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
+        if not is_integer(max_iterations) or max_iterations < 1:
             raise InvalidArgumentError("max_iterations", "a positive integer", repr(max_iterations))
-        self.max_iterations = max_iterations
+        self.max_iterations = int(max_iterations)
 
     def _describe(self) -> str:
         return f"substep={self.substep:g}, beta={self.beta:g}, gamma={self.gamma:g}"
