@@ -2,8 +2,9 @@
 
 ``python -m benchmarks.timing.breakdown [--vertices 2 8] [--states N] [--out DIR] [--compile]``
 
-For each polytope (paper P's satellite, 2 or 8 vertices, the default ``ipm`` path of
-:class:`lmi.KothareProblem`, warm-started along the closed loop of
+For each polytope (paper P's satellite, 2 or 8 vertices, the ``ipm`` path of
+:class:`lmi.KothareProblem` on its numba kernels (``solver_options={"core": "numba"}``; the C core
+that runs these problems by default is timed by ``python -m benchmarks.timing.ccore --phases``), warm-started along the closed loop of
 :func:`benchmarks.timing.rmpc.closed_loop_states`) every compiled kernel the solver calls (the
 residuals and the iteration itself, :mod:`lmi.ipm.kernels.iteration`) is timed by wrapping it,
 in CPU time of this thread (``time.thread_time``: a shared machine's other processes inflate
@@ -140,7 +141,9 @@ def breakdown(n_vertices: int, n_states: int = 40) -> dict[str, Any]:
 
     poly = polytope(n_vertices)
     states = closed_loop_states(n_states, "scalar" if n_vertices == 2 else "box")
-    prob = KothareProblem(poly.A, poly.B, Q1, R, dt=poly.dt, u_max=U_MAX)
+    # the numba kernels' path (the default "auto" runs these problems in the C core, whose phases
+    # python -m benchmarks.timing.ccore --phases times)
+    prob = KothareProblem(poly.A, poly.B, Q1, R, dt=poly.dt, u_max=U_MAX, solver_options={"core": "numba"})
     for x in states[:3]:  # kernels loaded, warm point set
         prob.solve(x)
     solver = prob._backend._solver
