@@ -107,8 +107,11 @@ def _write_sweep(tmp: str, text: str) -> None:
         handle.write(text)
 
 
-def _limit_memory() -> None:
+def _prepare_child() -> None:
+    """The command's memory limit, and SIGINT handled as in a terminal's foreground job (a shell
+    starts background jobs with SIGINT ignored, and an ignored signal stays ignored in children)."""
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, MEMORY_LIMIT_BYTES))
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 @dataclass(frozen=True)
@@ -146,7 +149,7 @@ class InterruptProbe(Probe):
             start = time.perf_counter()
             process = subprocess.Popen(
                 rmpc_command() + argv, cwd=scratch, env=env, stdout=subprocess.DEVNULL,
-                stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=_limit_memory,
+                stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=_prepare_child,
             )
             try:
                 sent, before = self._interrupt(process, scratch, start, timeout)
