@@ -27,6 +27,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -119,6 +120,11 @@ class Interrupts:
         self._settled.set()
         if self._resender is not None:
             self._resender.join()
+            # a resend already on its way is taken here (and ignored), not by the handler restored
+            # below, which would raise it in whatever the runner does next
+            deadline = time.monotonic() + 1.0
+            while self._resent > 0 and self._installed and time.monotonic() < deadline:
+                time.sleep(0.005)
         if self._installed:
             signal.signal(signal.SIGINT, self._previous)
             sys.unraisablehook = self._previous_hook

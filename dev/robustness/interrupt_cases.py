@@ -241,7 +241,7 @@ def _classify(
 
 def _methods(delay: float, to_group: bool = False) -> InterruptProbe:
     where = "group" if to_group else "process"
-    moment = "before the first case" if delay < 0 else f"{delay:g} s after the first case"
+    moment = f"{-delay:g} s after the start" if delay < 0 else f"{delay:g} s after the first case"
     return InterruptProbe(
         f"cli:interrupt methods, SIGINT to the {where} {moment}",
         "cli",
