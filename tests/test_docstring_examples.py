@@ -20,6 +20,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.compare",
     "benchmarks.core.executors",
     "benchmarks.core.family",
+    "benchmarks.core.interrupts",
     "benchmarks.core.jsonable",
     "benchmarks.core.metrics",
     "benchmarks.core.registry",

@@ -7,22 +7,23 @@ Used by the paper suite and by sweeps alike:
 - each result goes to ``on_result`` as soon as its case finishes (the sweep commits it to
   its store there);
 - the first SIGINT stops submitting, cancels what has not started and waits for the
-  running cases (their results are kept); a second SIGINT abandons them;
+  running cases (their results are kept); a second SIGINT abandons them (the handler is
+  :class:`benchmarks.core.interrupts.Interrupts`; a case run in this process, ``--workers 0``,
+  that an interrupt reached is not kept, whatever it returned);
 - a dead worker process (``kill -9``, out of memory) breaks the pool: the pool is restarted
   and the unfinished cases are submitted again, up to ``max_restarts`` times.
 """
 
 from __future__ import annotations
 
-import signal
 import sys
-import threading
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from benchmarks.core.executors import CaseExecutor, WorkerLost
+from benchmarks.core.interrupts import Interrupts
 from benchmarks.core.runner import run_case
 
 __all__ = ["ExecOutcome", "Task", "execute"]
@@ -45,33 +46,6 @@ class ExecOutcome:
     restarts: int = 0
     unfinished: list[str] = field(default_factory=list)
     lost_reason: str | None = None
-
-
-class _Interrupts:
-    """SIGINT handler: the first sets a flag, the second raises KeyboardInterrupt."""
-
-    def __init__(self, notice: Callable[[str], None]) -> None:
-        self.count = 0
-        self._notice = notice
-        self._previous: Any = None
-        self._installed = False
-
-    def __enter__(self) -> _Interrupts:
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self._handle)
-            self._installed = True
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._installed:
-            signal.signal(signal.SIGINT, self._previous)
-
-    def _handle(self, signum: int, frame: Any) -> None:
-        self.count += 1
-        if self.count == 1:
-            self._notice("interrupted: finishing the running cases (Ctrl-C again to abandon them)")
-            return
-        raise KeyboardInterrupt
 
 
 def _stderr(msg: str) -> None:
@@ -111,7 +85,8 @@ def execute(
     inflight: dict[Any, Task] = {}
     outcome = ExecOutcome()
     limit = 2 * max(1, executor.workers)
-    with _Interrupts(notice) as interrupts:
+    current: Task | None = None  # submitted, not yet in flight (an in-process case runs here)
+    with Interrupts(notice) as interrupts:
         try:
             while queue or inflight:
                 if interrupts.count and not outcome.interrupted:
@@ -121,9 +96,13 @@ def execute(
                     for fut in list(inflight):
                         if executor.cancel(fut):
                             outcome.unfinished.append(inflight.pop(fut).key)
-                while queue and len(inflight) < limit:
-                    task = queue.popleft()
-                    inflight[executor.submit(run_case, task.payload)] = task
+                while queue and len(inflight) < limit and not interrupts.count:
+                    current = queue.popleft()
+                    future = executor.submit(run_case, current.payload)
+                    if interrupts.interrupted():  # an interrupt reached a case run in this process
+                        raise KeyboardInterrupt
+                    inflight[future] = current
+                    current = None
                 if not inflight:
                     break
                 lost: list[Task] = []
@@ -161,7 +140,10 @@ def execute(
             if interrupts.count:
                 outcome.interrupted = True
         except KeyboardInterrupt:
+            interrupts.settle()
             outcome.interrupted = True
+            if current is not None:
+                outcome.unfinished.append(current.key)
             outcome.unfinished.extend(t.key for t in inflight.values())
             inflight.clear()
             executor.close(abandon=True)

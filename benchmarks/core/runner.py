@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.interrupts import is_interrupt
 from benchmarks.core.jsonable import json_safe
 from benchmarks.core.scenario import Scenario
 
@@ -132,7 +133,9 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
 
     Returns ``{"ok": True, "record": ..., "trace": ...}`` or, when the case raised or ran past
     ``time_limit``, ``{"ok": False, "error": "<type>: <message>", "traceback": ...}`` (the type
-    ``time_limit`` for a case stopped by its limit).
+    ``time_limit`` for a case stopped by its limit). An interrupt is not a failing case: a
+    ``KeyboardInterrupt``, or an error that compiled code raised because of one
+    (:func:`benchmarks.core.interrupts.is_interrupt`), propagates as ``KeyboardInterrupt``.
     """
     limit = payload.get("time_limit")
     timer = _Timer()
@@ -146,6 +149,8 @@ def run_case(payload: dict[str, Any]) -> dict[str, Any]:
     except CaseTimeLimit as err:
         return {"ok": False, "error": f"time_limit: {err}", "traceback": traceback.format_exc()}
     except Exception as err:  # a failing case is data, not a crash of the sweep
+        if is_interrupt(err):  # Ctrl-C wrapped by compiled code on its way (numba: SystemError)
+            raise KeyboardInterrupt from err
         if timer.expired:  # the limit's error, wrapped by compiled code it passed through
             message = f"the case ran longer than its limit of {limit:g} s"
             return {"ok": False, "error": f"time_limit: {message}", "traceback": traceback.format_exc()}

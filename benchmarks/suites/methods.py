@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from benchmarks.core.execute import ExecOutcome
+from benchmarks.core.interrupts import Interrupts
 from benchmarks.core.jsonable import json_safe
 from benchmarks.core.progress import CaseProgress
 from benchmarks.core.publish import published_paths, staged_reports
@@ -502,7 +503,9 @@ def run_methods(
     -------
     SuiteOutcome
         Records in problem x method order; ``execution.interrupted`` after Ctrl-C (the files
-        then hold the finished cases).
+        then hold the finished cases). Ctrl-C stops the running case at once, in the compiled
+        solvers too (:class:`benchmarks.core.interrupts.Interrupts`); that case is neither
+        stored nor counted as failed.
     """
     settings = MethodsSettings.short() if short else MethodsSettings()
     default_problems = list(SHORT_PROBLEMS) if short else list(PROBLEMS)
@@ -517,7 +520,8 @@ def run_methods(
     keys = [(p, m) for p in chosen_p for m in chosen_m]
     resumed = 0
     notes: list[str] = []
-    with CaseProgress(len(keys), "rmpc bench methods", progress) as bar:
+    bar_context = CaseProgress(len(keys), "rmpc bench methods", progress)
+    with bar_context as bar, Interrupts(first_raises=True) as stop:
         built: dict[str, MethodsProblem] = {}
         try:
             for p, m in keys:
@@ -537,11 +541,15 @@ def run_methods(
                         built[p] = build_problem(p)
                     rec, extra = evaluate(built[p], m, settings)
                 except Exception as err:  # a failing case is data, not a crash of the suite
+                    if stop.interrupted(err):  # Ctrl-C, wrapped by compiled code on its way
+                        raise KeyboardInterrupt from err
                     failures.append(
                         {"experiment": p, "key": f"{p}__{m}", "error": f"{type(err).__name__}: {err}"}
                     )
                     bar.advance(f"{p}/{m}", ok=False)
                     continue
+                if stop.interrupted():  # swallowed inside the case: what it returned is not a result
+                    raise KeyboardInterrupt
                 unstored = store_case(path, settings.as_dict(), rec, extra)
                 if unstored is not None:
                     notes.append(f"cases/{path.name}: not stored ({unstored}); a later run measures it again")
@@ -549,6 +557,7 @@ def run_methods(
                 execution.finished.append(f"{p}__{m}")
                 bar.advance(f"{p}/{m}" + (f" (stored case not used: {why}; measured again)" if why else ""))
         except KeyboardInterrupt:
+            stop.settle()
             execution.interrupted = True
             execution.unfinished = [f"{p}__{m}" for p, m in keys if (p, m) not in results]
     outcome = SuiteOutcome(

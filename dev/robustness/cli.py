@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from benchmarks.core.machine import machine_info
 from dev.robustness.api_cases import api_probes
 from dev.robustness.cli_cases import cli_probes
+from dev.robustness.interrupt_cases import interrupt_probes
 from dev.robustness.probe import Probe
 from dev.robustness.runner import run_probes
 from dev.robustness.solver_cases import solver_probes
@@ -60,7 +61,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     probes = [
         p
-        for p in api_probes() + solver_probes() + cli_probes() + store_probes()
+        for p in api_probes() + solver_probes() + cli_probes() + store_probes() + interrupt_probes()
         if (args.only in (None, p.group)) and (args.match is None or args.match in p.id)
     ]
     os.makedirs(args.out, exist_ok=True)

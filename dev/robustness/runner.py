@@ -178,7 +178,13 @@ def run_probes(
     preload()
     results = []
     for probe in probes:
-        outcome = run_api_probe(probe, timeout) if probe.group == "api" else run_cli_probe(probe, timeout)
+        own = getattr(probe, "run", None)  # a probe that drives its command itself (interrupts)
+        if callable(own):
+            outcome = own(timeout)
+        elif probe.group == "api":
+            outcome = run_api_probe(probe, timeout)
+        else:
+            outcome = run_cli_probe(probe, timeout)
         results.append((probe, outcome))
         if report is not None:
             report(probe, outcome)

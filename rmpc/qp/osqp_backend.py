@@ -21,11 +21,19 @@ Output. OSQP 1.1.3 prints "Polishing not needed - no active set detected at opti
 on every such solve even with ``verbose=False`` (osqp/osqp issue #785); with ``verbose``
 off this back-end sends Python's ``sys.stdout`` to a null sink for the duration of the
 solve call (OSQP writes through ``PySys_WriteStdout``).
+
+Interrupts. OSQP installs its own SIGINT handler while it solves, so Ctrl-C during a solve
+stops the solve (status ``interrupted``) and never reaches Python. This back-end raises the
+signal again in the process, where Python's handler acts on it (``KeyboardInterrupt`` by
+default); when the process goes on (SIGINT ignored, as in the benchmark's worker processes, or
+a handler that only takes note), the solve is run again, so an interrupt never becomes a solver
+failure. ``"interrupted"`` remains only after :data:`_SIGINT_RETRIES` interrupted solves in a row.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import signal
 import sys
 import time
 from typing import Any, ClassVar
@@ -117,6 +125,11 @@ _NULL = _NullSink()
 _S = osqp.SolverStatus
 
 
+#: Times a solve that OSQP's own SIGINT handler stopped is run again after the signal is handed
+#: to the process (see the module's note on interrupts).
+_SIGINT_RETRIES = 3
+
+
 class OSQPBackend(QPBackend):
     """QP back-end on OSQP 1.x (sparse ADMM, warm-started, polished).
 
@@ -183,6 +196,13 @@ class OSQPBackend(QPBackend):
             if quiet:
                 sys.stdout = _NULL  # type: ignore[assignment]
             res = self._solver.solve(raise_error=False)
+            for _ in range(_SIGINT_RETRIES):
+                if int(res.info.status_val) != int(_S.OSQP_SIGINT):
+                    break
+                # OSQP caught a SIGINT meant for the process: hand it over (the default handler
+                # raises KeyboardInterrupt here); a process that goes on gets the solve it asked for
+                signal.raise_signal(signal.SIGINT)
+                res = self._solver.solve(raise_error=False)
         except Exception as err:  # the binding raises on a failed setup/factorisation
             sys.stdout = saved
             return self._result(
