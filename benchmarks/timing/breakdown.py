@@ -4,7 +4,8 @@
 
 For each polytope (paper P's satellite, 2 or 8 vertices, the ``ipm`` path of
 :class:`lmi.KothareProblem` on its numba kernels (``solver_options={"core": "numba"}``; the C core
-that runs these problems by default is timed by ``python -m benchmarks.timing.ccore --phases``), warm-started along the closed loop of
+that runs these problems by default is timed by ``python -m benchmarks.timing.ccore --phases``),
+warm-started along the closed loop of
 :func:`benchmarks.timing.rmpc.closed_loop_states`) every compiled kernel the solver calls (the
 residuals and the iteration itself, :mod:`lmi.ipm.kernels.iteration`) is timed by wrapping it,
 in CPU time of this thread (``time.thread_time``: a shared machine's other processes inflate
