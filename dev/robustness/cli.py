@@ -13,6 +13,7 @@ from dev.robustness.api_cases import api_probes
 from dev.robustness.cli_cases import cli_probes
 from dev.robustness.probe import Probe
 from dev.robustness.runner import run_probes
+from dev.robustness.sweep_cases import sweep_probes
 from dev.robustness.verdicts import VERDICTS, Outcome
 
 
@@ -58,7 +59,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     probes = [
         p
-        for p in api_probes() + cli_probes()
+        for p in api_probes() + cli_probes() + sweep_probes()
         if (args.only in (None, p.group)) and (args.match is None or args.match in p.id)
     ]
     os.makedirs(args.out, exist_ok=True)
