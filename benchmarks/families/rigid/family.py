@@ -66,6 +66,7 @@ from benchmarks.core.family import (
 from benchmarks.core.metrics import AXES, compute_metrics, recovery
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
+from benchmarks.families.rigid.forms import FORM_DEFAULTS, SETTING_CHECKS, check_case
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 
@@ -247,7 +248,11 @@ RIGID = PlantFamily(
     name="rigid",
     description="paper P's rigid satellite (3-2-1 Euler angles, inertia polytope), linear or nonlinear",
     fields=FIELDS,
-    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
+    controllers=controller_specs(
+        CONTROLLERS,
+        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        CONSTRAINED,
+    ),
     simulate=simulate_case,
     check=_check,
     label=_label,
@@ -255,4 +260,7 @@ RIGID = PlantFamily(
     zero_allowed=frozenset({"adaptation_gain", "mit_gain", "hold_radius"}),
     settings_check=settings_check,
     montecarlo=MonteCarlo(dims=3, sets=("true_inertia",), apply=_draw_inertia),
+    setting_checks=SETTING_CHECKS,
+    quiet_settings=frozenset(FORM_DEFAULTS),
+    case_check=check_case,
 )
