@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from benchmarks.core.rmpc_forms import FORM_DEFAULTS
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import run_sweep
 from benchmarks.core.sweep_spec import SHIPPED, expand, load_sweep, parse_sweep
 from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS
-from benchmarks.families.rigid.forms import FORM_DEFAULTS
 from models import RigidSatellite
 from toolkit_common.errors import ConfigError, ToolkitError
 
@@ -237,3 +237,49 @@ def test_the_shipped_forms_sweep_runs_and_its_records_are_those_of_the_controlle
         (r["settings"]["settings"].get("lyapunov"), r["settings"]["settings"].get("free_moves"))
         for r in records
     } == {(None, None), ("vertex_pairs", None), (None, 1), ("vertex_pairs", 1)}
+
+
+@pytest.mark.parametrize("family", ["wheel", "mrp"])
+def test_the_other_families_rmpc_takes_the_forms_from_a_sweep(family, monkeypatch):
+    import rmpc.mpc.robust_mpc as robust_mpc
+    from benchmarks.core.runner import run_scenario
+
+    built = []
+    init = robust_mpc.RMPC.__init__
+
+    def spy(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        built.append(self)
+
+    monkeypatch.setattr(robust_mpc.RMPC, "__init__", spy)
+    extra = {"fault_kind": "none"} if family == "wheel" else {}
+    base = {**extra, "family": family, "controller": "RMPC", "saturation": "constraint"}
+    dt = Scenario.from_dict(base).dt
+    settings = {"lyapunov": "vertex", "soft": {"u": 100.0}, "on_failure": "raise"}
+    (scenario,) = expand(parse_sweep({"base": {**base, "duration": 3 * dt, "settings": settings}}))
+    record = run_scenario(scenario)
+    assert record["metrics"]["status_counts"] == {"optimal": 3}
+    (ctrl,) = built
+    assert (ctrl.form.lyapunov, dict(ctrl.form.soft), ctrl.certified.on_failure) == (
+        "vertex",
+        {"u": 100.0},
+        "raise",
+    )
+    assert ctrl.plant.n_states == 6
+    with pytest.raises(ConfigError) as info:
+        parse_sweep({"base": {**base, "settings": {"disturbance": {"E": [[1.0]] * 14, "w_max": 0.1}}}})
+    assert info.value.argument == "base.settings.disturbance.E" and "(6, q)" in info.value.expected
+
+
+def test_the_flexible_rmpc_takes_the_forms_on_its_14_states_and_soft_output_bounds_with_its_modal_bound():
+    base = {"family": "flexible", "controller": "RMPC", "saturation": "constraint"}
+    with pytest.raises(ConfigError) as info:
+        parse_sweep({"base": {**base, "settings": {"disturbance": {"E": E_ROLL_RATE, "w_max": 0.1}}}})
+    assert info.value.argument == "base.settings.disturbance.E" and "(14, q)" in info.value.expected
+    with pytest.raises(ConfigError) as info:
+        parse_sweep({"base": {**base, "settings": {"soft": {"y": 10.0}}}})
+    assert info.value.argument == "base.settings.soft" and "output bounds" in info.value.expected
+    (scenario,) = expand(
+        parse_sweep({"base": {**base, "modal_bound": 0.02, "settings": {"soft": {"y": 10.0}}}})
+    )
+    assert dict(scenario.settings["soft"]) == {"y": 10.0}

@@ -173,7 +173,6 @@ SETTING_CHOICES: Mapping[str, tuple[str, ...]] = MappingProxyType(
         "torque_budget": ("current", "split", "none"),
         "backend": ("ipm", "clarabel", "cvxpy", "proxqp", "osqp"),
         "formulation": ("delta", "delta_shared", "standard"),
-        "on_failure": ("fallback", "raise"),
     }
 )
 
