@@ -24,7 +24,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.core.jsonable",
     "benchmarks.core.metrics",
     "benchmarks.core.registry",
-    "benchmarks.core.rmpc_forms",
+    "benchmarks.families.rmpc_forms",
     "benchmarks.core.scenario",
     "benchmarks.core.store",
     "benchmarks.core.suite",

@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.core.rmpc_forms import FORM_DEFAULTS
 from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import run_sweep
 from benchmarks.core.sweep_spec import SHIPPED, expand, load_sweep, parse_sweep
 from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS
 from models import RigidSatellite
 from toolkit_common.errors import ConfigError, ToolkitError
 

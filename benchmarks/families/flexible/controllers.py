@@ -268,7 +268,7 @@ def modal_output(n_modes: int, bound: float | None) -> dict[str, Any]:
 
 
 def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from benchmarks.core.rmpc_forms import rmpc_kwargs
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"

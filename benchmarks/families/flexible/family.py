@@ -67,7 +67,6 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import step_timing
-from benchmarks.core.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import (
     CONSTRAINED,
@@ -76,6 +75,7 @@ from benchmarks.families.flexible.controllers import (
     FlexibleModel,
     settings_check,
 )
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from toolkit_common.errors import ConfigError
 
 __all__ = ["FLEXIBLE", "eta1_frequency", "simulate_case"]
@@ -335,7 +335,7 @@ def _handover_time(ctrl: Any, traj: Any) -> float | None:
     return None if step is None else float(traj.t[step])
 
 
-#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.core.rmpc_forms).
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
 FORMS = RMPCForms(14, has_output=lambda values: values["modal_bound"] is not None)
 
 

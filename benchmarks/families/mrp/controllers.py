@@ -75,7 +75,7 @@ def _mapped(ctrl: Any, m: MRPModel, name: str) -> Any:
 
 
 def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from benchmarks.core.rmpc_forms import rmpc_kwargs
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"

@@ -56,9 +56,9 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import step_timing, total_variation_rate
-from benchmarks.core.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from toolkit_common.errors import ConfigError
 
 __all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
@@ -265,7 +265,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     return CaseResult(extra, metrics, trace)
 
 
-#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.core.rmpc_forms).
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
 FORMS = RMPCForms(6)
 
 

@@ -36,7 +36,7 @@ def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from benchmarks.core.rmpc_forms import rmpc_kwargs
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc.mpc.robust_mpc import RMPC
 
     q, r = _weights(s)

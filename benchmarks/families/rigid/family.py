@@ -64,9 +64,9 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import AXES, compute_metrics, recovery
-from benchmarks.core.rmpc_forms import FORM_DEFAULTS, RMPCForms, changed_forms
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms, changed_forms
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 

@@ -61,7 +61,7 @@ def _abftc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContr
 
 
 def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
-    from benchmarks.core.rmpc_forms import rmpc_kwargs
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     q, r = _weights(s)

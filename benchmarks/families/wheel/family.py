@@ -81,7 +81,7 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import compute_metrics
-from benchmarks.core.rmpc_forms import FORM_DEFAULTS, RMPCForms
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
@@ -361,7 +361,7 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     return CaseResult(extra, metrics, trace)
 
 
-#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.core.rmpc_forms).
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
 FORMS = RMPCForms(6)
 
 
