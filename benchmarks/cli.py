@@ -92,13 +92,23 @@ def _experiments(text: str) -> list[str]:
 
 
 def _out_dir(text: str) -> str:
-    """An argparse type for ``--out``: a folder name, not empty, not an existing file."""
+    """An argparse type for ``--out``: a folder name, not empty, not an existing file, writable.
+
+    The folder (or, when it does not exist yet, the nearest folder above it that does) must take
+    a new file: a read-only folder is refused here, naming ``--out``, instead of failing later in
+    the store or the report writer with a message about a file.
+    """
     import os
 
     if not text.strip():
         raise argparse.ArgumentTypeError(f"expected a folder name, found {text!r}")
     if os.path.exists(text) and not os.path.isdir(text):
         raise argparse.ArgumentTypeError(f"expected a folder, found the file {text!r}")
+    from benchmarks.core.folders import not_writable
+
+    problem = not_writable(text)
+    if problem is not None:
+        raise argparse.ArgumentTypeError(f"expected a folder that can be written, found {text!r} ({problem})")
     return text
 
 

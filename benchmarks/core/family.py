@@ -197,6 +197,18 @@ class PlantFamily:
         ``settings_check(controller, settings, where)``: checks between settings.
     montecarlo : MonteCarlo, optional
         What a sweep's ``[montecarlo]`` draw changes; ``None``: the family has no draws.
+    setting_checks : mapping of str to callable, optional
+        ``check(value, where) -> normalised value`` of the settings whose values are not of the
+        kinds a default's type describes (a table of weights, a matrix, ``None`` by default): the
+        check raises :class:`ConfigError` naming ``where`` and returns a read-only value.
+    quiet_settings : frozenset of str
+        Settings left out of a case's record (and of its case id) while they hold their default,
+        so that a setting added later keeps the records and case ids of the cases that do not
+        set it (as :attr:`Field.written_at_default` does for fields).
+    case_check : callable, optional
+        ``case_check(values, controller, settings, name)``: checks between fields and settings
+        (a form that needs an input bound the scenario does not give); ``name(key)`` gives the
+        dotted name for errors (``name("settings")`` the settings table's).
     controller_defaults : callable, optional
         ``controller_defaults(controller) -> {field: default}``: defaults that depend on the
         controller (e.g. ``saturation = "limiter"`` for a controller without a constraint),
@@ -215,6 +227,9 @@ class PlantFamily:
     settings_check: Callable[[str, dict[str, Any], str], None] | None = None
     montecarlo: MonteCarlo | None = None
     controller_defaults: Callable[[str], Mapping[str, Any]] | None = None
+    setting_checks: Mapping[str, Callable[[Any, str], Any]] = field(default_factory=dict)
+    quiet_settings: frozenset[str] = frozenset()
+    case_check: Callable[[dict[str, Any], str, Mapping[str, Any], Callable[[str], str]], None] | None = None
 
     def default(self, key: str, controller: str) -> Any:
         """The default of field ``key`` for ``controller``."""
@@ -225,7 +240,10 @@ class PlantFamily:
         return self.fields[key].default
 
     # -- settings ---------------------------------------------------------------------
-    def _check_value(self, default: Any, value: Any, where: str) -> Any:
+    def _check_value(self, default: Any, value: Any, where: str, key: str | None = None) -> Any:
+        if key is not None and key in self.setting_checks:
+            # a setting that is None by default (none asked for) is left out of a file, or null in a record
+            return None if value is None and default is None else self.setting_checks[key](value, where)
         if isinstance(default, bool):
             return check_bool(value, where)
         if isinstance(default, int):
@@ -266,7 +284,7 @@ class PlantFamily:
         if not owners:
             expected = f"a controller setting ({', '.join(self.setting_names())})"
             raise ConfigError(where, expected, "an unknown name")
-        return self._check_value(owners[0][key], value, where)
+        return self._check_value(owners[0][key], value, where, key)
 
     def effective_settings(
         self, controller: str, overrides: Mapping[str, Any], where: str = "settings", lenient: bool = False
@@ -286,7 +304,7 @@ class PlantFamily:
                 raise ConfigError(
                     f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
                 )
-            out[key] = self._check_value(defaults[key], value, f"{where}.{key}")
+            out[key] = self._check_value(defaults[key], value, f"{where}.{key}", key)
         if self.settings_check is not None:
             self.settings_check(controller, out, where)
         return out

@@ -176,6 +176,8 @@ class Scenario:
         if problem is not None:
             raise ConfigError(name("saturation"), problem, "'constraint'")
         family.check(values, controller, name)
+        if family.case_check is not None:
+            family.case_check(values, controller, settings, name)
         if values["duration"] is not None:
             if values["duration"] < values["dt"]:
                 expected = f"at least one sample (dt = {values['dt']:g} s)"
@@ -211,7 +213,8 @@ class Scenario:
         The default family is not written, so the records of paper P's satellite keep the
         fields (and the case ids) they had before families existed; nor is a field declared
         with ``written_at_default=False`` (:class:`benchmarks.core.family.Field`) while it
-        holds its default.
+        holds its default, nor a setting among the family's ``quiet_settings`` while it holds
+        its default (:class:`benchmarks.core.family.PlantFamily`).
         """
         out: dict[str, Any] = {} if self._family == DEFAULT_FAMILY else {"family": self._family}
         fields = get_family(self._family).fields
@@ -221,9 +224,15 @@ class Scenario:
             if fields[key].written_at_default or value != fields[key].default
         ]
         first, rest = items[:1], items[1:]
-        settings = {k: list(v) if isinstance(v, tuple) else v for k, v in sorted(self._settings.items())}
+        fam = get_family(self._family)
+        defaults = fam.controllers[self._controller].defaults
+        settings = {
+            k: _plain(v)
+            for k, v in sorted(self._settings.items())
+            if k not in fam.quiet_settings or v != defaults.get(k)
+        }
         for key, value in [*first, ("controller", self._controller), ("settings", settings), *rest]:
-            out[key] = list(value) if isinstance(value, tuple) else value
+            out[key] = _plain(value)
         return out
 
     @property
@@ -239,3 +248,11 @@ class Scenario:
             return fam.label(self)
         return " ".join([self._controller, self.plant, self.saturation])
 
+
+def _plain(value: Any) -> Any:
+    """``value`` with its tuples as lists and its read-only tables as dicts (JSON-ready)."""
+    if isinstance(value, tuple | list):
+        return [_plain(v) for v in value]
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    return value

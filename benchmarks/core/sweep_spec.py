@@ -284,11 +284,25 @@ def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:
         try:
             points.append(Scenario.from_dict(data, lenient_settings=True))
         except ConfigError as err:
-            prefix = "grid" if err.argument in spec.grid else "base"
-            raise ConfigError(f"{prefix}.{err.argument}", err.expected, err.found) from None
+            raise ConfigError(_sweep_path(err.argument, spec), err.expected, err.found) from None
     if not points and first_problem is not None:
         raise first_problem
     return points, dropped
+
+
+def _sweep_path(argument: str, spec: SweepSpec) -> str:
+    """The key path of a scenario's error in the sweep file: each field named by where it is set.
+
+    ``settings.soft.u`` -> ``grid.settings.soft.u`` when the grid sets ``settings.soft``, else
+    ``base.settings.soft.u``; an error naming several fields (``settings.cost, settings.lyapunov``)
+    gets each its own.
+    """
+    parts = []
+    for part in argument.split(", "):
+        keys = part.split(".")
+        setting = ".".join(keys[:2]) if keys[0] == "settings" else keys[0]
+        parts.append(f"{'grid' if setting in spec.grid else 'base'}.{part}")
+    return ", ".join(parts)
 
 
 def expand(spec: SweepSpec) -> list[Scenario]:

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.core.folders import not_writable
 from benchmarks.core.jsonable import json_safe
 from benchmarks.core.machine import machine_info, package_versions
 from benchmarks.timing.common import Q1, SPREAD, U_MAX, R, polytope
@@ -211,7 +212,10 @@ def run_timing_command(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     if cfg.out.exists() and not cfg.out.is_dir():
         raise InvalidArgumentError("--out", "a directory (created if missing)", f"the file {str(cfg.out)!r}")
-    cfg.out.mkdir(parents=True, exist_ok=True)  # fail before minutes of measuring, not after
+    problem = not_writable(cfg.out)  # fail before minutes of measuring, not after
+    if problem is not None:
+        raise InvalidArgumentError("--out", "a folder that can be written", f"{str(cfg.out)!r} ({problem})")
+    cfg.out.mkdir(parents=True, exist_ok=True)
     result = run_timing(cfg)
     write_report(result, cfg.out)
     report = result["report"]

@@ -16,6 +16,7 @@ from dev.robustness.probe import Probe
 from dev.robustness.runner import run_probes
 from dev.robustness.solver_cases import solver_probes
 from dev.robustness.store_cases import store_probes
+from dev.robustness.sweep_cases import sweep_probes
 from dev.robustness.verdicts import VERDICTS, Outcome
 
 
@@ -61,7 +62,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     probes = [
         p
-        for p in api_probes() + solver_probes() + cli_probes() + store_probes() + interrupt_probes()
+        for p in (api_probes() + solver_probes() + cli_probes() + store_probes() + interrupt_probes()
+                  + sweep_probes())
         if (args.only in (None, p.group)) and (args.match is None or args.match in p.id)
     ]
     os.makedirs(args.out, exist_ok=True)

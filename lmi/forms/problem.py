@@ -192,12 +192,18 @@ class FormProblem:
         orders = [b.shape[0] for b in write(Program(self.layout, {}), self.options, template).blocks.values()]
         need = 3.0 * 8.0 * (self.layout.size + 1) * sum(k * k for k in orders)
         if need > MAX_COEFFICIENT_BYTES:
+            # name what was given (the plant's vertices, the options set), never an option at its default
+            given = {} if self.options.lyapunov == "common" else {"lyapunov": self.options.lyapunov}
+            given.update({} if self.options.saturation is None else {"saturation": self.options.saturation})
+            remedies = ["fewer vertices"] + ["lyapunov='common'"] * ("lyapunov" in given)
+            remedies += ["no auxiliary saturation"] * ("saturation" in given)
+            options = "".join(f", {key}={value!r}" for key, value in given.items())
             raise InvalidArgumentError(
-                "lyapunov, saturation",
-                f"a form whose LMIs fit in {MAX_COEFFICIENT_BYTES / 1e9:g} GB as dense coefficients (fewer "
-                "vertices, the common Lyapunov function, or no auxiliary saturation)",
-                f"{len(orders)} blocks of orders up to {max(orders)} in {self.layout.size} variables, "
-                f"about {need / 1e9:.1f} GB",
+                ", ".join(["plant", *given]),
+                f"a form whose LMIs fit in {MAX_COEFFICIENT_BYTES / 1e9:g} GB as dense coefficients "
+                f"({', '.join(remedies)})",
+                f"{template.n_vertices} vertices{options}: {len(orders)} blocks of orders up to "
+                f"{max(orders)} in {self.layout.size} variables, about {need / 1e9:.1f} GB",
             )
 
     def _check_nominal(self, nominal: Any) -> tuple[np.ndarray, np.ndarray] | None:

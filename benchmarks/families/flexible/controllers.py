@@ -268,6 +268,7 @@ def modal_output(n_modes: int, bound: float | None) -> dict[str, Any]:
 
 
 def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"
@@ -281,6 +282,9 @@ def _rmpc(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltControl
         **modal_output(m.satellite.n_modes, scenario.modal_bound),
         resolve_threshold=s["resolve_threshold"],
         backend=s["backend"],
+        certificate_tol=s["certificate_tol"],
+        on_failure=s["on_failure"],
+        **rmpc_kwargs(s),
     )
     return BuiltController(_with_avc(_mapped(ctrl, m, "RMPC"), m, scenario), _limited(scenario))
 

@@ -75,6 +75,7 @@ from benchmarks.families.flexible.controllers import (
     FlexibleModel,
     settings_check,
 )
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from toolkit_common.errors import ConfigError
 
 __all__ = ["FLEXIBLE", "eta1_frequency", "simulate_case"]
@@ -334,11 +335,19 @@ def _handover_time(ctrl: Any, traj: Any) -> float | None:
     return None if step is None else float(traj.t[step])
 
 
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
+FORMS = RMPCForms(14, has_output=lambda values: values["modal_bound"] is not None)
+
+
 FLEXIBLE = PlantFamily(
     name="flexible",
     description="paper V's flexible satellite (4 modes, PZT channel): the V-slew, steady error, small slew",
     fields=FIELDS,
-    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
+    controllers=controller_specs(
+        CONTROLLERS,
+        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        CONSTRAINED,
+    ),
     simulate=simulate_case,
     check=_check,
     label=_label,
@@ -346,4 +355,7 @@ FLEXIBLE = PlantFamily(
     zero_allowed=frozenset({"w_weight", "eta_weight"}),
     settings_check=settings_check,
     controller_defaults=_controller_defaults,
+    setting_checks=FORMS.setting_checks(),
+    quiet_settings=frozenset(FORM_DEFAULTS),
+    case_check=FORMS.check_case,
 )

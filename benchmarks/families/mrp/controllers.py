@@ -75,6 +75,7 @@ def _mapped(ctrl: Any, m: MRPModel, name: str) -> Any:
 
 
 def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     constrained = scenario.saturation == "constraint"
@@ -86,6 +87,9 @@ def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
         input_constraint=s["input_constraint"] if constrained else None,
         resolve_threshold=s["resolve_threshold"],
         backend=s["backend"],
+        certificate_tol=s["certificate_tol"],
+        on_failure=s["on_failure"],
+        **rmpc_kwargs(s),
     )
     return BuiltController(_mapped(ctrl, m, "RMPC"), scenario.saturation == "limiter")
 

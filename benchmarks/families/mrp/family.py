@@ -58,6 +58,7 @@ from benchmarks.core.family import (
 from benchmarks.core.metrics import step_timing, total_variation_rate
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from toolkit_common.errors import ConfigError
 
 __all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
@@ -264,15 +265,26 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     return CaseResult(extra, metrics, trace)
 
 
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
+FORMS = RMPCForms(6)
+
+
 MRP = PlantFamily(
     name="mrp",
     description="paper M's rigid satellite in MRPs on its orbit, with the spinning disk (M1-M3)",
     fields=FIELDS,
-    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
+    controllers=controller_specs(
+        CONTROLLERS,
+        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        CONSTRAINED,
+    ),
     simulate=simulate_case,
     check=_check,
     label=_label,
     setting_choices=defaults.SETTING_CHOICES,
     zero_allowed=frozenset({"adaptation_gain"}),
     settings_check=settings_check,
+    setting_checks=FORMS.setting_checks(),
+    quiet_settings=frozenset(FORM_DEFAULTS),
+    case_check=FORMS.check_case,
 )

@@ -36,6 +36,7 @@ def _weights(settings: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc.mpc.robust_mpc import RMPC
 
     q, r = _weights(s)
@@ -49,7 +50,7 @@ def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCon
             u_max=scenario.u_max if constrained else None,
             input_constraint=s["input_constraint"] if constrained else None,
             mode=scenario.mode, hold_radius=s["hold_radius"], backend=s["backend"],
-            formulation=s["formulation"],
+            formulation=s["formulation"], certificate_tol=s["certificate_tol"], on_failure=s["on_failure"],
         )
         return BuiltController(sched, scenario.saturation == "limiter")
     ctrl = RMPC(
@@ -62,6 +63,9 @@ def _rmpc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCon
         hold_radius=s["hold_radius"],
         backend=s["backend"],
         formulation=s["formulation"],
+        certificate_tol=s["certificate_tol"],
+        on_failure=s["on_failure"],
+        **rmpc_kwargs(s),
     )
     return BuiltController(ctrl, scenario.saturation == "limiter")
 

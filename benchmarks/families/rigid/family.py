@@ -66,6 +66,7 @@ from benchmarks.core.family import (
 from benchmarks.core.metrics import AXES, compute_metrics, recovery
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms, changed_forms
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 
@@ -152,6 +153,24 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
             "an initial pitch below 90 deg (3-2-1 Euler angles are singular there)",
             f"pitch {math.degrees(attitude[1]):.1f} deg",
         )
+
+
+#: The forms of the RMPC on the 6 states of the satellite (roll, pitch, yaw and their rates).
+FORMS = RMPCForms(6)
+
+
+def _case_check(
+    values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
+) -> None:
+    """The forms with the case's bounds; none with the scheduled polytope (Kothare's LMIs only)."""
+    changed = changed_forms(settings)
+    if controller == "RMPC" and changed and values["kinematics"] == "scheduled":
+        expected = (
+            f"'single' or 'cover' with {name('settings')}.{changed[0]} (the scheduled RMPC solves "
+            "Kothare's LMIs only)"
+        )
+        raise ConfigError(name("kinematics"), expected, "'scheduled'")
+    FORMS.check_case(values, controller, settings, name)
 
 
 def _label(scenario: Any) -> str:
@@ -247,7 +266,11 @@ RIGID = PlantFamily(
     name="rigid",
     description="paper P's rigid satellite (3-2-1 Euler angles, inertia polytope), linear or nonlinear",
     fields=FIELDS,
-    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
+    controllers=controller_specs(
+        CONTROLLERS,
+        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        CONSTRAINED,
+    ),
     simulate=simulate_case,
     check=_check,
     label=_label,
@@ -255,4 +278,7 @@ RIGID = PlantFamily(
     zero_allowed=frozenset({"adaptation_gain", "mit_gain", "hold_radius"}),
     settings_check=settings_check,
     montecarlo=MonteCarlo(dims=3, sets=("true_inertia",), apply=_draw_inertia),
+    setting_checks=FORMS.setting_checks(),
+    quiet_settings=frozenset(FORM_DEFAULTS),
+    case_check=_case_check,
 )

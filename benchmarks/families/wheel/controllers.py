@@ -61,6 +61,7 @@ def _abftc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContr
 
 
 def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.rmpc_forms import rmpc_kwargs
     from rmpc import RMPC
 
     q, r = _weights(s)
@@ -73,6 +74,9 @@ def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContro
         input_constraint=s["input_constraint"] if constrained else None,
         resolve_threshold=s["resolve_threshold"],
         backend=s["backend"],
+        certificate_tol=s["certificate_tol"],
+        on_failure=s["on_failure"],
+        **rmpc_kwargs(s),
     )
     return BuiltController(_mapped(ctrl, "RMPC"), False)
 

@@ -81,6 +81,7 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import compute_metrics
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
@@ -360,11 +361,19 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
     return CaseResult(extra, metrics, trace)
 
 
+#: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
+FORMS = RMPCForms(6)
+
+
 WHEEL = PlantFamily(
     name="wheel",
     description="paper W's satellite with four reaction wheels and wheel faults (S1-S4)",
     fields=FIELDS,
-    controllers=controller_specs(CONTROLLERS, defaults.CONTROLLER_DEFAULTS, CONSTRAINED),
+    controllers=controller_specs(
+        CONTROLLERS,
+        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        CONSTRAINED,
+    ),
     simulate=simulate_case,
     check=_check,
     label=_label,
@@ -372,4 +381,7 @@ WHEEL = PlantFamily(
     zero_allowed=frozenset({"adaptation_gain", "leakage", "gamma_g", "gamma_theta"}),
     settings_check=settings_check,
     controller_defaults=lambda controller: {} if controller in CONSTRAINED else {"saturation": "limiter"},
+    setting_checks=FORMS.setting_checks(),
+    quiet_settings=frozenset(FORM_DEFAULTS),
+    case_check=FORMS.check_case,
 )

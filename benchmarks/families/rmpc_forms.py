@@ -1,0 +1,226 @@
+"""The robust MPC's forms as settings of a scenario: their defaults, their checks, the keyword arguments.
+
+:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by six keyword arguments,
+``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft`` and ``disturbance``, and takes
+``certificate_tol`` and ``on_failure``; a sweep file sets them as ``settings.<name>`` of a
+family's controller ``"RMPC"`` (every shipped family: :class:`RMPCForms` holds what a family
+needs, its state count and whether its RMPC has output bounds). Each value is checked by the
+Python constructor's own check (:func:`lmi.forms.options.form_options`), and the error names the
+sweep file's key path (``base.settings.soft.u``, ``grid.settings.lyapunov``) instead of the
+Python argument. The values TOML cannot write as Python does:
+
+- ``soft``: a table ``{u = w_u, y = w_y}`` (Python's dict);
+- ``disturbance``: a table ``{E = [[...], ...], w_max = w, lam = l}`` (``lam`` optional) or the
+  list ``[E, w_max]`` / ``[E, w_max, lam]`` (Python's tuple); ``E`` is ``n x q`` (``n`` the
+  controller's states) or a list of ``n`` numbers (one column);
+- ``saturation``: ``"auxiliary"``; Python's ``None`` (the default) is left out of the file.
+
+Each of them is left out of a case's record while it holds its default, so the records and case
+ids of the cases that do not set them are those they had before the forms were settings.
+
+Examples
+--------
+>>> from benchmarks.core.scenario import Scenario
+>>> sc = Scenario.from_dict({"controller": "RMPC", "settings": {"soft": {"u": 100}}})
+>>> dict(sc.settings["soft"]), "lyapunov" in sc.to_dict()["settings"]
+({'u': 100.0}, False)
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from toolkit_common.errors import ArgumentTypeError, ConfigError, InvalidArgumentError
+
+__all__ = ["FORM_DEFAULTS", "FORM_SETTINGS", "RMPCForms", "changed_forms", "rmpc_kwargs"]
+
+#: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
+FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
+    {"lyapunov": "common", "cost": "worst_case", "free_moves": 0, "saturation": None, "soft": None,
+     "disturbance": None}
+)
+#: Every setting of this module with its default: the forms and the solve's two options.
+FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
+    {**FORM_SETTINGS, "certificate_tol": 1e-7, "on_failure": "fallback"}
+)
+_DISTURBANCE_KEYS = ("E", "w_max", "lam")
+
+
+def _python_check(where: str, n_states: int, has_output: bool, **options: Any) -> Any:
+    """:func:`lmi.forms.options.form_options` on ``options`` alone, its errors named by ``where``."""
+    from lmi.forms.options import form_options
+
+    try:
+        return form_options(n_states=n_states, input_constraint="peak", has_output=has_output, **options)
+    except (InvalidArgumentError, ArgumentTypeError) as err:
+        raise ConfigError(_path(err.argument, where), err.expected, err.found) from None
+
+
+def _path(argument: str, where: str) -> str:
+    """The key path of a Python argument: ``soft['u']`` -> ``<where>.u``, ``disturbance E`` -> ``<where>.E``.
+    """
+    inner = re.match(r"^\w+(?:\[['\"]?(\w+)['\"]?\]| (\w+))?$", argument)
+    if inner is None:
+        return where
+    part = inner.group(1) or inner.group(2)
+    return f"{where}.{part}" if part else where
+
+
+def _lyapunov(value: Any, where: str, n: int, out: bool) -> str:
+    return _python_check(where, n, out, lyapunov=value).lyapunov
+
+
+def _cost(value: Any, where: str, n: int, out: bool) -> str:
+    return _python_check(where, n, out, cost=value).cost
+
+
+def _free_moves(value: Any, where: str, n: int, out: bool) -> int:
+    return _python_check(where, n, out, free_moves=value).free_moves
+
+
+def _saturation(value: Any, where: str, n: int, out: bool) -> str:
+    if value is None:
+        raise ConfigError(where, "'auxiliary' (leave the setting out for none)", "None")
+    return _python_check(where, n, out, saturation=value).saturation
+
+
+def _soft(value: Any, where: str, n: int, out: bool) -> Mapping[str, float]:
+    if not isinstance(value, Mapping):
+        raise ConfigError(where, "a table of weights {u = w_u, y = w_y}", repr(value))
+    weights = _python_check(where, n, out, soft=dict(value)).soft
+    return MappingProxyType(dict(weights))
+
+
+def _disturbance(value: Any, where: str, n: int, out: bool) -> Mapping[str, Any]:
+    if isinstance(value, Mapping):
+        for key in value:
+            if key not in _DISTURBANCE_KEYS:
+                raise ConfigError(f"{where}.{key}", "E, w_max or lam", "an unknown key")
+        for key in ("E", "w_max"):
+            if key not in value:
+                expected = f"{key} in the table {{E = [[...]], w_max = w}}"
+                raise ConfigError(f"{where}.{key}", expected, "nothing")
+        given: Any = (value["E"], value["w_max"]) + ((value["lam"],) if "lam" in value else ())
+    elif isinstance(value, list):
+        given = tuple(value)
+    else:
+        expected = "a table {E = [[...]], w_max = w, lam = l} or a list [E, w_max(, lam)]"
+        raise ConfigError(where, expected, repr(value))
+    dist = _python_check(where, n, out, disturbance=given).disturbance
+    table: dict[str, Any] = {"E": tuple(tuple(float(v) for v in row) for row in dist.E), "w_max": dist.w_max}
+    if dist.lam is not None:
+        table["lam"] = dist.lam
+    return MappingProxyType(table)
+
+
+def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
+    from rmpc.mpc.fallback import ON_FAILURE
+
+    if not isinstance(value, str) or value not in ON_FAILURE:
+        raise ConfigError(where, "one of " + ", ".join(repr(c) for c in ON_FAILURE), repr(value))
+    return value
+
+
+_CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
+    {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
+     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure}
+)
+
+
+def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The keyword arguments of :class:`rmpc.RMPC` that the form settings stand for."""
+    out = {key: settings[key] for key in ("lyapunov", "cost", "free_moves", "saturation")}
+    out["soft"] = None if settings["soft"] is None else dict(settings["soft"])
+    dist = settings["disturbance"]
+    out["disturbance"] = None if dist is None else (
+        (np.array(dist["E"]), dist["w_max"]) + ((dist["lam"],) if "lam" in dist else ())
+    )
+    return out
+
+
+def _no_output(values: Mapping[str, Any]) -> bool:
+    return False
+
+
+@dataclass(frozen=True)
+class RMPCForms:
+    """What a family's RMPC needs to take the forms as settings.
+
+    Attributes
+    ----------
+    n_states : int
+        The states of the family's RMPC (the rows of a disturbance's ``E``).
+    has_output : callable
+        ``has_output(values) -> bool``: whether the RMPC of a case (its scenario fields
+        ``values``) has output bounds (then ``soft`` may weigh ``y``).
+
+    Examples
+    --------
+    >>> forms = RMPCForms(6)
+    >>> dict(forms.setting_checks()["soft"]({"u": 10}, "settings.soft"))
+    {'u': 10.0}
+    """
+
+    n_states: int
+    has_output: Callable[[Mapping[str, Any]], bool] = _no_output
+
+    def setting_checks(self) -> Mapping[str, Callable[[Any, str], Any]]:
+        """The check of each form setting on its own (``check(value, where) -> normalised value``).
+
+        A setting alone is checked as if the RMPC had an input bound (``input_constraint="peak"``)
+        and, for ``soft``, output bounds if the family's RMPC can have them at all; the case check
+        (:meth:`check_case`) then checks it with the case's own bounds.
+        """
+        out = self.has_output is not _no_output
+
+        def bind(check: Callable[[Any, str, int, bool], Any]) -> Callable[[Any, str], Any]:
+            return lambda value, where: check(value, where, self.n_states, out)
+
+        return MappingProxyType({key: bind(check) for key, check in _CHECKS.items()})
+
+    def check_case(
+        self, values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
+    ) -> None:
+        """The forms' combinations, with the case's input bound (``saturation = "constraint"``).
+
+        Raises
+        ------
+        ConfigError
+            Naming the settings (and the field ``saturation``) that do not go together.
+        """
+        if controller != "RMPC" or not changed_forms(settings):
+            return
+        from lmi.forms.options import form_options
+
+        where = name("settings")
+        constrained = values["saturation"] == "constraint"
+        bound = settings["input_constraint"] if constrained else None
+        try:
+            form_options(
+                n_states=self.n_states, input_constraint=bound, has_output=self.has_output(values),
+                **rmpc_kwargs(settings),
+            )
+        except (InvalidArgumentError, ArgumentTypeError) as err:
+            parts = []
+            for part in err.argument.split(", "):
+                if part == "input_constraint":
+                    parts.append(f"{where}.input_constraint" if constrained else name("saturation"))
+                else:
+                    parts.append(_path(part, f"{where}.{part.split(' ')[0].split('[')[0]}"))
+            expected = err.expected
+            if not constrained and ("u_max" in expected or "input_constraint" in err.argument):
+                expected += " (the controller has an input bound with saturation = 'constraint')"
+                if name("saturation") not in parts:
+                    parts.append(name("saturation"))
+            raise ConfigError(", ".join(parts), expected, err.found) from None
+
+
+def changed_forms(settings: Mapping[str, Any]) -> list[str]:
+    """The form settings of ``settings`` that are not at their defaults (Kothare's problem)."""
+    return [key for key, default in FORM_SETTINGS.items() if settings.get(key, default) != default]
