@@ -16,8 +16,12 @@ __all__ = ["add_export_parser"]
 
 def _cmd_export_c(args: argparse.Namespace) -> int:
     from rmpc import export_c, load
+    from toolkit_common.errors import ControllerFileError, InvalidArgumentError
 
-    controller = load(args.controller)
+    try:
+        controller = load(args.controller)
+    except ControllerFileError as err:  # the option the user gave, with the file's own complaint
+        raise InvalidArgumentError("--controller", err.expected, f"{err.found} ({err.argument})") from None
     result = export_c(controller, args.out)
     for path in result.paths:
         print(f"wrote {path} ({result.sizes[path.name]} bytes)")

@@ -38,10 +38,14 @@ def test_the_command_writes_what_export_c_writes_for_the_loaded_controller(kind,
 def test_bad_files_and_unexportable_controllers_end_with_status_2(tmp_path: Path, capsys) -> None:
     out = str(tmp_path / "out")
     assert main(["export", "c", "--controller", str(tmp_path / "missing.rmpc"), "--out", out]) == 2
-    assert "missing.rmpc" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "missing.rmpc" in err and "--controller" in err  # the option and the file
     (tmp_path / "bad.rmpc").write_text("{ not json")
     assert main(["export", "c", "--controller", str(tmp_path / "bad.rmpc"), "--out", out]) == 2
     assert "bad.rmpc" in capsys.readouterr().err
+    assert main(["export", "c", "--controller", str(tmp_path), "--out", out]) == 2  # a folder
+    err = capsys.readouterr().err
+    assert "--controller" in err and "directory" in err and str(tmp_path) in err
     vertex = RMPC(_plant(), np.diag([1.0, 0.0]), [[2e-5]], u_max=2.0, lyapunov="vertex")
     saved = vertex.save(tmp_path / "vertex.rmpc")
     assert main(["export", "c", "--controller", str(saved), "--out", out]) == 2
