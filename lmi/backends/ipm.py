@@ -655,18 +655,23 @@ class IPMKothare(KothareBackend):
                              time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
-        if res.status == "infeasible":
-            cert = self.farkas_check(res.Z, x, u_max, y_max, *_nest_args(outer))
+        return self._raw(res.status, res.solver_status, res.x, res.Z, res.iterations, elapsed,
+                         (x, u_max, y_max, *_nest_args(outer)))
+
+    def _raw(self, status: str, word: str, x_vec: np.ndarray, z_blocks: list[np.ndarray], iterations: int,
+             elapsed: float, at: tuple[np.ndarray, ...]) -> RawResult:
+        """The :class:`RawResult` of one run (numba's or the C core's): an ``"infeasible"`` run's
+        ray checked by :meth:`farkas_check` at ``at`` (state, bounds and outer ``Q``), else ``Q``, ``Y``
+        and gamma from the variables ``x_vec``."""
+        if status == INFEASIBLE:
+            cert = self.farkas_check(z_blocks, *at)
             if cert.ok:
-                return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
+                return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, iterations, elapsed,
                                  infeasibility=cert)
-            return RawResult(NUMERICAL_ERROR, "infeasible (unchecked)", np.nan, None, None, res.iterations,
+            return RawResult(NUMERICAL_ERROR, "infeasible (unchecked)", np.nan, None, None, iterations,
                              elapsed)
-        q_mat, y_mat = self.conic.variables(res.x)
-        return RawResult(
-            res.status, res.solver_status, self.gamma(res.x[0]), q_mat, y_mat,
-            res.iterations, elapsed,
-        )
+        q_mat, y_mat = self.conic.variables(x_vec)
+        return RawResult(status, word, self.gamma(x_vec[0]), q_mat, y_mat, iterations, elapsed)
 
     def _solve_core(self, x: np.ndarray, u_max: np.ndarray, y_max: np.ndarray, start: float) -> RawResult:
         """:meth:`_solve_ipm` by the C core: the same iterations, the same result. A solve that does
@@ -678,12 +683,4 @@ class IPMKothare(KothareBackend):
         status = SOLVER_STATUS_MAP[res.word]
         if status != OPTIMAL:
             self._update_blocks(x, u_max, y_max)
-        if status == INFEASIBLE:
-            cert = self.farkas_check(res.Z, x, u_max, y_max)
-            if cert.ok:
-                return RawResult(INFEASIBLE, "infeasible", np.nan, None, None, res.iterations, elapsed,
-                                 infeasibility=cert)
-            return RawResult(NUMERICAL_ERROR, "infeasible (unchecked)", np.nan, None, None, res.iterations,
-                             elapsed)
-        q_mat, y_mat = self.conic.variables(res.x)
-        return RawResult(status, res.word, self.gamma(res.x[0]), q_mat, y_mat, res.iterations, elapsed)
+        return self._raw(status, res.word, res.x, res.Z, res.iterations, elapsed, (x, u_max, y_max))
