@@ -123,3 +123,66 @@ def test_solver_options_left_out_keep_the_record_and_the_case_id():
     assert numba.case_id != plain.case_id
     again = Scenario.from_dict(json.loads(json.dumps(numba.to_dict())))
     assert again.case_id == numba.case_id and again == numba
+
+
+class _Captured(Exception):
+    """Raised by the spy once it has the constructor's keywords (the table is not designed)."""
+
+
+@pytest.mark.parametrize(("family", "fields"), [("rigid", {}), ("flexible", {"saturation": "constraint"})])
+def test_offline_rmpc_cost_is_reachable_and_reaches_the_constructor(family, fields, monkeypatch):
+    import rmpc.mpc.offline as offline
+
+    seen = []
+
+    def spy(self, *args, **kwargs):
+        seen.append(kwargs.get("cost"))
+        raise _Captured
+
+    (scenario,) = expand(parse_sweep(
+        {"base": {"family": family, "controller": "OfflineRMPC", **fields, "settings": {"cost": "nominal"}}}
+    ))
+    assert scenario.to_dict()["settings"]["cost"] == "nominal"
+    plain = Scenario.from_dict({"family": family, "controller": "OfflineRMPC"})
+    assert "cost" not in plain.to_dict()["settings"]
+    monkeypatch.setattr(offline.OfflineRMPC, "__init__", spy)
+    fam = scenario.plant_family
+    with pytest.raises(_Captured):
+        fam.simulate(scenario, fam.effective_settings(scenario.controller, scenario.settings), False)
+    assert seen == ["nominal"]
+
+
+def test_offline_rmpc_nominal_cost_from_a_sweep_runs_as_the_python_controller_does():
+    from benchmarks.core.metrics import compute_metrics
+    from benchmarks.core.runner import run_scenario
+    from rmpc import OfflineRMPC, simulate
+
+    settings = {"cost": "nominal", "n_ellipsoids": 3}
+    (scenario,) = expand(parse_sweep(
+        {"base": {"controller": "OfflineRMPC", "plant": "linear", "duration": 0.03, "settings": settings}}
+    ))
+    record = run_scenario(scenario)
+    sat = RigidSatellite.paper_p()
+    poly = sat.polytope(sat.initial_state(), 0.01, 0.3, "scalar")
+    d = CONTROLLER_DEFAULTS["OfflineRMPC"]
+
+    def metrics_of(cost):
+        ctrl = OfflineRMPC(poly, np.diag(d["Q_diag"]), np.diag(d["R_diag"]), u_max=1.0,
+                           input_constraint="ellipsoid", n_ellipsoids=3, cost=cost)
+        return compute_metrics(simulate(ctrl, poly, sat.initial_state(), duration=0.03), 1.0, 0.02)
+
+    nominal, worst = metrics_of("nominal"), metrics_of("worst_case")
+    for key in ("sum_abs_err", "max_abs_u"):
+        np.testing.assert_allclose(_flat(record["metrics"][key]), _flat(nominal[key]), rtol=1e-9, atol=1e-12)
+    assert not np.allclose(_flat(nominal["max_abs_u"]), _flat(worst["max_abs_u"]), rtol=1e-6)
+
+
+def _flat(value):
+    return [value[k] for k in sorted(value)] if isinstance(value, dict) else value
+
+
+@pytest.mark.parametrize("value", ["average", 3])
+def test_a_bad_offline_rmpc_cost_is_refused_naming_the_key(value):
+    with pytest.raises(ConfigError) as info:
+        parse_sweep({"base": {"controller": "OfflineRMPC", "settings": {"cost": value}}})
+    assert info.value.argument == "base.settings.cost" and "'nominal'" in info.value.expected
