@@ -13,7 +13,10 @@ Python argument. The values TOML cannot write as Python does:
 - ``disturbance``: a table ``{E = [[...], ...], w_max = w, lam = l}`` (``lam`` optional) or the
   list ``[E, w_max]`` / ``[E, w_max, lam]`` (Python's tuple); ``E`` is ``n x q`` (``n`` the
   controller's states) or a list of ``n`` numbers (one column);
-- ``saturation``: ``"auxiliary"``; Python's ``None`` (the default) is left out of the file.
+- ``saturation``: ``"auxiliary"``; Python's ``None`` (the default) is left out of the file;
+- ``solver_options``: a table of the back-end's settings (``{core = "numba", max_iter = 60}``),
+  checked by :class:`rmpc.RMPC` itself with the case's ``backend``
+  (:func:`check_solver_options`), its error naming ``settings.solver_options.<name>``.
 
 Each of them is left out of a case's record while it holds its default, so the records and case
 ids of the cases that do not set them are those they had before the forms were settings.
@@ -38,16 +41,18 @@ import numpy as np
 
 from toolkit_common.errors import ArgumentTypeError, ConfigError, InvalidArgumentError
 
-__all__ = ["FORM_DEFAULTS", "FORM_SETTINGS", "RMPCForms", "changed_forms", "rmpc_kwargs"]
+__all__ = [
+    "FORM_DEFAULTS", "FORM_SETTINGS", "RMPCForms", "changed_forms", "check_solver_options", "rmpc_kwargs",
+]
 
 #: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
 FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
     {"lyapunov": "common", "cost": "worst_case", "free_moves": 0, "saturation": None, "soft": None,
      "disturbance": None}
 )
-#: Every setting of this module with its default: the forms and the solve's two options.
+#: Every setting of this module with its default: the forms and the solve's three options.
 FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
-    {**FORM_SETTINGS, "certificate_tol": 1e-7, "on_failure": "fallback"}
+    {**FORM_SETTINGS, "certificate_tol": 1e-7, "on_failure": "fallback", "solver_options": None}
 )
 _DISTURBANCE_KEYS = ("E", "w_max", "lam")
 
@@ -119,6 +124,49 @@ def _disturbance(value: Any, where: str, n: int, out: bool) -> Mapping[str, Any]
     return MappingProxyType(table)
 
 
+def _solver_options(value: Any, where: str, n: int, out: bool) -> Mapping[str, Any]:
+    """A table of the back-end's settings; its names and values are checked with the case's backend."""
+    if not isinstance(value, Mapping):
+        expected = "a table of the backend's settings (e.g. {core = \"numba\"} for the ipm)"
+        raise ConfigError(where, expected, repr(value))
+    for key, item in value.items():
+        if isinstance(item, Mapping | list):
+            raise ConfigError(f"{where}.{key}", "a number, a string, true or false", repr(item))
+    return MappingProxyType(dict(value))
+
+
+def check_solver_options(settings: Mapping[str, Any], n_states: int, where: str) -> None:
+    """``settings.solver_options`` checked by :class:`rmpc.RMPC` itself with the case's ``backend``.
+
+    An RMPC is built on a one-vertex stand-in of the case's ``n_states`` states (the check of the
+    options does not depend on the model), with the forms' problem when a form is set, as the
+    case's RMPC is; its error names the key path ``<where>.solver_options.<name>``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the option the backend refuses.
+    """
+    options = settings.get("solver_options")
+    if options is None:
+        return
+    from models import PolytopicModel
+    from rmpc.mpc.robust_mpc import RMPC
+
+    stand_in = PolytopicModel([(0.5 * np.eye(n_states), np.ones((n_states, 1)))], dt=1.0)
+    form = {"lyapunov": "vertex"} if changed_forms(settings) else {}
+    try:
+        RMPC(stand_in, np.eye(n_states), np.eye(1), u_max=[1.0], input_constraint="peak",
+             backend=settings["backend"], solver_options=dict(options), **form)
+    except (InvalidArgumentError, ArgumentTypeError) as err:
+        if not err.argument.startswith("solver_options"):
+            return  # not the options': the case's own build reports it
+        raise ConfigError(
+            _path(err.argument, f"{where}.solver_options"),
+            f"{err.expected} (backend {settings['backend']!r})", err.found,
+        ) from None
+
+
 def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
     from rmpc.mpc.fallback import ON_FAILURE
 
@@ -129,7 +177,7 @@ def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
 
 _CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
     {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
-     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure}
+     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options}
 )
 
 
@@ -141,6 +189,8 @@ def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
     out["disturbance"] = None if dist is None else (
         (np.array(dist["E"]), dist["w_max"]) + ((dist["lam"],) if "lam" in dist else ())
     )
+    options = settings.get("solver_options")
+    out["solver_options"] = None if options is None else dict(options)
     return out
 
 
@@ -194,7 +244,10 @@ class RMPCForms:
         ConfigError
             Naming the settings (and the field ``saturation``) that do not go together.
         """
-        if controller != "RMPC" or not changed_forms(settings):
+        if controller != "RMPC":
+            return
+        check_solver_options(settings, self.n_states, name("settings"))
+        if not changed_forms(settings):
             return
         from lmi.forms.options import form_options
 
@@ -204,7 +257,7 @@ class RMPCForms:
         try:
             form_options(
                 n_states=self.n_states, input_constraint=bound, has_output=self.has_output(values),
-                **rmpc_kwargs(settings),
+                **{k: v for k, v in rmpc_kwargs(settings).items() if k != "solver_options"},
             )
         except (InvalidArgumentError, ArgumentTypeError) as err:
             parts = []

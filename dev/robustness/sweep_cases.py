@@ -3,7 +3,8 @@
 Each form option of :class:`rmpc.RMPC` (``lyapunov``, ``cost``, ``free_moves``, ``saturation``,
 ``soft``, ``disturbance``, ``certificate_tol``, ``on_failure``) is tried in a sweep file's
 ``settings`` with a good value (the tiny sweep must run: ``either``) and with bad values (refused
-with exit 2, the message naming the key path ``base.settings.<name>`` down to the wrong entry).
+with exit 2, the message naming the key path ``base.settings.<name>`` down to the wrong entry);
+so are RMPC's ``solver_options`` and OfflineRMPC's ``cost``.
 """
 
 from __future__ import annotations
@@ -80,6 +81,27 @@ _CASES: tuple[tuple[str, str, tuple[str, ...], Expect], ...] = (
     ("on_failure bad", 'on_failure = "ignore"', ("settings.on_failure: expected one of",), "error"),
     ("certificate_tol 0", "certificate_tol = 0.0", ("settings.certificate_tol: expected a number > 0",),
      "error"),
+    ("solver_options core numba", 'solver_options = {core = "numba", max_iter = 60}', _MUST_RUN, "either"),
+    ("solver_options core bad", 'solver_options = {core = "fortran"}',
+     ("settings.solver_options.core: expected one of",), "error"),
+    ("solver_options unknown", "solver_options = {bogus = 1}",
+     ("settings.solver_options: expected ipm settings",), "error"),
+    ("solver_options max_iter 0", "solver_options = {max_iter = 0}",
+     ("settings.solver_options.max_iter: expected an integer > 0",), "error"),
+    ("solver_options number", "solver_options = 5", ("settings.solver_options: expected a table",), "error"),
+    ("solver_options nested", "solver_options = {core = [1]}", ("settings.solver_options.core: expected",),
+     "error"),
+    ("solver_options clarabel core", 'backend = "clarabel"\nsolver_options = {core = "c"}',
+     ("settings.solver_options: expected clarabel settings",), "error"),
+)
+
+OFFLINE_SWEEP = FORM_SWEEP.replace('controller = "RMPC"', 'controller = "OfflineRMPC"')
+"""One OfflineRMPC case of three samples on the linear satellite, with ``{settings}`` in its settings."""
+
+#: (label, settings lines, names a clear refusal contains, expect) of OfflineRMPC
+_OFFLINE_CASES: tuple[tuple[str, str, tuple[str, ...], Expect], ...] = (
+    ("cost nominal", 'cost = "nominal"\nn_ellipsoids = 3', _MUST_RUN, "either"),
+    ("cost bad", 'cost = "average"', ("settings.cost: expected one of",), "error"),
 )
 
 
@@ -128,6 +150,18 @@ def sweep_probes() -> list[Probe]:
             kind="sweep form",
         )
         for label, body, names, expect in _CASES
+    ]
+    probes += [
+        Probe(
+            f"cli:sweep OfflineRMPC {label}",
+            "cli",
+            names,
+            argv=SWEEP_ARGV,
+            setup=_write("sweep.toml", OFFLINE_SWEEP.format(settings=body)),
+            expect=expect,
+            kind="sweep form",
+        )
+        for label, body, names, expect in _OFFLINE_CASES
     ]
     probes += [
         Probe(

@@ -305,6 +305,7 @@ def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCont
         n_ellipsoids=s["n_ellipsoids"],
         shrink=s["shrink"],
         formulation=s["formulation"],
+        cost=s["cost"],
     )
     law = _mapped(ctrl, m, "OfflineRMPC")
     if scenario.handover_deg is not None:

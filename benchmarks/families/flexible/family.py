@@ -345,7 +345,12 @@ FLEXIBLE = PlantFamily(
     fields=FIELDS,
     controllers=controller_specs(
         CONTROLLERS,
-        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        {
+            **defaults.CONTROLLER_DEFAULTS,
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
+            # Kothare's or the nominal cost of the table (left out of a record at its default)
+            "OfflineRMPC": {**defaults.CONTROLLER_DEFAULTS["OfflineRMPC"], "cost": FORM_DEFAULTS["cost"]},
+        },
         CONSTRAINED,
     ),
     simulate=simulate_case,

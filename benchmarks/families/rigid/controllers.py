@@ -146,6 +146,7 @@ def _offline(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> Built
         n_ellipsoids=s["n_ellipsoids"],
         shrink=s["shrink"],
         interpolate=s["interpolate"],
+        cost=s["cost"],
     )
     return BuiltController(ctrl, scenario.saturation == "limiter")
 

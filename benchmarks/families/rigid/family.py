@@ -162,12 +162,14 @@ FORMS = RMPCForms(6)
 def _case_check(
     values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
 ) -> None:
-    """The forms with the case's bounds; none with the scheduled polytope (Kothare's LMIs only)."""
+    """The forms with the case's bounds; none, nor solver options, with the scheduled polytope."""
     changed = changed_forms(settings)
+    if settings.get("solver_options") is not None:
+        changed.append("solver_options")
     if controller == "RMPC" and changed and values["kinematics"] == "scheduled":
         expected = (
             f"'single' or 'cover' with {name('settings')}.{changed[0]} (the scheduled RMPC solves "
-            "Kothare's LMIs only)"
+            "Kothare's LMIs with the default solver options only)"
         )
         raise ConfigError(name("kinematics"), expected, "'scheduled'")
     FORMS.check_case(values, controller, settings, name)
@@ -268,7 +270,12 @@ RIGID = PlantFamily(
     fields=FIELDS,
     controllers=controller_specs(
         CONTROLLERS,
-        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        {
+            **defaults.CONTROLLER_DEFAULTS,
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
+            # Kothare's or the nominal cost of the table (left out of a record at its default)
+            "OfflineRMPC": {**defaults.CONTROLLER_DEFAULTS["OfflineRMPC"], "cost": FORM_DEFAULTS["cost"]},
+        },
         CONSTRAINED,
     ),
     simulate=simulate_case,
