@@ -315,3 +315,23 @@ def test_sigint_stops_rmpc_bench_methods(tmp_path):
     proc = _start([*rmpc, *argv], out)
     before = _interrupt_after_first_case(proc, out, 2.0)  # in the disturbance case (about 9 s)
     _assert_interrupted(proc, out, before)
+
+
+def test_in_process_each_result_is_taken_before_the_next_case_runs(monkeypatch):
+    """``--workers 0``: a case's result reaches ``on_result`` (and so the store) before the next case
+    starts; with two cases submitted at once, an interrupt during the second would lose the first."""
+    from benchmarks.core import execute as execute_module
+    from benchmarks.core.executors import InlineExecutor
+
+    log: list[str] = []
+
+    def fake_run_case(payload):
+        log.append(f"run {payload['key']}")
+        return {"ok": True}
+
+    monkeypatch.setattr(execute_module, "run_case", fake_run_case)
+    tasks = [execute_module.Task(k, {"key": k}) for k in ("a", "b", "c")]
+    outcome = execute_module.execute(
+        tasks, InlineExecutor(), lambda task, _: log.append(f"stored {task.key}"), notice=lambda _: None)
+    assert outcome.finished == ["a", "b", "c"]
+    assert log == ["run a", "stored a", "run b", "stored b", "run c", "stored c"]

@@ -84,7 +84,8 @@ def execute(
     queue: deque[Task] = deque(tasks)
     inflight: dict[Any, Task] = {}
     outcome = ExecOutcome()
-    limit = 2 * max(1, executor.workers)
+    # two cases per worker keep a pool busy; an executor may ask for fewer (InlineExecutor: one)
+    limit = getattr(executor, "in_flight", 2 * max(1, executor.workers))
     current: Task | None = None  # submitted, not yet in flight (an in-process case runs here)
     with Interrupts(notice) as interrupts:
         try:

@@ -158,6 +158,10 @@ class InlineExecutor:
     """Runs each case in the calling process when it is submitted (``--workers 0``)."""
 
     workers = 1
+    #: cases submitted before their results are taken: one, so that a case's result is stored
+    #: before the next case runs (a second case run first would hold the first's result unstored,
+    #: and an interrupt during it would lose a finished case)
+    in_flight = 1
     description = "in-process (no workers)"
 
     def submit(self, fn: Callable[[Any], Any], payload: Any) -> cf.Future:
