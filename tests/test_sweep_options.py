@@ -186,3 +186,134 @@ def test_a_bad_offline_rmpc_cost_is_refused_naming_the_key(value):
     with pytest.raises(ConfigError) as info:
         parse_sweep({"base": {"controller": "OfflineRMPC", "settings": {"cost": value}}})
     assert info.value.argument == "base.settings.cost" and "'nominal'" in info.value.expected
+
+
+@pytest.mark.parametrize(
+    ("family", "fields"), [("rigid", {"plant": "linear"}), ("wheel", {"fault_kind": "none"})]
+)
+def test_gipc_solver_options_reach_the_constructor_and_the_case_runs(family, fields, monkeypatch):
+    import rmpc.mpc.gipc as gipc
+    from benchmarks.core.runner import run_scenario
+
+    seen = []
+    init = gipc.GIPC.__init__
+
+    def spy(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        seen.append((kwargs.get("solver_options"), self.backend.settings.max_iter))
+
+    monkeypatch.setattr(gipc.GIPC, "__init__", spy)
+    base = {"family": family, "controller": "GIPC", **fields}
+    dt = Scenario.from_dict(base).dt
+    settings = {"backend": "osqp", "solver_options": {"max_iter": 1234}, "Np": 10}
+    (scenario,) = expand(parse_sweep({"base": {**base, "duration": 2 * dt, "settings": settings}}))
+    assert scenario.to_dict()["settings"]["solver_options"] == {"max_iter": 1234}
+    record = run_scenario(scenario)
+    assert seen[-1] == ({"max_iter": 1234}, 1234)
+    assert record["status"] == "done", record.get("error")
+
+
+#: (backend, options, the sweep's key path)
+BAD_GIPC = [
+    ("proxqp", {"eps": 1e-6}, "base.settings.solver_options"),
+    ("proxqp", {"eps_abs": -1.0}, "base.settings.solver_options.eps_abs"),
+    ("osqp", {"max_iter": 0}, "base.settings.solver_options.max_iter"),
+]
+
+
+@pytest.mark.parametrize("family", ["rigid", "wheel"])
+@pytest.mark.parametrize(("backend", "options", "path"), BAD_GIPC, ids=[str(b[1]) for b in BAD_GIPC])
+def test_a_bad_gipc_solver_option_is_refused_with_pythons_message_at_the_key_path(
+    family, backend, options, path
+):
+    from models import PolytopicModel
+    from rmpc import GIPC
+
+    stand_in = PolytopicModel([(0.5 * np.eye(2), np.ones((2, 1)))], dt=1.0)
+    with pytest.raises(ToolkitError) as in_python:
+        GIPC(stand_in, Np=3, Nc=1, backend=backend, solver_options=options)
+    settings = {"backend": backend, "solver_options": options}
+    with pytest.raises(ConfigError) as in_sweep:
+        parse_sweep({"base": {"family": family, "controller": "GIPC", "settings": settings}})
+    assert in_sweep.value.argument == path
+    assert in_sweep.value.expected.startswith(in_python.value.expected) and backend in in_sweep.value.expected
+    assert in_sweep.value.found == in_python.value.found
+
+
+@pytest.mark.parametrize("family", ["rigid", "wheel"])
+def test_gipc_solver_options_left_out_keep_the_record_and_the_case_id(family):
+    plain = Scenario.from_dict({"family": family, "controller": "GIPC"})
+    assert "solver_options" not in plain.to_dict()["settings"]
+    settings = {"solver_options": {"max_iter": 50}}
+    tuned = Scenario.from_dict({"family": family, "controller": "GIPC", "settings": settings})
+    assert tuned.case_id != plain.case_id
+    again = Scenario.from_dict(json.loads(json.dumps(tuned.to_dict())))
+    assert again.case_id == tuned.case_id and again == tuned
+
+
+OFFLINE_FAMILIES = [("rigid", {}), ("flexible", {"saturation": "constraint"})]
+
+
+@pytest.mark.parametrize(("family", "fields"), OFFLINE_FAMILIES)
+def test_offline_rmpc_solve_options_reach_the_constructor(family, fields, monkeypatch):
+    import rmpc.mpc.offline as offline
+
+    seen = []
+
+    def spy(self, *args, **kwargs):
+        seen.append({k: kwargs.get(k) for k in ("backend", "solver_options", "certificate_tol")})
+        raise _Captured
+
+    settings = {"backend": "clarabel", "solver_options": {"max_iter": 77}, "certificate_tol": 1e-6}
+    (scenario,) = expand(parse_sweep(
+        {"base": {"family": family, "controller": "OfflineRMPC", **fields, "settings": settings}}
+    ))
+    assert {k: scenario.to_dict()["settings"][k] for k in settings} == settings
+    monkeypatch.setattr(offline.OfflineRMPC, "__init__", spy)
+    fam = scenario.plant_family
+    with pytest.raises(_Captured):
+        fam.simulate(scenario, fam.effective_settings(scenario.controller, scenario.settings), False)
+    assert seen == [settings]
+
+
+@pytest.mark.parametrize("family", ["rigid", "flexible"])
+def test_offline_rmpc_solve_options_left_out_keep_the_record_and_the_case_id(family):
+    plain = Scenario.from_dict({"family": family, "controller": "OfflineRMPC"})
+    assert not {"backend", "solver_options", "certificate_tol"} & set(plain.to_dict()["settings"])
+    rmpc = Scenario.from_dict({"family": family, "controller": "RMPC"})
+    assert rmpc.to_dict()["settings"]["backend"] == "ipm"  # the RMPC's backend stays written
+    settings = {"certificate_tol": 1e-6}
+    tuned = Scenario.from_dict({"family": family, "controller": "OfflineRMPC", "settings": settings})
+    assert tuned.case_id != plain.case_id
+    again = Scenario.from_dict(json.loads(json.dumps(tuned.to_dict())))
+    assert again.case_id == tuned.case_id and again == tuned
+
+
+#: (settings, the sweep's key path)
+BAD_OFFLINE = [
+    ({"backend": "proxqp"}, "base.settings.backend"),
+    ({"certificate_tol": -1.0}, "base.settings.certificate_tol"),
+    ({"solver_options": {"core": "fortran"}}, "base.settings.solver_options.core"),
+    ({"solver_options": {"bogus": 1}}, "base.settings.solver_options"),
+    ({"backend": "clarabel", "solver_options": {"core": "numba"}}, "base.settings.solver_options"),
+]
+
+
+@pytest.mark.parametrize(("family", "fields"), OFFLINE_FAMILIES)
+@pytest.mark.parametrize(("settings", "path"), BAD_OFFLINE, ids=[str(b[0]) for b in BAD_OFFLINE])
+def test_a_bad_offline_rmpc_solve_option_is_refused_with_pythons_message_at_the_key_path(
+    family, fields, settings, path
+):
+    from models import PolytopicModel
+    from rmpc import OfflineRMPC
+
+    stand_in = PolytopicModel([(0.5 * np.eye(2), np.ones((2, 1)))], dt=1.0)
+    with pytest.raises(ToolkitError) as in_python:
+        OfflineRMPC(stand_in, np.eye(2), np.eye(1), u_max=1.0, **settings)
+    with pytest.raises(ConfigError) as in_sweep:
+        parse_sweep({"base": {"family": family, "controller": "OfflineRMPC", **fields, "settings": settings}})
+    assert in_sweep.value.argument == path and in_sweep.value.found == in_python.value.found
+    if path == "base.settings.backend":  # the family's choices may refuse it first: OfflineRMPC's three
+        assert all(f"'{name}'" in in_sweep.value.expected for name in ("ipm", "clarabel", "cvxpy"))
+    else:
+        assert in_sweep.value.expected.startswith(in_python.value.expected)

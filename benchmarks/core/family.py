@@ -204,7 +204,9 @@ class PlantFamily:
     quiet_settings : frozenset of str
         Settings left out of a case's record (and of its case id) while they hold their default,
         so that a setting added later keeps the records and case ids of the cases that do not
-        set it (as :attr:`Field.written_at_default` does for fields).
+        set it (as :attr:`Field.written_at_default` does for fields). ``"<controller>.<setting>"``
+        quiets the setting of that controller only (``"OfflineRMPC.backend"``: the RMPC's
+        ``backend`` stays written).
     case_check : callable, optional
         ``case_check(values, controller, settings, name)``: checks between fields and settings
         (a form that needs an input bound the scenario does not give); ``name(key)`` gives the

@@ -229,7 +229,7 @@ class Scenario:
         settings = {
             k: _plain(v)
             for k, v in sorted(self._settings.items())
-            if k not in fam.quiet_settings or v != defaults.get(k)
+            if not {k, f"{self._controller}.{k}"} & fam.quiet_settings or v != defaults.get(k)
         }
         for key, value in [*first, ("controller", self._controller), ("settings", settings), *rest]:
             out[key] = _plain(value)

@@ -306,6 +306,9 @@ def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCont
         shrink=s["shrink"],
         formulation=s["formulation"],
         cost=s["cost"],
+        backend=s["backend"],
+        solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
+        certificate_tol=s["certificate_tol"],
     )
     law = _mapped(ctrl, m, "OfflineRMPC")
     if scenario.handover_deg is not None:

@@ -67,6 +67,7 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import step_timing
+from benchmarks.families.controller_options import OFFLINE_DEFAULTS, OFFLINE_QUIET, check_offline_options
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import (
     CONSTRAINED,
@@ -339,6 +340,16 @@ def _handover_time(ctrl: Any, traj: Any) -> float | None:
 FORMS = RMPCForms(14, has_output=lambda values: values["modal_bound"] is not None)
 
 
+
+def _case_check(
+    values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
+) -> None:
+    """The RMPC's forms with the case's bounds; OfflineRMPC's solve options by its constructor."""
+    if controller == "OfflineRMPC":
+        check_offline_options(settings, name("settings"))
+    FORMS.check_case(values, controller, settings, name)
+
+
 FLEXIBLE = PlantFamily(
     name="flexible",
     description="paper V's flexible satellite (4 modes, PZT channel): the V-slew, steady error, small slew",
@@ -349,7 +360,11 @@ FLEXIBLE = PlantFamily(
             **defaults.CONTROLLER_DEFAULTS,
             "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
             # Kothare's or the nominal cost of the table (left out of a record at its default)
-            "OfflineRMPC": {**defaults.CONTROLLER_DEFAULTS["OfflineRMPC"], "cost": FORM_DEFAULTS["cost"]},
+            "OfflineRMPC": {
+                **defaults.CONTROLLER_DEFAULTS["OfflineRMPC"],
+                "cost": FORM_DEFAULTS["cost"],
+                **OFFLINE_DEFAULTS,  # backend, solver_options, certificate_tol
+            },
         },
         CONSTRAINED,
     ),
@@ -361,6 +376,6 @@ FLEXIBLE = PlantFamily(
     settings_check=settings_check,
     controller_defaults=_controller_defaults,
     setting_checks=FORMS.setting_checks(),
-    quiet_settings=frozenset(FORM_DEFAULTS),
-    case_check=FORMS.check_case,
+    quiet_settings=frozenset(FORM_DEFAULTS) | OFFLINE_QUIET,
+    case_check=_case_check,
 )

@@ -128,6 +128,7 @@ def _gipc(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCon
         u_max=scenario.u_max if constrained else None,
         du_max=s["du_max"] if constrained else None,
         backend=s["backend"],
+        solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
     )
     return BuiltController(ctrl, scenario.saturation == "limiter")
 
@@ -147,6 +148,9 @@ def _offline(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> Built
         shrink=s["shrink"],
         interpolate=s["interpolate"],
         cost=s["cost"],
+        backend=s["backend"],
+        solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
+        certificate_tol=s["certificate_tol"],
     )
     return BuiltController(ctrl, scenario.saturation == "limiter")
 

@@ -64,6 +64,12 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import AXES, compute_metrics, recovery
+from benchmarks.families.controller_options import (
+    OFFLINE_DEFAULTS,
+    OFFLINE_QUIET,
+    check_gipc_solver_options,
+    check_offline_options,
+)
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
 from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms, changed_forms
@@ -172,6 +178,10 @@ def _case_check(
             "Kothare's LMIs with the default solver options only)"
         )
         raise ConfigError(name("kinematics"), expected, "'scheduled'")
+    if controller == "GIPC":
+        check_gipc_solver_options(settings, name("settings"))
+    if controller == "OfflineRMPC":
+        check_offline_options(settings, name("settings"))
     FORMS.check_case(values, controller, settings, name)
 
 
@@ -274,7 +284,13 @@ RIGID = PlantFamily(
             **defaults.CONTROLLER_DEFAULTS,
             "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
             # Kothare's or the nominal cost of the table (left out of a record at its default)
-            "OfflineRMPC": {**defaults.CONTROLLER_DEFAULTS["OfflineRMPC"], "cost": FORM_DEFAULTS["cost"]},
+            "OfflineRMPC": {
+                **defaults.CONTROLLER_DEFAULTS["OfflineRMPC"],
+                "cost": FORM_DEFAULTS["cost"],
+                **OFFLINE_DEFAULTS,  # backend, solver_options, certificate_tol
+            },
+            # the QP back-end's settings (left out of a record at their default, None)
+            "GIPC": {**defaults.CONTROLLER_DEFAULTS["GIPC"], "solver_options": None},
         },
         CONSTRAINED,
     ),
@@ -286,6 +302,6 @@ RIGID = PlantFamily(
     settings_check=settings_check,
     montecarlo=MonteCarlo(dims=3, sets=("true_inertia",), apply=_draw_inertia),
     setting_checks=FORMS.setting_checks(),
-    quiet_settings=frozenset(FORM_DEFAULTS),
+    quiet_settings=frozenset(FORM_DEFAULTS) | OFFLINE_QUIET,
     case_check=_case_check,
 )

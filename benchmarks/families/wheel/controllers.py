@@ -115,6 +115,7 @@ def _gipc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContro
         u_max=scenario.u_max if constrained else None,
         du_max=s["du_max"] if constrained else None,
         backend=s["backend"],
+        solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
     )
     return BuiltController(_mapped(ctrl, "GIPC"), False)
 

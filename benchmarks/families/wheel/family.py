@@ -81,6 +81,7 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import compute_metrics
+from benchmarks.families.controller_options import check_gipc_solver_options
 from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
@@ -365,13 +366,27 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 FORMS = RMPCForms(6)
 
 
+def _case_check(
+    values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
+) -> None:
+    """The RMPC's forms with the case's bounds; GIPC's solver options with the case's backend."""
+    if controller == "GIPC":
+        check_gipc_solver_options(settings, name("settings"))
+    FORMS.check_case(values, controller, settings, name)
+
+
 WHEEL = PlantFamily(
     name="wheel",
     description="paper W's satellite with four reaction wheels and wheel faults (S1-S4)",
     fields=FIELDS,
     controllers=controller_specs(
         CONTROLLERS,
-        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        {
+            **defaults.CONTROLLER_DEFAULTS,
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
+            # the QP back-end's settings (left out of a record at their default, None)
+            "GIPC": {**defaults.CONTROLLER_DEFAULTS["GIPC"], "solver_options": None},
+        },
         CONSTRAINED,
     ),
     simulate=simulate_case,
@@ -383,5 +398,5 @@ WHEEL = PlantFamily(
     controller_defaults=lambda controller: {} if controller in CONSTRAINED else {"saturation": "limiter"},
     setting_checks=FORMS.setting_checks(),
     quiet_settings=frozenset(FORM_DEFAULTS),
-    case_check=FORMS.check_case,
+    case_check=_case_check,
 )
