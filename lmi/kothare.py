@@ -71,6 +71,10 @@ class LMISolution:
         The back-end's own dual bound on the optimal ``gamma`` (Clarabel's dual objective; with
         ``gamma`` it brackets the optimum to the accuracy the solver actually reached, whatever
         its status says); ``None`` where the back-end reports none.
+    steps : dict of str to ndarray or None
+        The forms with steps (:mod:`lmi.forms.steps`): the later steps' variables by name
+        (``"Y@2"``, ``"G@2"``, ``"Q0@2"``, Li et al.'s second-step gains ``"Y@v0"``, ...), at the
+        scale of ``Y`` and ``Q``; the first step's are ``Q``, ``Y``, ``G``, ``Q_vertices``, ``H``.
     """
 
     status: str
@@ -92,6 +96,7 @@ class LMISolution:
     slack: dict[str, float] | None = field(default=None, repr=False)
     lam: float | None = field(default=None, repr=False)
     gamma_dual: float | None = field(default=None, repr=False)
+    steps: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

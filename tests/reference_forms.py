@@ -438,3 +438,178 @@ def realised_cost(
         x = A @ x + B @ u
     return total, u_peak, x
 
+
+
+# -- the forms with steps, from MUP's sdp_li.m / sdp_shi.m (Oravec & Bakosova's toolbox) -----------
+
+def reference_steps(
+    A_list: list[np.ndarray],
+    B_list: list[np.ndarray],
+    Q1: np.ndarray,
+    R: np.ndarray,
+    x: np.ndarray,
+    *,
+    u_max: float | np.ndarray,
+    method: str,
+    horizon: int = 2,
+    lyapunov: str = "vertex_pairs",
+    saturation: str | None = None,
+    output_matrix: np.ndarray | None = None,
+    y_max: float | np.ndarray | None = None,
+    at: dict[str, Any] | None = None,
+) -> tuple[str, float, dict[str, Any]]:
+    """Li et al.'s two-step form (``method="li"``) or Shi et al.'s N steps (``"shi"``) in cvxpy,
+    written after MUP's ``sdp_li.m`` and ``sdp_shi.m`` with MUP's own variables, with the changes
+    the docs' page states: the objective ``gamma`` alone (MUP adds ``trace(X)``), per-component
+    peak input bounds, output bounds ``|c_r x|`` at every step and every vertex (pair), and for
+    Shi the last step's ellipsoid as the terminal one (``Q_(N+1) = Q_N``).
+
+    MUP's variables: Li: ``X``, ``Y``, ``Yp[v]``; Shi: per step ``X[t]`` (not symmetric),
+    ``Y[t]``, ``Z[t]`` (the law's inputs ``Y - E_j Z`` over the diagonal 0/1 matrices ``E_j``, the
+    bound on ``Y - Z``) and ``Q[t][v]`` (a list of one matrix with ``lyapunov="common"``, where
+    ``X[t] = Q[t][0]`` is symmetric). ``at`` evaluates every LMI at given values of these names
+    (and ``gamma``) instead of solving. Returns as :func:`reference_gamma`.
+    """
+    A_list = [np.atleast_2d(np.asarray(a, float)) for a in A_list]
+    B_list = [np.asarray(b, float).reshape(A_list[0].shape[0], -1) for b in B_list]
+    n, m = B_list[0].shape
+    nv = len(A_list)
+    x = np.asarray(x, float).reshape(n)
+    Wx = _psd_sqrt(np.atleast_2d(np.asarray(Q1, float)))
+    Wu = _psd_sqrt(np.atleast_2d(np.asarray(R, float)))
+    umax = np.broadcast_to(np.asarray(u_max, float), (m,)).copy()
+    C = None if output_matrix is None else np.atleast_2d(np.asarray(output_matrix, float))
+    ymax = None if C is None else np.broadcast_to(np.asarray(y_max, float), (C.shape[0],)).copy()
+    Zx, Zxu, Zux = np.zeros((n, n)), np.zeros((n, m)), np.zeros((m, n))
+    g = cp.Variable(name="gamma")
+    lmis: list[Any] = []
+    named: dict[str, Any] = {"gamma": g}
+
+    def peak(gain: Any, t_mat: Any) -> None:
+        for k in range(m):
+            row = _r(gain[k, :], (1, n))
+            lmis.append(cp.bmat([[np.full((1, 1), umax[k] ** 2), row], [row.T, t_mat]]))
+
+    def outputs(image: Any, t_mat: Any) -> None:
+        if C is None:
+            return
+        for r in range(C.shape[0]):
+            row = _r(C[r] @ image, (1, n))
+            lmis.append(cp.bmat([[np.full((1, 1), ymax[r] ** 2), row], [row.T, t_mat]]))
+
+    if method == "li":
+        X = cp.Variable((n, n), symmetric=True, name="X")
+        Y = cp.Variable((m, n), name="Y")
+        Yp = [cp.Variable((m, n), name=f"Yp{v}") for v in range(nv)]
+        named.update({"X": X, "Y": Y, **{f"Yp{v}": Yp[v] for v in range(nv)}})
+        for v in range(nv):
+            x1 = A_list[v] @ X + B_list[v] @ Y
+            for vp in range(nv):
+                x2 = A_list[vp] @ x1 + B_list[vp] @ Yp[v]
+                lmis.append(cp.bmat([
+                    [X, x2.T, (Wx @ X).T, (Wu @ Y).T, (Wx @ x1).T, (Wu @ Yp[v]).T],
+                    [x2, X, Zx, Zxu, Zx, Zxu],
+                    [Wx @ X, Zx, g * np.eye(n), Zxu, Zx, Zxu],
+                    [Wu @ Y, Zux, Zux, g * np.eye(m), Zux, np.zeros((m, m))],
+                    [Wx @ x1, Zx, Zx, Zxu, g * np.eye(n), Zxu],
+                    [Wu @ Yp[v], Zux, Zux, np.zeros((m, m)), Zux, g * np.eye(m)],
+                ]))
+                outputs(x2, X)
+            outputs(x1, X)
+            peak(Yp[v], X)
+        peak(Y, X)
+        lmis.append(cp.bmat([[np.ones((1, 1)), x[None, :]], [x[:, None], X]]))
+    elif method == "shi":
+        common = lyapunov == "common"
+        nq = 1 if common else nv
+        if lyapunov == "vertex_pairs" or common:
+            pairs = [(v, vp) for v in range(nv) for vp in range(nv)]
+        else:
+            pairs = [(v, v) for v in range(nv)]
+        Q = [[cp.Variable((n, n), symmetric=True, name=f"Q{t}_{v}") for v in range(nq)]
+             for t in range(horizon)]
+        X = [Q[t][0] if common else cp.Variable((n, n), name=f"X{t}") for t in range(horizon)]
+        Y = [cp.Variable((m, n), name=f"Y{t}") for t in range(horizon)]
+        # without saturation the law is Y itself and the bound is on Y: Z = 0, E = {0}
+        aux = saturation == "auxiliary"
+        Z = [cp.Variable((m, n), name=f"Z{t}") if aux else np.zeros((m, n)) for t in range(horizon)]
+        for t in range(horizon):
+            named.update({f"Y{t}": Y[t], **{f"Q{t}_{v}": Q[t][v] for v in range(nq)}})
+            if aux:
+                named[f"Z{t}"] = Z[t]
+            if not common:
+                named[f"X{t}"] = X[t]
+        E = [np.diag(bits) for bits in itertools.product((0.0, 1.0), repeat=m)] if aux else [np.zeros((m, m))]
+
+        def top(t: int, v: int) -> Any:
+            return Q[t][0] if common else X[t] + X[t].T - Q[t][v]
+
+        for t in range(horizon):
+            nxt = Q[min(t + 1, horizon - 1)]  # the terminal ellipsoid: Q_(N+1) = Q_N
+            for Ej in E:
+                law = Y[t] - Ej @ Z[t]
+                for v, vp in pairs:
+                    image = A_list[v] @ X[t] + B_list[v] @ law
+                    lmis.append(cp.bmat([
+                        [top(t, v), image.T, (Wx @ X[t]).T, (Wu @ law).T],
+                        [image, nxt[0 if common else vp], Zx, Zxu],
+                        [Wx @ X[t], Zx, g * np.eye(n), Zxu],
+                        [Wu @ law, Zux, Zux, g * np.eye(m)],
+                    ]))
+                for v in range(nv):
+                    outputs(A_list[v] @ X[t] + B_list[v] @ law, top(t, v))
+            for v in range(nq):
+                peak(Y[t] - Z[t], top(t, v))
+        for v in range(nq):
+            lmis.append(cp.bmat([[np.ones((1, 1)), x[None, :]], [x[:, None], Q[0][v]]]))
+    else:
+        raise ValueError(method)
+
+    if at is not None:
+        for name, var in named.items():
+            val = np.asarray(at[name], float).reshape(var.shape)
+            var.value = _symmetrised(val) if var.is_symmetric() else val
+        values = [np.asarray(M.value, float) for M in lmis]
+        return "evaluated", float(at["gamma"]), {
+            "lmis": values, "residual": min(relative_min_eig(M) for M in values),
+        }
+    problem = cp.Problem(cp.Minimize(g), [_sym(M) >> 0 for M in lmis])
+    try:
+        problem.solve(solver="CLARABEL")
+    except cp.error.SolverError as exc:  # Clarabel fails on Kothare's example 2: reported
+        return f"solver_error: {exc}", float("nan"), {"residual": -np.inf}
+    if problem.status not in ("optimal", "optimal_inaccurate"):
+        return problem.status, float("nan"), {"residual": -np.inf}
+    values = [np.asarray(M.value, float) for M in lmis]
+    return problem.status, float(g.value), {
+        "residual": min(relative_min_eig(M) for M in values),
+        **{name: np.asarray(var.value) for name, var in named.items()},
+    }
+
+
+def steps_values(sol: Any, method: str, horizon: int, n_vertices: int) -> dict[str, Any]:
+    """The variables of an :class:`lmi.LMISolution` of a form with steps in MUP's names
+    (:func:`reference_steps`'s ``at``): Shi's ``Z`` is ``Y - H G`` (MUP bounds ``Y - Z``)."""
+    out: dict[str, Any] = {"gamma": sol.gamma}
+    if method == "li":
+        out.update({"X": sol.Q, "Y": sol.Y})
+        out.update({f"Yp{v}": sol.steps[f"Y@v{v}"] for v in range(n_vertices)})
+        return out
+    vertex = sol.G is not None
+
+    def var(name: str, t: int) -> np.ndarray:
+        return sol.steps[f"{name}@{t + 1}"] if t else {"G": sol.G, "Y": sol.Y}[name]
+
+    for t in range(horizon):
+        g_mat = var("G", t) if vertex else (sol.steps[f"Q@{t + 1}"] if t else sol.Q)
+        y_mat = var("Y", t)
+        out[f"Y{t}"] = y_mat
+        if sol.H is not None:
+            out[f"Z{t}"] = y_mat - (sol.H @ g_mat if t == 0 else sol.steps[f"Z@{t + 1}"])
+        if vertex:
+            out[f"X{t}"] = g_mat
+            for v in range(n_vertices):
+                out[f"Q{t}_{v}"] = sol.Q_vertices[v] if t == 0 else sol.steps[f"Q{v}@{t + 1}"]
+        else:
+            out[f"Q{t}_0"] = g_mat
+    return out

@@ -20,6 +20,8 @@ EXPECTED = {
     "cao": {"saturation": "auxiliary"},
     "mao_cao": {"lyapunov": "vertex_pairs", "saturation": "auxiliary"},
     "wan_cao": {"cost": "nominal", "saturation": "auxiliary"},
+    "li": {"horizon": 2, "step_gains": "vertex", "lyapunov": "common"},
+    "shi": {"horizon": 3, "lyapunov": "vertex_pairs", "saturation": "auxiliary"},
 }
 #: MUP's 19 keys (rmpc_methods/feas_<key>.m).
 MUP_KEYS = {
@@ -65,3 +67,14 @@ def test_refusals_name_the_argument() -> None:
         RMPC.from_method(1, p.plant, **kw)
     with pytest.raises(InvalidArgumentError, match=r"lyapunov: expected 'vertex'.*found 'common'"):
         RMPC.from_method("cuzzola", p.plant, lyapunov="common", **kw)
+
+
+def test_shi_takes_the_callers_horizon_and_li_refuses_another() -> None:
+    """shi's ``horizon=3`` is MUP's demo's choice, the caller's own is taken; li's two steps are the
+    method."""
+    p = build_problem("mup_demo")
+    kw = {"Q": p.Q, "R": p.R, "u_max": p.u_max}
+    assert RMPC.from_method("shi", p.plant, **kw).form.horizon == 3
+    assert RMPC.from_method("shi", p.plant, horizon=5, **kw).form.horizon == 5
+    with pytest.raises(InvalidArgumentError, match=r"horizon: expected 2 \(method 'li' sets it\)"):
+        RMPC.from_method("li", p.plant, horizon=3, **kw)

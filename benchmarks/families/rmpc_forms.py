@@ -1,7 +1,8 @@
 """The robust MPC's forms as settings of a scenario: their defaults, their checks, the keyword arguments.
 
-:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by six keyword arguments,
-``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft`` and ``disturbance``, and takes
+:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by eight keyword arguments,
+``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft``, ``disturbance``, ``horizon`` and
+``step_gains``, and takes
 ``certificate_tol`` and ``on_failure``; a sweep file sets them as ``settings.<name>`` of a
 family's controller ``"RMPC"`` (every shipped family: :class:`RMPCForms` holds what a family
 needs, its state count and whether its RMPC has output bounds). Each value is checked by the
@@ -48,7 +49,7 @@ __all__ = [
 #: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
 FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
     {"lyapunov": "common", "cost": "worst_case", "free_moves": 0, "saturation": None, "soft": None,
-     "disturbance": None}
+     "disturbance": None, "horizon": 1, "step_gains": "common"}
 )
 #: Every setting of this module with its default: the forms and the solve's three options.
 FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
@@ -175,15 +176,28 @@ def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
     return value
 
 
+def _horizon(value: Any, where: str, n: int, out: bool) -> int:
+    return _python_check(where, n, out, horizon=value).horizon
+
+
+def _step_gains(value: Any, where: str, n: int, out: bool) -> str:
+    # on its own with the horizon it needs, so that only the value is judged here (the case
+    # check judges the combination with the case's own horizon)
+    horizon = 2 if value == "vertex" else 1
+    return _python_check(where, n, out, step_gains=value, horizon=horizon).step_gains
+
+
 _CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
     {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
-     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options}
+     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options,
+     "horizon": _horizon, "step_gains": _step_gains}
 )
 
 
 def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
     """The keyword arguments of :class:`rmpc.RMPC` that the form settings stand for."""
     out = {key: settings[key] for key in ("lyapunov", "cost", "free_moves", "saturation")}
+    out.update({key: settings.get(key, FORM_SETTINGS[key]) for key in ("horizon", "step_gains")})
     out["soft"] = None if settings["soft"] is None else dict(settings["soft"])
     dist = settings["disturbance"]
     out["disturbance"] = None if dist is None else (

@@ -8,8 +8,10 @@ cost, a free first move, saturation-aware gains, soft bounds and bounded disturb
 from lmi.forms.options import (
     COSTS,
     LYAPUNOV_FORMS,
+    MAX_HORIZON,
     MAX_SOFT_WEIGHT,
     SATURATIONS,
+    STEP_GAINS,
     Disturbance,
     FormOptions,
     form_options,
@@ -17,6 +19,6 @@ from lmi.forms.options import (
 from lmi.forms.problem import FormProblem
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "MAX_SOFT_WEIGHT", "SATURATIONS", "Disturbance", "FormOptions", "FormProblem",
-    "form_options",
+    "COSTS", "LYAPUNOV_FORMS", "MAX_HORIZON", "MAX_SOFT_WEIGHT", "SATURATIONS", "STEP_GAINS", "Disturbance",
+    "FormOptions", "FormProblem", "form_options",
 ]

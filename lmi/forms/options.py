@@ -19,7 +19,8 @@ from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_real_array
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "MAX_SOFT_WEIGHT", "SATURATIONS", "Disturbance", "FormOptions", "form_options",
+    "COSTS", "LYAPUNOV_FORMS", "MAX_HORIZON", "MAX_SOFT_WEIGHT", "SATURATIONS", "STEP_GAINS", "Disturbance",
+    "FormOptions", "form_options",
 ]
 
 #: ``"common"``: one quadratic Lyapunov function (Kothare 1996); ``"vertex"``: one ``Q_j`` per
@@ -52,6 +53,8 @@ class FormOptions:
     saturation: Literal["auxiliary"] | None = None
     soft: Mapping[str, float] | None = None
     disturbance: Disturbance | None = None
+    horizon: int = 1
+    step_gains: Literal["common", "vertex"] = "common"
 
     @property
     def is_kothare(self) -> bool:
@@ -60,7 +63,13 @@ class FormOptions:
             self.lyapunov == "common" and self.cost == "worst_case" and self.free_moves == 0
             and self.saturation is None and self.soft is None
             and (self.disturbance is None or self.disturbance.w_max == 0.0)
+            and not self.has_steps
         )
+
+    @property
+    def has_steps(self) -> bool:
+        """Whether the form has later steps with gains of their own (``horizon > 1``)."""
+        return self.horizon > 1
 
     @property
     def vertex_lyapunov(self) -> bool:
@@ -163,6 +172,8 @@ def form_options(
     saturation: Any = None,
     soft: Any = None,
     disturbance: Any = None,
+    horizon: Any = 1,
+    step_gains: Any = "common",
 ) -> FormOptions:
     """Check every option and every combination; return the :class:`FormOptions`.
 
@@ -181,6 +192,8 @@ def form_options(
     _choice(saturation, SATURATIONS, "saturation")
     soft_weights = _soft(soft, input_constraint is not None, has_output)
     dist = _disturbance(disturbance, n_states)
+    steps = _steps(horizon, step_gains)
+    _step_combinations(steps, lyapunov, cost, free_moves, saturation, soft_weights, dist)
     if cost == "nominal" and lyapunov != "common":
         raise InvalidArgumentError(
             "cost, lyapunov",
@@ -201,4 +214,67 @@ def form_options(
         )
     return FormOptions(
         str(lyapunov), str(cost), int(free_moves), saturation, soft_weights, dist,  # type: ignore[arg-type]
+        *steps,  # type: ignore[arg-type]
     )
+
+
+# -- the forms with steps: Li, Shi, Sun & Wang (2008) and Shi, Su & Chu (2013) -----------------------
+
+#: ``"common"``: the gain of a later step does not depend on the plant of the step before (Shi, Su
+#: & Chu's N steps, each with its own ``G_t, Y_t`` and Lyapunov matrices); ``"vertex"``: the second
+#: step's gain ``Y_v`` depends on the vertex ``v`` of the first (Li, Shi, Sun & Wang's two steps).
+STEP_GAINS: tuple[str, ...] = ("common", "vertex")
+
+#: The largest ``horizon``. The variables and blocks grow linearly with it: each step adds its own
+#: ``G_t``/``Y_t``/``Z_t`` and Lyapunov matrices (``n_v n (n + 1) / 2 + n^2 + 2 m n`` variables with
+#: ``"vertex_pairs"`` and the auxiliary saturation) and its cost, input and output blocks
+#: (``n_v^2 2^m + m n_v + p n_v 2^m``), and the interior-point iteration grows faster than
+#: linearly in the variables. Measured with MUP's ``shi`` (``"vertex_pairs"``, auxiliary
+#: saturation), median of 7 warm solves on a 2-core machine shared with other jobs: Kothare's
+#: example 2 (44 variables and 10 blocks per step) 0.11 s at 3 steps (133 variables), 0.61 s at 6
+#: (265), 2.4 s at 8 (353 variables, 82 blocks), its gamma 189.45, 157.88 and 157.45 (0.3 % from 6
+#: to 8 steps); MUP's demo system (17 variables and 33 blocks per step) 0.24 s at 8 steps (137
+#: variables, 267 blocks), its gamma the same to 1e-8 relative from 4 steps on. Beyond 8 steps the
+#: solve time keeps growing for a gamma that has stopped moving, so 8 is the limit.
+MAX_HORIZON = 8
+
+
+def _steps(horizon: Any, step_gains: Any) -> tuple[int, str]:
+    if isinstance(horizon, bool | np.bool_) or not isinstance(horizon, int | np.integer):
+        found = f"{type(horizon).__name__} {horizon!r}"
+        raise ArgumentTypeError("horizon", f"an integer from 1 to MAX_HORIZON = {MAX_HORIZON}", found)
+    if not 1 <= horizon <= MAX_HORIZON:
+        raise InvalidArgumentError(
+            "horizon", f"an integer from 1 to MAX_HORIZON = {MAX_HORIZON} (the steps with gains of their "
+            "own before the terminal ellipsoid)", repr(horizon))
+    _choice(step_gains, STEP_GAINS, "step_gains")
+    return int(horizon), str(step_gains)
+
+
+def _step_combinations(steps: tuple[int, str], lyapunov: Any, cost: Any, free_moves: Any, saturation: Any,
+                       soft: dict[str, float] | None, dist: Disturbance | None) -> None:
+    """The forms with steps that exist: Li et al.'s (``horizon=2, step_gains="vertex"`` with one
+    Lyapunov function) and Shi et al.'s (``horizon=N`` with any Lyapunov form, with or without the
+    auxiliary saturation); each other option is refused naming it."""
+    horizon, step_gains = steps
+    if step_gains == "vertex":
+        li = "step_gains='vertex' (Li et al.'s two-step form) with "
+        if horizon != 2:
+            raise InvalidArgumentError("step_gains, horizon", li + "horizon=2",
+                                       f"step_gains={step_gains!r}, horizon={horizon!r}")
+        if lyapunov != "common":
+            raise InvalidArgumentError("step_gains, lyapunov", li + "lyapunov='common'",
+                                       f"step_gains={step_gains!r}, lyapunov={lyapunov!r}")
+        if saturation is not None:
+            raise InvalidArgumentError("step_gains, saturation", li + "saturation=None",
+                                       f"step_gains={step_gains!r}, saturation={saturation!r}")
+    if horizon == 1:
+        return
+    given = {"cost": (cost, "worst_case"), "free_moves": (free_moves, 0), "soft": (soft, None),
+             "disturbance": (None if dist is None or dist.w_max == 0.0 else dist.w_max, None)}
+    for name, (value, default) in given.items():
+        if value != default:
+            raise InvalidArgumentError(
+                f"horizon, {name}", f"horizon=1 with {name}={value!r} (the forms with steps bound the "
+                f"worst-case cost, with no free move, soft bound or disturbance), or {name}={default!r}",
+                f"horizon={horizon!r}, {name}={value!r}")

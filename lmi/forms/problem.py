@@ -25,9 +25,13 @@ from scipy import sparse
 from lmi.affine import svec_matrix
 from lmi.certificate import Certificate
 from lmi.data import InputConstraint, KothareData, build_kothare_data
-from lmi.forms.lmis import FormData, declare, objective, write
+from lmi.forms.lmis import FormData, objective
 from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
+
+# every form's variables and blocks: lmi.forms.lmis's, or with steps (horizon > 1) lmi.forms.steps's
+from lmi.forms.steps import declare_form as declare
+from lmi.forms.steps import write_form as write
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
 from lmi.ipm import BlockLMISolver
 from lmi.kothare import MIX_WEIGHTS, KothareProblem, LMISolution
@@ -107,6 +111,10 @@ class FormProblem:
         (``tol_feas``, ``max_iter``, ...). For ``"clarabel"``/``"cvxpy"``: Clarabel's settings.
     certificate_tol : float
         A solve is ``"optimal"`` only if every recomputed block's relative margin is ``>= -tol``.
+    horizon, step_gains
+        The forms with steps (:mod:`lmi.forms.steps`): ``horizon`` steps with gains of their own
+        (Shi, Su & Chu 2013), or ``horizon=2, step_gains="vertex"`` (Li, Shi, Sun & Wang 2008);
+        the answer's ``F``, ``Q``, ``Y`` are the first step's.
 
     Examples
     --------
@@ -146,6 +154,8 @@ class FormProblem:
         backend: str = "ipm",
         solver_options: dict[str, Any] | None = None,
         certificate_tol: float = 1e-7,
+        horizon: int = 1,
+        step_gains: str = "common",
     ) -> None:
         self.data: KothareData = build_kothare_data(
             A, B, Q, R, dt=dt, input_constraint=input_constraint, u_max=u_max,
@@ -155,7 +165,7 @@ class FormProblem:
         self.options: FormOptions = form_options(
             n_states=data.n, input_constraint=data.input_constraint, has_output=data.C_out is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance,
+            disturbance=disturbance, horizon=horizon, step_gains=step_gains,
         )
         if backend not in _BACKENDS:
             raise InvalidArgumentError("backend", "'ipm', 'clarabel' or 'cvxpy'", repr(backend))
@@ -674,6 +684,7 @@ class FormProblem:
             G=s2 * g_mat if opts.vertex_lyapunov else None, Q_vertices=q_vertices,
             u0=scale * values["u0"][:, 0] if "u0" in values else None,
             H=h_mat, slack=slack, lam=lam if dist is not None and w_max > 0.0 else None,
+            steps={name: s2 * val for name, val in values.items() if "@" in name} if opts.has_steps else None,
         )
 
     def _original(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -681,9 +692,10 @@ class FormProblem:
         t = _as_matrix(self._t)
         out = {}
         for name, val in values.items():
-            if name == "G" or name[0] in "QW":  # G, Q, Q_j and the shared W
+            base = name.split("@")[0]  # a later step's variable (lmi.forms.steps), as the first's
+            if base == "G" or name[0] in "QW":  # G, Q, Q_j and the shared W
                 out[name] = t @ val @ t.T
-            elif name in ("Y", "Z"):
+            elif base in ("Y", "Z"):
                 out[name] = val @ t.T
             else:
                 out[name] = val

@@ -17,10 +17,19 @@ key            method                                                 options
                                                                       ``saturation="auxiliary"``
 ``wan_cao``    Wan & Kothare (2003) with Cao & Lin (2005)             ``cost="nominal"``,
                                                                       ``saturation="auxiliary"``
+``li``         Li, Shi, Sun & Wang (2008)                             ``horizon=2``,
+                                                                      ``step_gains="vertex"``,
+                                                                      ``lyapunov="common"``
+``shi``        Shi, Su & Chu (2013)                                   ``horizon=3`` (MUP's demo; the
+                                                                      caller may give another),
+                                                                      ``lyapunov="vertex_pairs"``,
+                                                                      ``saturation="auxiliary"``
 =============  =====================================================  =================================
 
 As in MUP, the input bound is per component (``input_constraint="peak"``) unless the caller
-gives ``input_constraint``. MUP's other keys (``ding``, ``li``, ``huang``, ``shi``, ``zhang``,
+gives ``input_constraint``. ``li`` and ``shi`` differ from MUP's own code where the docs' page on
+the forms says (``Y - E_j Z`` of MUP's ``sdp_shi.m`` is the auxiliary saturation with ``H = Y -
+Z``; the terminal ellipsoid; output bounds at every step). MUP's other keys (``ding``, ``huang``, ``zhang``,
 ``wan_huang``, ``mao_huang``, ``wan_zhang`` and the ``*_soft_con`` variants, whose soft limits are
 separate from the hard bounds with one slack per component) have no form here yet: asked for by
 name they are refused with the nearest option the toolkit has.
@@ -28,7 +37,7 @@ name they are refused with the nearest option the toolkit has.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
@@ -44,6 +53,8 @@ class Method:
     key: str
     source: str
     options: MappingProxyType
+    #: options the key sets unless the caller gives them (shi's ``horizon``)
+    defaults: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
 
 
 def _method(key: str, source: str, **options: Any) -> Method:
@@ -59,15 +70,17 @@ METHODS: MappingProxyType = MappingProxyType({m.key: m for m in (
     _method("cao", "Cao & Lin (2005)", saturation="auxiliary"),
     _method("mao_cao", "Mao (2003) with Cao & Lin (2005)", lyapunov="vertex_pairs", saturation="auxiliary"),
     _method("wan_cao", "Wan & Kothare (2003) with Cao & Lin (2005)", cost="nominal", saturation="auxiliary"),
+    _method("li", "Li, Shi, Sun & Wang (2008)", horizon=2, step_gains="vertex", lyapunov="common"),
+    Method("shi", "Shi, Su & Chu (2013)",
+           MappingProxyType({"lyapunov": "vertex_pairs", "saturation": "auxiliary"}),
+           MappingProxyType({"horizon": 3})),
 )})
 
 #: MUP's keys without a form here yet, with the nearest option the toolkit has.
 NOT_YET: MappingProxyType = MappingProxyType({
     "ding": "cost='nominal' with lyapunov='vertex_pairs' (Ding et al. 2007) is not a form yet; "
             "nearest: 'wan' or 'mao'",
-    "li": "the two-step gains of Li et al. (2008) are not a form yet; nearest: 'mao'",
     "huang": "the weighted unsaturated blocks of Huang et al. (2011) are not a form yet; nearest: 'cao'",
-    "shi": "the N-step chained Lyapunov matrices of Shi et al. (2013) are not a form yet; nearest: 'mao'",
     "zhang": "the saturation-dependent Lyapunov function of Zhang et al. (2013) is not a form yet; "
              "nearest: 'cao'",
     "wan_huang": "huang is not a form yet; nearest: 'wan_cao'",
@@ -106,5 +119,5 @@ def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
             raise InvalidArgumentError(
                 name, f"{value!r} (method {key!r} sets it) or no {name} argument", repr(given[name])
             )
-    merged = {"input_constraint": "peak", **given, **options}
+    merged = {"input_constraint": "peak", **METHODS[key].defaults, **given, **options}
     return merged

@@ -55,7 +55,11 @@ def rmpc_arguments(design: Design, partial: bool = False) -> dict[str, Any]:
         "soft": lambda d, k: d.optional_mapping(k), "disturbance": _disturbance,
         "offset_free": Design.flag,
     }
-    return {name: read(design, name) for name, read in readers.items() if not partial or design.has(name)}
+    out = {name: read(design, name) for name, read in readers.items() if not partial or design.has(name)}
+    # the forms with steps: written only when set (a design saved before them has neither)
+    steps: dict[str, Any] = {"horizon": Design.integer, "step_gains": Design.text}
+    out.update({name: read(design, name) for name, read in steps.items() if design.has(name)})
+    return out
 
 
 def target_design(target: SteadyTarget | None) -> dict[str, Any] | None:
@@ -137,6 +141,15 @@ class RMPC(Saveable):
         it (``lam``, the S-procedure's contraction factor, searched when not given).
         The LMIs of every form and the combinations that exist: the page "The field's robust MPC
         forms" of the docs (:mod:`lmi.forms`). The defaults give Kothare's problem.
+    horizon : int
+        The prediction steps with gains of their own before the terminal invariant ellipsoid,
+        from 1 (default: the forms above) to :data:`lmi.forms.MAX_HORIZON` (Shi, Su & Chu 2013:
+        ``horizon=N``, chained Lyapunov matrices). The law applied is the first step's; with
+        ``horizon > 1`` its ellipsoid contains the state but is not invariant under the first
+        gain alone, so ``resolve_threshold`` must be 1.
+    step_gains : {"common", "vertex"}
+        ``"vertex"``: the second step's gain depends on the first step's vertex (Li, Shi, Sun &
+        Wang 2008: with ``horizon=2`` and ``lyapunov="common"`` only).
     offset_free : bool
         Offset-free action on a constant input disturbance: every :meth:`step` takes the
         disturbance estimate ``StepInputs(d_hat=...)`` (from an estimator with
@@ -218,6 +231,8 @@ class RMPC(Saveable):
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
         offset_free: bool = False,
+        horizon: int = 1,
+        step_gains: Literal["common", "vertex"] = "common",
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             hint = ""
@@ -230,7 +245,7 @@ class RMPC(Saveable):
         self.form = form_options(
             n_states=plant.n_states, input_constraint=input_constraint, has_output=output_matrix is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance,
+            disturbance=disturbance, horizon=horizon, step_gains=step_gains,
         )
         self.problem: KothareProblem | FormProblem
         if self.form.is_kothare:
@@ -250,11 +265,17 @@ class RMPC(Saveable):
                 output_matrix=output_matrix, y_max=y_max, nominal=plant.nominal, lyapunov=lyapunov,
                 cost=cost, free_moves=free_moves, saturation=saturation, soft=soft, disturbance=disturbance,
                 backend=backend, solver_options=solver_options, certificate_tol=certificate_tol,
+                horizon=horizon, step_gains=step_gains,
             )
         self.certified = CertifiedGain("RMPC", on_failure, hold_radius)
         self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
         if self.resolve_threshold > 1.0:
             raise InvalidArgumentError("resolve_threshold", "a level in (0, 1]", repr(resolve_threshold))
+        if self.resolve_threshold < 1.0 and self.form.has_steps:
+            raise InvalidArgumentError(
+                "resolve_threshold, horizon", "resolve_threshold=1 with horizon > 1 (the first step's "
+                "ellipsoid is not invariant under its gain alone)",
+                f"resolve_threshold={resolve_threshold!r}, horizon={self.form.horizon!r}")
         n = plant.n_states
         self.x_ref = np.zeros(n) if x_ref is None else as_vector(x_ref, "x_ref", n)
         drift = max(float(np.max(np.abs(a @ self.x_ref - self.x_ref))) for a in plant.A)
@@ -284,6 +305,9 @@ class RMPC(Saveable):
             "disturbance": (None if disturbance is None
                             else (disturbance.E, disturbance.w_max, disturbance.lam)),
             "offset_free": self.offset_free,
+            # the forms with steps, only when set (the designs of the other forms stay as they were)
+            **({"horizon": self.form.horizon, "step_gains": self.form.step_gains}
+               if self.form.has_steps else {}),
         })
 
     # -- save and load ---------------------------------------------------------------------
@@ -329,10 +353,10 @@ class RMPC(Saveable):
         """The robust MPC of the literature's method ``key`` (MUP's method keys).
 
         ``key`` is one of :data:`rmpc.mpc.methods.METHODS` (``"kothare"``, ``"cuzzola"``,
-        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``), which sets the form's
-        options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other arguments of
-        :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per component
-        (``input_constraint="peak"``) unless ``input_constraint`` is given.
+        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``, ``"li"``, ``"shi"``), which
+        sets the form's options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other
+        arguments of :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per
+        component (``input_constraint="peak"``) unless ``input_constraint`` is given.
 
         Examples
         --------
