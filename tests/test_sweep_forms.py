@@ -283,3 +283,36 @@ def test_the_flexible_rmpc_takes_the_forms_on_its_14_states_and_soft_output_boun
         parse_sweep({"base": {**base, "modal_bound": 0.02, "settings": {"soft": {"y": 10.0}}}})
     )
     assert dict(scenario.settings["soft"]) == {"y": 10.0}
+
+
+# -- the forms with steps (horizon, step_gains) ------------------------------------------------------
+
+@pytest.mark.parametrize(("settings", "want"), [
+    ({"horizon": 2, "lyapunov": "vertex_pairs"}, (2, "common", "vertex_pairs")),
+    ({"horizon": 2, "step_gains": "vertex"}, (2, "vertex", "common")),
+])
+def test_the_steps_are_reachable_from_a_sweep(settings, want):
+    (scenario,) = expand(parse_sweep(_rmpc_sweep(settings)))
+    poly, _ = _python_rmpc()
+    built = scenario.plant_family.build_controller(poly, scenario).controller
+    assert (built.form.horizon, built.form.step_gains, built.form.lyapunov) == want
+
+
+STEPS_BAD = [
+    ({"horizon": 0}, "base.settings.horizon"),
+    ({"horizon": 2.5}, "base.settings.horizon"),
+    ({"step_gains": "per_vertex"}, "base.settings.step_gains"),
+    ({"step_gains": "vertex"}, "base.settings.step_gains, base.settings.horizon"),
+    ({"horizon": 2, "cost": "nominal"}, "base.settings.horizon, base.settings.cost"),
+]
+
+
+@pytest.mark.parametrize(("settings", "path"), STEPS_BAD, ids=[str(b[0]) for b in STEPS_BAD])
+def test_a_bad_step_setting_is_refused_with_pythons_message_at_its_key_path(settings, path):
+    with pytest.raises(ToolkitError) as in_python:
+        _python_rmpc(**settings)
+    with pytest.raises(ConfigError) as in_sweep:
+        parse_sweep(_rmpc_sweep(settings))
+    assert in_sweep.value.argument == path
+    assert in_sweep.value.expected == in_python.value.expected
+    assert in_sweep.value.found == in_python.value.found
