@@ -217,3 +217,17 @@ def test_the_cvxpy_backend_solves_the_same_program():
             ref = _rmpc(problem, backend="cvxpy", **options).solve(problem["x"])
         assert ref.status in ("optimal", "inaccurate") and ref.certificate.ok
         assert ipm.gamma == pytest.approx(ref.gamma, rel=1e-5)
+
+
+def test_a_form_too_large_for_memory_names_the_horizon():
+    """The size check of :class:`lmi.forms.FormProblem` counts every step's blocks and variables
+    and names ``horizon`` among the causes (14 states, 8 vertices, 8 steps: about 224 GB)."""
+    rng = np.random.default_rng(0)
+    n, m = 14, 3
+    A = [np.eye(n) + 0.01 * rng.normal(size=(n, n)) for _ in range(8)]
+    B = [0.01 * rng.normal(size=(n, m)) for _ in range(8)]
+    message = r"plant, lyapunov, horizon: .*a shorter horizon.*horizon=8"
+    with pytest.raises(InvalidArgumentError, match=message):
+        FormProblem(A, B, np.eye(n), np.eye(m), u_max=[1.0] * m, input_constraint="peak",
+                    lyapunov="vertex_pairs", horizon=8)
+    FormProblem(A[:2], B[:2], np.eye(n), np.eye(m), u_max=[1.0] * m, input_constraint="peak", horizon=2)

@@ -205,8 +205,10 @@ class FormProblem:
             # name what was given (the plant's vertices, the options set), never an option at its default
             given = {} if self.options.lyapunov == "common" else {"lyapunov": self.options.lyapunov}
             given.update({} if self.options.saturation is None else {"saturation": self.options.saturation})
+            given.update({"horizon": self.options.horizon} if self.options.has_steps else {})
             remedies = ["fewer vertices"] + ["lyapunov='common'"] * ("lyapunov" in given)
             remedies += ["no auxiliary saturation"] * ("saturation" in given)
+            remedies += ["a shorter horizon"] * ("horizon" in given)
             options = "".join(f", {key}={value!r}" for key, value in given.items())
             raise InvalidArgumentError(
                 ", ".join(["plant", *given]),
