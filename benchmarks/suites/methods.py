@@ -28,9 +28,10 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -47,7 +48,9 @@ from benchmarks.suites.methods_store import case_path, load_case, store_case
 from rmpc.analysis import TimeBudgetExceeded, boundary_along
 from toolkit_common.errors import ConfigError
 
-__all__ = ["METHODS", "MethodsSettings", "evaluate", "method_options", "run_methods"]
+__all__ = [
+    "METHODS", "MUP_KEYS", "MUP_PARAMETERS", "MethodsSettings", "evaluate", "method_options", "run_methods",
+]
 
 #: Method -> what it is (the options of :class:`rmpc.RMPC` are in :func:`method_options`).
 METHODS: dict[str, str] = {
@@ -59,7 +62,27 @@ METHODS: dict[str, str] = {
     "auxiliary_saturation": "Cao & Lin 2005: u = sat(F x) with an auxiliary gain H carrying the peak bound",
     "soft": "Oravec & Bakosova 2016: soft input (and output) bounds with linear slack penalties",
     "disturbance": "bounded disturbance E w, ||w|| <= w_max: an invariant ellipsoid under it",
+    "ding": "Ding, Xi, Cychowski & O'Mahony 2007: nominal cost with vertex-pair Lyapunov matrices",
+    "li": "Li, Shi, Sun & Wang 2008: two-step gains, a second-step gain per first-step vertex",
+    "huang": "Huang, Li, Lin & Xi 2011: auxiliary saturation, the unsaturated blocks under gamma_s",
+    "shi": "Shi, Su & Chu 2013: N steps with chained vertex Lyapunov matrices",
+    "zhang": "Zhang, Wang & Li 2013: a saturation-dependent Lyapunov function",
+    "wan_huang": "Wan & Kothare 2003 with Huang et al. 2011 (nominal cost)",
+    "mao_huang": "Mao 2003 with Huang et al. 2011 (vertex-pair Lyapunov matrices)",
+    "wan_zhang": "Wan & Kothare 2003 with Zhang et al. 2013 (nominal cost)",
 }
+
+#: The methods of :data:`METHODS` that are MUP's method keys beyond the eight forms: their options
+#: are :data:`rmpc.mpc.methods.METHODS`'s, with the tuning parameters of MUP's demo
+#: (``mup_rmpc_demo.m``: ``beta = 1e3`` for Huang et al.'s weight, ``N = 3`` for Shi et al.'s
+#: horizon).
+MUP_KEYS: tuple[str, ...] = ("ding", "li", "huang", "shi", "zhang", "wan_huang", "mao_huang", "wan_zhang")
+MUP_PARAMETERS: Mapping[str, Mapping[str, Any]] = MappingProxyType({
+    "huang": MappingProxyType({"unsaturated_weight": 1e3}),
+    "wan_huang": MappingProxyType({"unsaturated_weight": 1e3}),
+    "mao_huang": MappingProxyType({"unsaturated_weight": 1e3}),
+    "shi": MappingProxyType({"horizon": 3}),
+})
 
 #: The soft method's slack weights.
 SOFT_WEIGHT: float = 1e3
@@ -147,6 +170,8 @@ def method_options(problem: MethodsProblem, method: str) -> tuple[dict[str, Any]
         raise ConfigError("method", "one of " + ", ".join(METHODS), repr(method))
     if method == "kothare":
         return {}, None, True
+    if method in MUP_KEYS:
+        return _mup_options(problem, method)
     if method in ("vertex", "vertex_pairs"):
         return {"lyapunov": method}, None, True
     if method == "nominal":
@@ -165,6 +190,19 @@ def method_options(problem: MethodsProblem, method: str) -> tuple[dict[str, Any]
     if w_max <= 0.0:
         return None, "the problem has no input bound to size the disturbance by", True
     return {"disturbance": (e, w_max)}, None, True
+
+
+def _mup_options(problem: MethodsProblem, key: str) -> tuple[dict[str, Any], None, bool]:
+    """MUP's method ``key`` (:data:`rmpc.mpc.methods.METHODS`) with MUP's demo parameters; a method
+    with the auxiliary saturation runs with the peak bound, as ``auxiliary_saturation``."""
+    from rmpc.mpc.methods import METHODS as MUP
+
+    options = {**dict(MUP[key].options), **MUP_PARAMETERS.get(key, {})}
+    comparable = True
+    if options.get("saturation") is not None:
+        comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
+        options["input_constraint"] = "peak"
+    return options, None, comparable
 
 
 def _controller(problem: MethodsProblem, options: dict[str, Any], backend: str = "ipm") -> Any:
