@@ -17,13 +17,31 @@ key            method                                                 options
                                                                       ``saturation="auxiliary"``
 ``wan_cao``    Wan & Kothare (2003) with Cao & Lin (2005)             ``cost="nominal"``,
                                                                       ``saturation="auxiliary"``
+``ding``       Ding, Xi, Cychowski & O'Mahony (2007)                  ``cost="nominal"``,
+                                                                      ``lyapunov="vertex_pairs"``
 =============  =====================================================  =================================
 
+MUP's four soft-constrained keys (Oravec & Bakošová, 2016) stand for the form of their base key
+with soft limits the caller gives (MUP's ``u_sl, y_sl, Wsu, Wsy, Esu, Esy``: a weight per input
+and output, ``0`` for those not softened, the limit where the weight is ``> 0``, ``0``
+elsewhere); the hard bounds stay hard:
+
+======================  ========================  ==================================================
+key                     options                   the caller gives
+======================  ========================  ==================================================
+``kothare_soft_con``    the defaults              ``soft={"u": [w_1, ..., w_m], "u_limit": [l_1, ...
+``wan_soft_con``        ``cost="nominal"``        ..., l_m]}`` and/or ``"y": [...]``,
+``cao_soft_con``        ``saturation=             ``"y_limit": [...]`` (one entry per input /
+                        "auxiliary"``             output of ``output_matrix``)
+``wan_cao_soft_con``    ``cost="nominal"``,
+                        ``saturation=
+                        "auxiliary"``
+======================  ========================  ==================================================
+
 As in MUP, the input bound is per component (``input_constraint="peak"``) unless the caller
-gives ``input_constraint``. MUP's other keys (``ding``, ``li``, ``huang``, ``shi``, ``zhang``,
-``wan_huang``, ``mao_huang``, ``wan_zhang`` and the ``*_soft_con`` variants, whose soft limits are
-separate from the hard bounds with one slack per component) have no form here yet: asked for by
-name they are refused with the nearest option the toolkit has.
+gives ``input_constraint``. MUP's other keys (``li``, ``huang``, ``shi``, ``zhang``,
+``wan_huang``, ``mao_huang``, ``wan_zhang``) have no form here yet: asked for by name they are
+refused with the nearest option the toolkit has.
 """
 
 from __future__ import annotations
@@ -34,7 +52,7 @@ from typing import Any
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
-__all__ = ["METHODS", "NOT_YET", "Method", "method_options"]
+__all__ = ["METHODS", "NOT_YET", "SOFT_CON_KEYS", "Method", "method_options"]
 
 
 @dataclass(frozen=True)
@@ -59,12 +77,24 @@ METHODS: MappingProxyType = MappingProxyType({m.key: m for m in (
     _method("cao", "Cao & Lin (2005)", saturation="auxiliary"),
     _method("mao_cao", "Mao (2003) with Cao & Lin (2005)", lyapunov="vertex_pairs", saturation="auxiliary"),
     _method("wan_cao", "Wan & Kothare (2003) with Cao & Lin (2005)", cost="nominal", saturation="auxiliary"),
+    _method("kothare_soft_con", "Kothare et al. (1996) with Oravec & Bakosova's soft constraints (2016)"),
+    _method("wan_soft_con", "Wan & Kothare (2003) with Oravec & Bakosova's soft constraints (2016)",
+            cost="nominal"),
+    _method("cao_soft_con", "Cao & Lin (2005) with Oravec & Bakosova's soft constraints (2016)",
+            saturation="auxiliary"),
+    _method("wan_cao_soft_con", "Wan & Kothare (2003) with Cao & Lin (2005) and Oravec & Bakosova's soft "
+            "constraints (2016)", cost="nominal", saturation="auxiliary"),
+    _method("ding", "Ding, Xi, Cychowski & O'Mahony (2007)", cost="nominal", lyapunov="vertex_pairs"),
 )})
+
+#: MUP's soft-constrained keys: the caller gives the soft limits (``soft`` with ``"u_limit"``
+#: and/or ``"y_limit"``).
+SOFT_CON_KEYS: frozenset[str] = frozenset(
+    {"kothare_soft_con", "wan_soft_con", "cao_soft_con", "wan_cao_soft_con"}
+)
 
 #: MUP's keys without a form here yet, with the nearest option the toolkit has.
 NOT_YET: MappingProxyType = MappingProxyType({
-    "ding": "cost='nominal' with lyapunov='vertex_pairs' (Ding et al. 2007) is not a form yet; "
-            "nearest: 'wan' or 'mao'",
     "li": "the two-step gains of Li et al. (2008) are not a form yet; nearest: 'mao'",
     "huang": "the weighted unsaturated blocks of Huang et al. (2011) are not a form yet; nearest: 'cao'",
     "shi": "the N-step chained Lyapunov matrices of Shi et al. (2013) are not a form yet; nearest: 'mao'",
@@ -73,13 +103,6 @@ NOT_YET: MappingProxyType = MappingProxyType({
     "wan_huang": "huang is not a form yet; nearest: 'wan_cao'",
     "mao_huang": "huang is not a form yet; nearest: 'mao_cao'",
     "wan_zhang": "zhang is not a form yet; nearest: 'wan_cao'",
-    "kothare_soft_con": "MUP's soft limits (separate from the hard bounds, one slack per component) "
-                        "are not a form yet; nearest: 'kothare' with soft={'u': w_u, 'y': w_y} (the "
-                        "bounds themselves softened, one slack per family)",
-    "wan_soft_con": "MUP's per-component soft limits are not a form yet; nearest: 'wan' with soft=...",
-    "cao_soft_con": "MUP's per-component soft limits are not a form yet; nearest: 'cao' with soft=...",
-    "wan_cao_soft_con": "MUP's per-component soft limits are not a form yet; "
-                        "nearest: 'wan_cao' with soft=...",
 })
 
 
@@ -107,4 +130,18 @@ def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
                 name, f"{value!r} (method {key!r} sets it) or no {name} argument", repr(given[name])
             )
     merged = {"input_constraint": "peak", **given, **options}
+    _check_soft_con(key, merged.get("soft"))
     return merged
+
+
+def _check_soft_con(key: str, soft: Any) -> None:
+    """MUP's ``*_soft_con`` keys need the caller's soft limits (the weights and limits themselves
+    are checked by :func:`lmi.forms.options.form_options`)."""
+    if key not in SOFT_CON_KEYS:
+        return
+    if not isinstance(soft, dict) or not ({"u_limit", "y_limit"} & set(soft)):
+        raise InvalidArgumentError(
+            "soft", f"MUP's soft limits for {key!r}: {{'u': [w_1, ..., w_m], 'u_limit': [l_1, ..., l_m]}} "
+            "and/or {'y': [...], 'y_limit': [...]} (a weight and a limit per component, 0 and 0 where not "
+            "softened)",
+            repr(soft))
