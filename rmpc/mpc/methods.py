@@ -22,21 +22,21 @@ key            method                                                 options
 =============  =====================================================  =================================
 
 MUP's four soft-constrained keys (Oravec & Bakošová, 2016) stand for the form of their base key
-with soft limits the caller gives (MUP's ``u_sl, y_sl, Wsu, Wsy, Esu, Esy``: a weight per input
-and output, ``0`` for those not softened, the limit where the weight is ``> 0``, ``0``
-elsewhere); the hard bounds stay hard:
+with soft limits the caller gives; the hard bounds stay hard:
 
-======================  ========================  ==================================================
-key                     options                   the caller gives
-======================  ========================  ==================================================
-``kothare_soft_con``    the defaults              ``soft={"u": [w_1, ..., w_m], "u_limit": [l_1, ...
-``wan_soft_con``        ``cost="nominal"``        ..., l_m]}`` and/or ``"y": [...]``,
-``cao_soft_con``        ``saturation=             ``"y_limit": [...]`` (one entry per input /
-                        "auxiliary"``             output of ``output_matrix``)
-``wan_cao_soft_con``    ``cost="nominal"``,
-                        ``saturation=
-                        "auxiliary"``
-======================  ========================  ==================================================
+======================  ===================================================
+key                     options
+======================  ===================================================
+``kothare_soft_con``    the defaults
+``wan_soft_con``        ``cost="nominal"``
+``cao_soft_con``        ``saturation="auxiliary"``
+``wan_cao_soft_con``    ``cost="nominal"``, ``saturation="auxiliary"``
+======================  ===================================================
+
+The caller gives MUP's ``u_sl, y_sl, Wsu, Wsy, Esu, Esy`` as ``soft={"u": [w_1, ..., w_m],
+"u_limit": [l_1, ..., l_m]}`` and/or ``"y": [...]``, ``"y_limit": [...]`` (one entry per input /
+output of ``output_matrix``; a weight ``0`` and a limit ``0`` for a component not softened;
+:mod:`lmi.forms.soft`).
 
 As in MUP, the input bound is per component (``input_constraint="peak"``) unless the caller
 gives ``input_constraint``. MUP's other keys (``li``, ``huang``, ``shi``, ``zhang``,
