@@ -25,6 +25,7 @@ from reference_forms import mup_reference
 from benchmarks.suites.methods_problems import build_problem
 from models import PolytopicModel
 from rmpc import RMPC, load
+from toolkit_common.errors import InvalidArgumentError
 
 REFERENCE_LMI = -1e-8
 OBJECTIVE_RTOL = 1e-6
@@ -182,3 +183,18 @@ def test_saved_and_loaded_the_forms_give_the_same_answer(tmp_path, key):
     first, second = ctrl.solve(p.x0), again.solve(p.x0)
     assert first.status == second.status == "optimal"
     assert second.gamma == pytest.approx(first.gamma, rel=1e-9)
+
+
+def test_a_sweep_cases_soft_lists_are_checked_against_the_controllers_inputs():
+    """A sweep file's check does not know the family's input count; building the case's controller
+    names the setting and both lengths (paper P's satellite has 3 inputs)."""
+    from benchmarks.core.sweep_spec import expand, parse_sweep
+    from models import RigidSatellite
+
+    spec = {"base": {"controller": "RMPC", "plant": "linear", "duration": 0.02,
+                     "settings": {"soft": {"u": [100, 5], "u_limit": [0.5, 0.2]}}}}
+    (scenario,) = expand(parse_sweep(spec))
+    sat = RigidSatellite.paper_p()
+    poly = sat.polytope(sat.initial_state(), 0.01, 0.3, "scalar")
+    with pytest.raises(InvalidArgumentError, match=r"soft\['u'\]: expected 3 values.*found 2 values"):
+        scenario.plant_family.build_controller(poly, scenario)

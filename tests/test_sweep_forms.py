@@ -53,6 +53,15 @@ GOOD = [
     ({"soft": {"u": 100}}, {"soft": {"u": 100.0}}),
     ({"disturbance": {"E": E_ROLL_RATE, "w_max": 0.01}}, {"disturbance": (np.array(E_ROLL_RATE), 0.01)}),
     ({"disturbance": [[0, 0, 0, 1, 0, 0], 0.01, 0.5]}, {"disturbance": (np.array(E_ROLL_RATE), 0.01, 0.5)}),
+    ({"cost": "nominal", "lyapunov": "vertex_pairs"}, {"cost": "nominal", "lyapunov": "vertex_pairs"}),
+    (
+        {"soft": {"u": [100, 0, 5]}, "input_constraint": "peak"},
+        {"soft": {"u": [100.0, 0.0, 5.0]}, "input_constraint": "peak"},
+    ),
+    (
+        {"soft": {"u": [100, 0, 5], "u_limit": [0.5, 0, 0.2]}},
+        {"soft": {"u": (100.0, 0.0, 5.0), "u_limit": (0.5, 0.0, 0.2)}},
+    ),
 ]
 
 
