@@ -457,6 +457,7 @@ def mup_reference(
     soft_u: tuple[list[float], list[float] | None] | None = None,
     soft_y: tuple[list[float], list[float] | None] | None = None,
     at: dict[str, Any] | None = None,
+    level: float | None = None,
     solver: str = "CLARABEL",
 ) -> tuple[str, float, dict[str, Any]]:
     """Ding et al.'s nominal cost with vertex Lyapunov matrices and Oravec & Bakošová's soft
@@ -482,7 +483,9 @@ def mup_reference(
       saturation); the objective ``gamma + sum w_k s_k``.
 
     ``at``: evaluate every LMI at ``gamma, Y, Q or G and Q_vertices, Z, slack`` (``sol.slack``'s
-    keys ``"u0"``, ``"y1"``) instead of solving. Returns as :func:`reference_gamma`.
+    keys ``"u0"``, ``"y1"``) instead of solving; ``level``: keep the objective ``<= level`` and
+    maximise the smallest eigenvalue of every LMI (``abs_min_eig`` then says whether the point is
+    strictly feasible, :func:`mup_reference_upper`). Returns as :func:`reference_gamma`.
     """
     A_list = [np.asarray(a, float) for a in A_list]
     n = A_list[0].shape[0]
@@ -582,7 +585,12 @@ def mup_reference(
             "lmis": values, "residual": min(relative_min_eig(M) for M in values),
             "objective": float(objective.value),
         }
-    problem = cp.Problem(cp.Minimize(objective), [_sym(M) >> 0 for M in lmis])
+    if level is None:
+        problem = cp.Problem(cp.Minimize(objective), [_sym(M) >> 0 for M in lmis])
+    else:
+        margin = cp.Variable(name="margin")
+        problem = cp.Problem(cp.Maximize(margin), [_sym(M) - margin * np.eye(M.shape[0]) >> 0 for M in lmis]
+                             + [objective <= level, margin <= 1.0])
     try:
         problem.solve(solver=solver)
         status = problem.status
@@ -592,8 +600,42 @@ def mup_reference(
         return status, float("nan"), {"objective": float("nan"), "residual": -np.inf}
     values = [np.asarray(M.value) for M in lmis]
     return status, float(gamma.value), {
+        "abs_min_eig": min(float(np.linalg.eigvalsh((M + M.T) / 2)[0]) for M in values),
         "F": np.asarray(Y.value) @ np.linalg.inv(np.asarray(G.value)),
         "slack": {key: float(var.value) for key, var in slacks.items()},
         "objective": float(objective.value), "lmis": values,
         "residual": min(relative_min_eig(M) for M in values),
     }
+
+
+def mup_reference_upper(*args: Any, rtol: float = 1e-6, max_steps: int = 40, **kwargs: Any) -> float:
+    """The smallest objective level found at which :func:`mup_reference`'s LMIs have a strictly
+    feasible point checked in numpy (bisection from Clarabel's minimum, as
+    :func:`reference_upper`): the reference's optimum is ``<=`` it whatever Clarabel's accuracy."""
+    status, _, var = mup_reference(*args, **kwargs)
+    g0 = var["objective"]
+    if not np.isfinite(g0):
+        raise RuntimeError(f"reference not solved: {status}")
+
+    def certified(level: float) -> bool:
+        status, _, var = mup_reference(*args, level=level, **kwargs)
+        ok = status in ("optimal", "optimal_inaccurate")
+        return ok and var["abs_min_eig"] > 0.0 and var["objective"] <= level
+
+    lo, hi = g0, g0
+    for k in range(30):
+        if certified(hi):
+            break
+        lo = hi
+        hi = g0 + max(abs(g0), 1e-12) * 1e-6 * 2.0**k
+    else:
+        raise RuntimeError("no certified level")
+    for _ in range(max_steps):
+        if hi - lo <= rtol * abs(hi):
+            break
+        mid = 0.5 * (lo + hi)
+        if certified(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
