@@ -48,7 +48,7 @@ class FormData:
     lam: float
     dt: float = 1.0
     q_outer: np.ndarray | None = None  # the off-line design's previous ellipsoid (common Q only)
-    u_limit: np.ndarray | None = None  # soft limits (soft["u_limit"], inf where none), at the scale of x
+    u_limit: np.ndarray | None = None  # soft limits (soft["u_limit"], 0 where none), at the scale of x
     y_limit: np.ndarray | None = None
 
     @property

@@ -136,19 +136,20 @@ def check_soft(
     if not any(k in soft for k in FAMILIES):
         raise InvalidArgumentError("soft", 'at least one weight ("u" or "y")',
                                    "an empty dict" if not soft else f"only {sorted(soft)}")
+    for family in FAMILIES:
+        if f"{family}_limit" in soft and family not in soft:
+            raise InvalidArgumentError(f"soft[{family + '_limit'!r}]",
+                                       f"the per-component weights soft[{family!r}] beside it", "none")
     sizes = {"u": n_inputs, "y": n_outputs}
     out: dict[str, float | tuple[float, ...]] = {}
-    for family in FAMILIES:
-        if family not in soft:
-            if f"{family}_limit" in soft:
-                raise InvalidArgumentError(
-                    f"soft[{family + '_limit'!r}]", f"the per-component weights soft[{family!r}] beside it",
-                    "none")
-            continue
+    for family in [key for key in soft if key in FAMILIES]:  # in the order given
         weight = soft[family]
         limit_key = f"{family}_limit"
         if _is_number(weight):
             out[family] = _scalar_weight(family, weight, max_weight)
+        elif not isinstance(weight, list | tuple | np.ndarray):
+            expected = "a number > 0 (or a list of weights >= 0, one per component)"
+            raise ArgumentTypeError(f"soft[{family!r}]", expected, type(weight).__name__)
         if family == "u" and input_constraint is None:
             expected = 'no "u" weight without an input bound (u_max)'
             raise InvalidArgumentError("soft", expected, repr(dict(soft)))
@@ -161,9 +162,6 @@ def check_soft(
                     f"soft[{family!r}]", f"a list of weights, one per component, with soft[{limit_key!r}]",
                     repr(weight))
             continue
-        if not isinstance(weight, list | tuple | np.ndarray):
-            raise ArgumentTypeError(f"soft[{family!r}]", "a number > 0 or a list of weights >= 0",
-                                    type(weight).__name__)
         weights = _component_weights(family, weight, sizes[family], max_weight)
         out[family] = weights
         if limit_key in soft:
@@ -174,7 +172,7 @@ def check_soft(
                 "input_constraint='peak' with per-component weights soft['u'] (the ellipsoid bound has "
                 "no components; or give soft limits soft['u_limit'])",
                 f"input_constraint={input_constraint!r}")
-    return out
+    return {key: out[key] for key in soft if key in out}  # in the order given (a sweep's records)
 
 
 def soft_slacks(soft: Mapping[str, Any] | None) -> tuple[SoftSlack, ...]:
