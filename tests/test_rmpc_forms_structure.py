@@ -170,7 +170,13 @@ E_OK = np.array([[0.1], [0.0]])
     ({"soft": {"x": 1.0}}, ["soft"]),
     ({"saturation": "auxiliary", "input_constraint": "ellipsoid"}, ["saturation", "input_constraint"]),
     ({"free_moves": 1, "disturbance": (E_OK, 0.1)}, ["free_moves", "disturbance"]),
-    ({"cost": "nominal", "lyapunov": "vertex"}, ["cost", "lyapunov"]),
+    ({"soft": {"u": [1.0, 0.0]}}, ["soft['u']", "1 values", "2 values"]),
+    ({"soft": {"u": [0.0]}}, ["soft['u']", "at least one weight > 0"]),
+    ({"soft": {"u": [1e9]}}, ["soft['u'][0]", "MAX_SOFT_WEIGHT"]),
+    ({"soft": {"u": [1.0], "u_limit": [0.0]}}, ["soft['u_limit'][0]", "finite soft limit > 0"]),
+    ({"soft": {"u": 1.0, "u_limit": [0.5]}}, ["soft['u']", "a list of weights"]),
+    ({"soft": {"u_limit": [0.5]}}, ["soft", "at least one weight"]),
+    ({"soft": {"u": [1.0]}, "input_constraint": "ellipsoid"}, ["soft, input_constraint", "'peak'"]),
 ])
 def test_bad_options_name_the_argument(options, names):
     kwargs = {"u_max": 10.0, "input_constraint": "peak", **options}

@@ -53,6 +53,15 @@ GOOD = [
     ({"soft": {"u": 100}}, {"soft": {"u": 100.0}}),
     ({"disturbance": {"E": E_ROLL_RATE, "w_max": 0.01}}, {"disturbance": (np.array(E_ROLL_RATE), 0.01)}),
     ({"disturbance": [[0, 0, 0, 1, 0, 0], 0.01, 0.5]}, {"disturbance": (np.array(E_ROLL_RATE), 0.01, 0.5)}),
+    ({"cost": "nominal", "lyapunov": "vertex_pairs"}, {"cost": "nominal", "lyapunov": "vertex_pairs"}),
+    (
+        {"soft": {"u": [100, 0, 5]}, "input_constraint": "peak"},
+        {"soft": {"u": [100.0, 0.0, 5.0]}, "input_constraint": "peak"},
+    ),
+    (
+        {"soft": {"u": [100, 0, 5], "u_limit": [0.5, 0, 0.2]}},
+        {"soft": {"u": (100.0, 0.0, 5.0), "u_limit": (0.5, 0.0, 0.2)}},
+    ),
 ]
 
 
@@ -92,10 +101,12 @@ BAD = [
     ({"lyapunov": "quartic"}, {"lyapunov": "quartic"}, "base.settings.lyapunov"),
     ({"lyapunov": 3}, {"lyapunov": 3}, "base.settings.lyapunov"),
     ({"cost": "average"}, {"cost": "average"}, "base.settings.cost"),
+    ({"soft": {"u": [1.0, -1.0, 0.0]}}, {"soft": {"u": [1.0, -1.0, 0.0]}}, "base.settings.soft.u[1]"),
+    ({"soft": {"u": [0.0, 0.0, 0.0]}}, {"soft": {"u": [0.0, 0.0, 0.0]}}, "base.settings.soft.u"),
     (
-        {"cost": "nominal", "lyapunov": "vertex"},
-        {"cost": "nominal", "lyapunov": "vertex"},
-        "base.settings.cost, base.settings.lyapunov",
+        {"soft": {"u": [1.0, 0.0, 0.0], "u_limit": [0.5, 0.2, 0.0]}},
+        {"soft": {"u": [1.0, 0.0, 0.0], "u_limit": [0.5, 0.2, 0.0]}},
+        "base.settings.soft.u_limit[1]",
     ),
     ({"free_moves": 2}, {"free_moves": 2}, "base.settings.free_moves"),
     ({"free_moves": True}, {"free_moves": True}, "base.settings.free_moves"),
@@ -177,11 +188,11 @@ def test_a_form_with_the_scheduled_polytope_is_refused_naming_kinematics():
 
 
 def test_an_error_between_a_grid_setting_and_a_base_setting_names_each_where_it_is():
-    data = _rmpc_sweep({"lyapunov": "vertex"})
-    data["grid"] = {"settings": {"cost": ["worst_case", "nominal"]}}
+    data = _rmpc_sweep({"disturbance": {"E": E_ROLL_RATE, "w_max": 0.01}})
+    data["grid"] = {"settings": {"free_moves": [0, 1]}}
     with pytest.raises(ConfigError) as info:
         parse_sweep(data)
-    assert info.value.argument == "grid.settings.cost, base.settings.lyapunov"
+    assert info.value.argument == "grid.settings.free_moves, base.settings.disturbance"
 
 
 def test_a_form_setting_of_another_controller_is_refused():

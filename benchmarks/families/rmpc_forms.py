@@ -10,7 +10,9 @@ Python constructor's own check (:func:`lmi.forms.options.form_options`), and the
 sweep file's key path (``base.settings.soft.u``, ``grid.settings.lyapunov``) instead of the
 Python argument. The values TOML cannot write as Python does:
 
-- ``soft``: a table ``{u = w_u, y = w_y}`` (Python's dict);
+- ``soft``: a table ``{u = w_u, y = w_y}`` (Python's dict), per component ``{u = [w_1, 0, w_3],
+  u_limit = [l_1, 0, l_3]}`` (:mod:`lmi.forms.soft`; the lengths are checked when the case's
+  controller is built);
 - ``disturbance``: a table ``{E = [[...], ...], w_max = w, lam = l}`` (``lam`` optional) or the
   list ``[E, w_max]`` / ``[E, w_max, lam]`` (Python's tuple); ``E`` is ``n x q`` (``n`` the
   controller's states) or a list of ``n`` numbers (one column);
@@ -69,13 +71,14 @@ def _python_check(where: str, n_states: int, has_output: bool, **options: Any) -
 
 
 def _path(argument: str, where: str) -> str:
-    """The key path of a Python argument: ``soft['u']`` -> ``<where>.u``, ``disturbance E`` -> ``<where>.E``.
+    """The key path of a Python argument: ``soft['u']`` -> ``<where>.u``, ``soft['u'][1]`` ->
+    ``<where>.u[1]``, ``disturbance E`` -> ``<where>.E``.
     """
-    inner = re.match(r"^\w+(?:\[['\"]?(\w+)['\"]?\]| (\w+))?$", argument)
+    inner = re.match(r"^\w+(?:\[['\"]?(\w+)['\"]?\](\[\d+\])?| (\w+))?$", argument)
     if inner is None:
         return where
-    part = inner.group(1) or inner.group(2)
-    return f"{where}.{part}" if part else where
+    part = inner.group(1) or inner.group(3)
+    return f"{where}.{part}{inner.group(2) or ''}" if part else where
 
 
 def _lyapunov(value: Any, where: str, n: int, out: bool) -> str:

@@ -18,6 +18,7 @@ import numpy as np
 from lmi.affine import AffineMatrix
 from lmi.forms.options import FormOptions
 from lmi.forms.program import Layout, Program
+from lmi.forms.soft import bound_slack, limit_slacks, soft_slacks
 
 __all__ = ["FormData", "declare", "delta_congruence", "objective", "pairs", "write"]
 
@@ -47,6 +48,8 @@ class FormData:
     lam: float
     dt: float = 1.0
     q_outer: np.ndarray | None = None  # the off-line design's previous ellipsoid (common Q only)
+    u_limit: np.ndarray | None = None  # soft limits (soft["u_limit"], 0 where none), at the scale of x
+    y_limit: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -93,11 +96,8 @@ def declare(opts: FormOptions, fd: FormData) -> Layout:
     if opts.free_moves:
         lay.full("u0", m, 1)
         lay.full("s0", 1, 1)
-    soft = opts.soft or {}
-    if "u" in soft:
-        lay.full("s_u", 1, 1)
-    if "y" in soft:
-        lay.full("s_y", 1, 1)
+    for slack in soft_slacks(opts.soft):
+        lay.full(slack.name, 1, 1)
     return lay
 
 
@@ -106,8 +106,11 @@ def shares_cost(opts: FormOptions, n_vertices: int) -> bool:
     cost LMI per input sign): ``[[dt W, G' Q1h', Y_s' Rh'], [Q1h G, gamma I, 0], [Rh Y_s, 0, gamma
     I]] >= 0`` once, and ``[[T_i - dt W, M'], [M, Q_j]] >= 0`` per pair: by a Schur complement the
     same set of ``(G, Q_j, Y, gamma)`` (the best ``W`` is ``(G' Q1 G + Y_s' R Y_s) / (dt gamma)``),
-    with each pair's block of order ``2n`` instead of ``2n + p + m`` (as Kothare's "delta_shared")."""
-    return opts.cost == "worst_case" and len(pairs(opts, n_vertices)) > 1
+    with each pair's block of order ``2n`` instead of ``2n + p + m`` (as Kothare's "delta_shared").
+    With the nominal cost and the vertex Lyapunov forms (Ding et al.) the pairs' blocks hold the
+    nominal model ``M = A_0 G + B_0 Y_s``; the nominal cost with one ``Q`` stays one block."""
+    several = len(pairs(opts, n_vertices)) > 1
+    return several and (opts.cost == "worst_case" or opts.vertex_lyapunov)
 
 
 def objective(opts: FormOptions, lay: Layout) -> np.ndarray:
@@ -116,8 +119,8 @@ def objective(opts: FormOptions, lay: Layout) -> np.ndarray:
     c[lay.index("gamma")] = 1.0
     if "s0" in lay:
         c[lay.index("s0")] = 1.0
-    for key, weight in (opts.soft or {}).items():
-        c[lay.index(f"s_{key}")] = weight
+    for slack in soft_slacks(opts.soft):
+        c[lay.index(slack.name)] = slack.weight
     return c
 
 
@@ -208,21 +211,32 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
             prog.add(f"cost_shared{tag}", prog.bmat(rows), congruence=scale)
         if shared:
             w_dt = prog.var(f"W{k}") * fd.dt
+            nominal = opts.cost == "nominal"  # Ding et al.: the nominal model with T_i and Q_j
             for i, j in vertex_pairs:
-                if not prog.wants(f"cost_{i}_{j}{tag}"):
+                name = f"cost_nominal_{i}_{j}{tag}" if nominal else f"cost_{i}_{j}{tag}"
+                if not prog.wants(name):
                     continue
-                mid = g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])
+                a, b = (fd.A0, fd.B0) if nominal else (fd.A[i], fd.B[i])
+                assert a is not None and b is not None
+                mid = g_var.lmul(a) + ys.lmul(b)
                 block = prog.bmat([[top(i) - w_dt, mid.T], [mid, q_next(j)]])
-                prog.add(f"cost_{i}_{j}{tag}", block, congruence=delta(0, 1.0))
+                prog.add(name, block, congruence=delta(0, 1.0))
         elif opts.cost == "worst_case":
             for i, j in vertex_pairs:
                 if prog.wants(f"cost_{i}_{j}{tag}"):
                     prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys),
                              congruence=cost_delta)
-        elif prog.wants(f"cost_nominal{tag}"):
+        elif not opts.vertex_lyapunov:
+            if prog.wants(f"cost_nominal{tag}"):
+                assert fd.A0 is not None and fd.B0 is not None
+                prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys),
+                         congruence=cost_delta)
+        else:  # the nominal cost with one vertex Lyapunov matrix: one pair, (0, 0)
             assert fd.A0 is not None and fd.B0 is not None
-            prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys),
-                     congruence=cost_delta)
+            for i, j in vertex_pairs:
+                if prog.wants(f"cost_nominal_{i}_{j}{tag}"):
+                    prog.add(f"cost_nominal_{i}_{j}{tag}",
+                             cost_block(fd.A0, fd.B0, top(i), q_next(j), ys), congruence=cost_delta)
         if disturbed or opts.cost == "nominal":
             for i, j in vertex_pairs:
                 if not prog.wants(f"invariance_{i}_{j}{tag}"):
@@ -233,6 +247,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
         prog.add("nesting", prog.const(fd.q_outer) - lyap[0])
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)
     _bound_blocks(prog, opts, fd, top, y_sign, signs, lyap)
+    _soft_limit_blocks(prog, opts, fd, top, y_sign, signs, lyap)
     return prog
 
 
@@ -257,14 +272,15 @@ def delta_congruence(n: int, extra: int, dt: float, rest_scale: float) -> np.nda
     return lmat
 
 
-def _with_slacks(prog: Program, block: AffineMatrix) -> AffineMatrix:
-    """``block`` with the soft constraints' slacks ``s_u, s_y >= 0`` appended on its diagonal.
+def _with_slacks(prog: Program, opts: FormOptions, block: AffineMatrix) -> AffineMatrix:
+    """``block`` with the soft constraints' slacks (``s_u, s_y``, or one per softened component,
+    :func:`lmi.forms.soft.soft_slacks`) ``>= 0`` appended on its diagonal.
 
     A slack is zero at the optimum wherever the hard bound holds; on a ``1 x 1`` block of its
     own, the solver's block-wise residual test (relative to the block's size, then about zero)
     could never pass, so the slacks share the state block, whose size is one.
     """
-    slacks = [prog.var(name) for name in ("s_u", "s_y") if name in prog.layout]
+    slacks = [prog.var(slack.name) for slack in soft_slacks(opts.soft)]
     if not slacks:
         return block
     rows: list[list[AffineMatrix | None]] = [[block] + [None] * len(slacks)]
@@ -277,10 +293,10 @@ def _with_slacks(prog: Program, block: AffineMatrix) -> AffineMatrix:
     return prog.bmat(rows)
 
 
-def _soft_square(prog: Program, bound: float, name: str) -> AffineMatrix:
-    """``bound^2 (+ s_name)`` as a ``1 x 1`` affine matrix."""
+def _soft_square(prog: Program, bound: float, name: str | None) -> AffineMatrix:
+    """``bound^2 (+ s_name)`` as a ``1 x 1`` affine matrix (``name`` ``None``: a hard bound)."""
     square = prog.const(bound**2)
-    return square + prog.var(name) if name in prog.layout else square
+    return square + prog.var(name) if name is not None and name in prog.layout else square
 
 
 def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[AffineMatrix],
@@ -290,7 +306,7 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
         xc = prog.const(fd.x[:, None])
         for j, q in enumerate(lyap):
             block = prog.bmat([[one, xc.T], [xc, q]])
-            prog.add(f"state_{j}", _with_slacks(prog, block) if j == 0 else block)
+            prog.add(f"state_{j}", _with_slacks(prog, opts, block) if j == 0 else block)
         return
     u0 = prog.var("u0")
     # every vertex's prediction x(k+1) = A_i x + B_i u0 inside the ellipsoid of Q_j
@@ -306,7 +322,7 @@ def _state_blocks(prog: Program, opts: FormOptions, fd: FormData, lyap: list[Aff
     stage = float(fd.x @ fd.Q1h.T @ fd.Q1h @ fd.x)
     s0 = prog.var("s0") - prog.const(stage)
     stage_block = prog.bmat([[s0, u0.T.rmul(fd.Rh.T)], [u0.lmul(fd.Rh), prog.eye(fd.m)]])
-    prog.add("stage_cost", _with_slacks(prog, stage_block))
+    prog.add("stage_cost", _with_slacks(prog, opts, stage_block))
 
 
 def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, signs,
@@ -317,23 +333,23 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
     for j in range(len(lyap)):
         t = top(j)
         if kind == "ellipsoid":
-            square = _soft_square(prog, float(fd.u_max[0]), "s_u")
+            square = _soft_square(prog, float(fd.u_max[0]), bound_slack(opts.soft, "u", None))
             prog.add(f"input_{j}", prog.bmat([[prog.times(square, np.eye(m)), bounded],
                                                [bounded.T, t]]))
         elif kind == "peak":
             for ell in range(m):
                 row = bounded.lmul(np.eye(m)[ell : ell + 1])
-                square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
+                square = _soft_square(prog, float(fd.u_max[ell]), bound_slack(opts.soft, "u", ell))
                 prog.add(f"input_{ell}_{j}", prog.bmat([[square, row], [row.T, t]]))
     if opts.free_moves and kind is not None:
         u0 = prog.var("u0")
         if kind == "ellipsoid":
-            square = _soft_square(prog, float(fd.u_max[0]), "s_u")
+            square = _soft_square(prog, float(fd.u_max[0]), bound_slack(opts.soft, "u", None))
             prog.add("input_u0", prog.bmat([[square, u0.T], [u0, prog.eye(m)]]))
         else:
             for ell in range(m):
                 comp = u0.lmul(np.eye(m)[ell : ell + 1])
-                square = _soft_square(prog, float(fd.u_max[ell]), "s_u")
+                square = _soft_square(prog, float(fd.u_max[ell]), bound_slack(opts.soft, "u", ell))
                 prog.add(f"input_u0_{ell}", prog.bmat([[square, comp], [comp, prog.const(1.0)]]))
     if fd.C_out is None:
         return
@@ -345,10 +361,49 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
                 tag = "" if sign is None else f"_s{k}"
                 ys = y_sign(sign)
                 out = (g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])).lmul(c_row[None, :])
-                square = _soft_square(prog, square_bound, "s_y")
+                square = _soft_square(prog, square_bound, bound_slack(opts.soft, "y", r))
                 prog.add(f"output_{r}_{i}{tag}", prog.bmat([[square, out], [out.T, top(i)]]))
             if opts.free_moves:
                 u0 = prog.var("u0")
                 pred = (u0.lmul(fd.B[i]) + prog.const((fd.A[i] @ fd.x)[:, None])).lmul(c_row[None, :])
-                square = _soft_square(prog, square_bound, "s_y")
+                square = _soft_square(prog, square_bound, bound_slack(opts.soft, "y", r))
                 prog.add(f"output_{r}_{i}_u0", prog.bmat([[square, pred], [pred.T, prog.const(1.0)]]))
+
+
+def _soft_limit_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, signs,
+                       lyap: list[AffineMatrix]) -> None:
+    """The soft limits (``soft["u_limit"]``, ``soft["y_limit"]``) after Oravec & Bakošová, one
+    block per softened component ``k`` (as the peak bounds): ``[[l_k^2 + s_k, y_k], [y_k', T_j]]
+    >= 0`` for every ``j`` (``y_k`` the row ``k`` of ``Y``, the law's own gain, also with the
+    auxiliary saturation, as MUP's ``sdp_cao_soft_con.m``) and, with output bounds,
+    ``[[l_r^2 + s_r, c_r (A_i G + B_i Y_s)], [., T_i]] >= 0`` for every vertex ``i`` (and
+    ``D_s``); with a free move, the same on ``u0`` and on every vertex's ``c_r x(k+1)``."""
+    one = prog.const(1.0)
+    for slack in limit_slacks(opts.soft, "u"):
+        assert fd.u_limit is not None
+        k = slack.component
+        assert k is not None
+        square = _soft_square(prog, float(fd.u_limit[k]), slack.name)
+        row = prog.var("Y").lmul(np.eye(fd.m)[k : k + 1])
+        for j in range(len(lyap)):
+            prog.add(f"soft_limit_u{k}_{j}", prog.bmat([[square, row], [row.T, top(j)]]))
+        if opts.free_moves:
+            comp = prog.var("u0").lmul(np.eye(fd.m)[k : k + 1])
+            prog.add(f"soft_limit_u{k}_u0", prog.bmat([[square, comp], [comp.T, one]]))
+    if fd.C_out is None:
+        return
+    g_var = lyap[0] if opts.lyapunov == "common" else prog.var("G")
+    for slack in limit_slacks(opts.soft, "y"):
+        assert fd.y_limit is not None
+        r = slack.component
+        assert r is not None
+        square = _soft_square(prog, float(fd.y_limit[r]), slack.name)
+        c_row = fd.C_out[r][None, :]
+        for i in range(fd.n_vertices):
+            for k, sign in enumerate(signs):
+                tag = "" if sign is None else f"_s{k}"
+                out = (g_var.lmul(fd.A[i]) + y_sign(sign).lmul(fd.B[i])).lmul(c_row)
+                prog.add(f"soft_limit_y{r}_{i}{tag}", prog.bmat([[square, out], [out.T, top(i)]]))
+            if opts.free_moves:
+                pred = (prog.var("u0").lmul(fd.B[i]) + prog.const((fd.A[i] @ fd.x)[:, None])).lmul(c_row)
+                prog.add(f"soft_limit_y{r}_{i}_u0", prog.bmat([[square, pred], [pred.T, one]]))

@@ -15,6 +15,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from lmi.forms.soft import check_soft
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_real_array
 
@@ -51,7 +52,9 @@ class FormOptions:
     cost: Literal["worst_case", "nominal"] = "worst_case"
     free_moves: int = 0
     saturation: Literal["auxiliary"] | None = None
-    soft: Mapping[str, float] | None = None
+    #: ``{"u": w_u, "y": w_y}`` (one slack per family), or per component ``{"u": (w_1, ...),
+    #: "u_limit": (l_1, ...)}`` (:mod:`lmi.forms.soft`)
+    soft: Mapping[str, float | tuple[float, ...]] | None = None
     disturbance: Disturbance | None = None
     horizon: int = 1
     step_gains: Literal["common", "vertex"] = "common"
@@ -96,37 +99,6 @@ def _choice(value: Any, allowed: tuple, name: str) -> Any:
 #: fallback, called several of them unbounded, and at 1e200 the kernels divided by zero. 1e8 keeps
 #: a factor of 100 from the first failure.
 MAX_SOFT_WEIGHT = 1e8
-
-
-def _soft(soft: Any, has_input: bool, has_output: bool) -> dict[str, float] | None:
-    if soft is None:
-        return None
-    if not isinstance(soft, Mapping):
-        raise ArgumentTypeError("soft", 'None or a dict of weights {"u": w_u, "y": w_y}', type(soft).__name__)
-    unknown = sorted(str(k) for k in soft if k not in ("u", "y"))
-    if unknown:
-        raise InvalidArgumentError("soft", 'weights for "u" and/or "y"', f"unknown keys {unknown}")
-    if not soft:
-        raise InvalidArgumentError("soft", 'at least one weight ("u" or "y")', "an empty dict")
-    out: dict[str, float] = {}
-    for key, weight in soft.items():
-        if isinstance(weight, bool) or not isinstance(weight, int | float | np.floating | np.integer):
-            raise ArgumentTypeError(f"soft[{key!r}]", "a number > 0", type(weight).__name__)
-        if not (np.isfinite(weight) and weight > 0.0):
-            raise InvalidArgumentError(f"soft[{key!r}]", "a finite weight > 0", repr(weight))
-        if weight > MAX_SOFT_WEIGHT:
-            raise InvalidArgumentError(
-                f"soft[{key!r}]", f"a weight <= MAX_SOFT_WEIGHT = {MAX_SOFT_WEIGHT:g} (beyond it the solvers "
-                "cannot resolve the cost bound next to the penalty; see the page on the forms)", repr(weight))
-        if key == "u" and not has_input:
-            expected = 'no "u" weight without an input bound (u_max)'
-            raise InvalidArgumentError("soft", expected, repr(dict(soft)))
-        if key == "y" and not has_output:
-            raise InvalidArgumentError(
-                "soft", 'no "y" weight without output bounds (output_matrix, y_max)', repr(dict(soft))
-            )
-        out[key] = float(weight)
-    return out
 
 
 def _disturbance(disturbance: Any, n: int) -> Disturbance | None:
@@ -174,8 +146,13 @@ def form_options(
     disturbance: Any = None,
     horizon: Any = 1,
     step_gains: Any = "common",
+    n_inputs: int | None = None,
+    n_outputs: int | None = None,
 ) -> FormOptions:
     """Check every option and every combination; return the :class:`FormOptions`.
+
+    ``n_inputs``/``n_outputs``: the plant's inputs and bounded outputs, the lengths of per-component
+    soft weights and limits (:mod:`lmi.forms.soft`; ``None``: not checked here).
 
     Raises
     ------
@@ -190,16 +167,11 @@ def form_options(
     if free_moves not in (0, 1):
         raise InvalidArgumentError("free_moves", "0 or 1", repr(free_moves))
     _choice(saturation, SATURATIONS, "saturation")
-    soft_weights = _soft(soft, input_constraint is not None, has_output)
+    soft_weights = check_soft(soft, input_constraint=input_constraint, has_output=has_output,
+                              n_inputs=n_inputs, n_outputs=n_outputs, max_weight=MAX_SOFT_WEIGHT)
     dist = _disturbance(disturbance, n_states)
     steps = _steps(horizon, step_gains)
     _step_combinations(steps, lyapunov, cost, free_moves, saturation, soft_weights, dist)
-    if cost == "nominal" and lyapunov != "common":
-        raise InvalidArgumentError(
-            "cost, lyapunov",
-            "cost='nominal' with lyapunov='common' (the nominal model has no Q_j of its own)",
-            f"cost={cost!r}, lyapunov={lyapunov!r}",
-        )
     if saturation == "auxiliary" and input_constraint != "peak":
         raise InvalidArgumentError(
             "saturation, input_constraint",

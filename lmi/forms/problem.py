@@ -28,6 +28,7 @@ from lmi.data import InputConstraint, KothareData, build_kothare_data
 from lmi.forms.lmis import FormData, objective
 from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
+from lmi.forms.soft import soft_slacks
 
 # every form's variables and blocks: lmi.forms.lmis's, or with steps (horizon > 1) lmi.forms.steps's
 from lmi.forms.steps import declare_form as declare
@@ -166,6 +167,8 @@ class FormProblem:
             n_states=data.n, input_constraint=data.input_constraint, has_output=data.C_out is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
             disturbance=disturbance, horizon=horizon, step_gains=step_gains,
+            n_inputs=data.m,
+            n_outputs=None if data.C_out is None else data.C_out.shape[0],
         )
         if backend not in _BACKENDS:
             raise InvalidArgumentError("backend", "'ipm', 'clarabel' or 'cvxpy'", repr(backend))
@@ -185,6 +188,9 @@ class FormProblem:
                 )
         # the nesting block's Q_outer / ||x||^2 of the solve under way (set by every solve)
         self._q_outer: np.ndarray | None = None
+        # ||x|| of the solve under way: the soft limits (soft["u_limit"], "y_limit") are divided by it
+        self._scale = 1.0
+        self._check_limits()
         use_scaling = self._settings.pop("state_scaling", True) if backend == "ipm" else False
         self._t = state_scaling(data) if use_scaling else np.ones(data.n)
         self._t0 = self._t  # a rebalanced retry replaces _t; reset() restores this
@@ -216,6 +222,21 @@ class FormProblem:
                 f"({', '.join(remedies)})",
                 f"{template.n_vertices} vertices{options}: {len(orders)} blocks of orders up to "
                 f"{max(orders)} in {self.layout.size} variables, about {need / 1e9:.1f} GB",
+            )
+
+    def _check_limits(self) -> None:
+        """Output soft limits larger than the disturbance's own reach (they are tightened by it as
+        the hard output bounds are)."""
+        soft = self.options.soft or {}
+        if self._E is None or self.data.C_out is None or "y_limit" not in soft:
+            return
+        reach = np.linalg.norm(self.data.C_out @ self._E, axis=1) * self.options.disturbance.w_max
+        tight = np.asarray(soft["y_limit"]) - reach
+        if np.any(tight <= 0.0):
+            raise InvalidArgumentError(
+                "disturbance, soft['y_limit']",
+                "output soft limits larger than the disturbance's own reach ||c_r E|| w_max",
+                f"y_limit - ||C E|| w_max = {tight.tolist()}",
             )
 
     def _check_nominal(self, nominal: Any) -> tuple[np.ndarray, np.ndarray] | None:
@@ -268,7 +289,16 @@ class FormProblem:
         if self._E is not None and data.C_out is not None:
             y_tight = y_max - np.linalg.norm(data.C_out @ self._E, axis=1) * w_max
         q_outer = self._q_outer
+        soft = self.options.soft or {}
+        u_limit = y_limit = None
+        if "u_limit" in soft:
+            u_limit = np.asarray(soft["u_limit"], dtype=float) / self._scale
+        if "y_limit" in soft and data.C_out is not None:
+            y_limit = np.asarray(soft["y_limit"], dtype=float) / self._scale
+            if self._E is not None:
+                y_limit = y_limit - np.linalg.norm(data.C_out @ self._E, axis=1) * w_max
         return FormData(
+            u_limit=u_limit, y_limit=y_limit,
             q_outer=None if q_outer is None else ti @ q_outer @ ti.T,
             A=a, B=b, A0=a0, B0=b0, Q1h=data.Q1h @ t, Rh=data.Rh,
             input_constraint=data.input_constraint,
@@ -312,6 +342,7 @@ class FormProblem:
         bound = self.data.u_max if u_max is None else self.input_bound(u_max)
         xs, us, ys = x / scale, bound / scale, self.data.y_max / scale
         self._q_outer = None if q_outer is None else 0.5 * (q_outer + q_outer.T) / scale**2
+        self._scale = scale
         dist = self.options.disturbance
         w_max = 0.0 if dist is None else dist.w_max / scale
         if w_max > 0.0 and dist is not None and dist.lam is None:
@@ -374,7 +405,7 @@ class FormProblem:
     def _objective(self, sol: LMISolution) -> float:
         """The minimised objective: the cost bound plus the soft constraints' penalties."""
         slack = sol.slack or {}
-        return sol.gamma + sum(w * slack.get(key, 0.0) for key, w in (self.options.soft or {}).items())
+        return sol.gamma + sum(s.weight * slack.get(s.key, 0.0) for s in soft_slacks(self.options.soft))
 
     def _solve_at(self, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
                   w_max: float, lam: float, keep: bool = True) -> LMISolution:
@@ -648,14 +679,18 @@ class FormProblem:
                       self._form_data(xs, us, ys, w_max, lam, t=np.ones(self.data.n)))
         margins = check.margins()
         opts = self.options
-        for key, bounds in (("u", us), ("y", ys)):
-            if key in (opts.soft or {}):
-                # a slack is >= 0 (its diagonal entry of the state block is certified with that
-                # block, relative to the block's size); here also against the squared bound it
-                # softens: a negative slack tightens that bound, and lowers the objective by w |s|
-                slack_n = float(values[f"s_{key}"][0, 0])
-                square = float(np.min(np.asarray(bounds) ** 2))
-                margins[f"slack_{key}"] = slack_n / max(square, abs(slack_n), np.finfo(float).tiny)
+        for soft in soft_slacks(opts.soft):
+            # a slack is >= 0 (its diagonal entry of the state block is certified with that
+            # block, relative to the block's size); here also against the squared bound it
+            # softens: a negative slack tightens that bound, and lowers the objective by w |s|
+            slack_n = float(values[soft.name][0, 0])
+            if soft.limit is not None:
+                bound = soft.limit / scale
+            else:
+                bounds = np.asarray(us if soft.family == "u" else ys)
+                bound = float(np.min(bounds) if soft.component is None else bounds[soft.component])
+            square = bound**2
+            margins[f"slack_{soft.key}"] = slack_n / max(square, abs(slack_n), np.finfo(float).tiny)
         g_mat = values["G"] if opts.vertex_lyapunov else values["Q"]
         try:
             g_inv = np.linalg.inv(g_mat)
@@ -675,7 +710,7 @@ class FormProblem:
         gamma = float(values["gamma"][0, 0]) + (float(values["s0"][0, 0]) if "s0" in values else 0.0)
         slack = None
         if opts.soft is not None:
-            slack = {key: s2 * float(values[f"s_{key}"][0, 0]) for key in opts.soft}
+            slack = {s.key: s2 * float(values[s.name][0, 0]) for s in soft_slacks(opts.soft)}
         finite = f_mat is not None and np.all(np.isfinite(f_mat)) and q_mat is not None
         if status == OPTIMAL and not (cert.ok and finite):
             status = UNCERTIFIED

@@ -24,14 +24,32 @@ key            method                                                 options
                                                                       caller may give another),
                                                                       ``lyapunov="vertex_pairs"``,
                                                                       ``saturation="auxiliary"``
+``ding``       Ding, Xi, Cychowski & O'Mahony (2007)                  ``cost="nominal"``,
+                                                                      ``lyapunov="vertex_pairs"``
 =============  =====================================================  =================================
+
+MUP's four soft-constrained keys (Oravec & Bakošová, 2016) stand for the form of their base key
+with soft limits the caller gives; the hard bounds stay hard:
+
+======================  ===================================================
+key                     options
+======================  ===================================================
+``kothare_soft_con``    the defaults
+``wan_soft_con``        ``cost="nominal"``
+``cao_soft_con``        ``saturation="auxiliary"``
+``wan_cao_soft_con``    ``cost="nominal"``, ``saturation="auxiliary"``
+======================  ===================================================
+
+The caller gives MUP's ``u_sl, y_sl, Wsu, Wsy, Esu, Esy`` as ``soft={"u": [w_1, ..., w_m],
+"u_limit": [l_1, ..., l_m]}`` and/or ``"y": [...]``, ``"y_limit": [...]`` (one entry per input /
+output of ``output_matrix``; a weight ``0`` and a limit ``0`` for a component not softened;
+:mod:`lmi.forms.soft`).
 
 As in MUP, the input bound is per component (``input_constraint="peak"``) unless the caller
 gives ``input_constraint``. ``li`` and ``shi`` differ from MUP's own code where the docs' page on
 the forms says (``Y - E_j Z`` of MUP's ``sdp_shi.m`` is the auxiliary saturation with ``H = Y -
-Z``; the terminal ellipsoid; output bounds at every step). MUP's other keys (``ding``, ``huang``, ``zhang``,
-``wan_huang``, ``mao_huang``, ``wan_zhang`` and the ``*_soft_con`` variants, whose soft limits are
-separate from the hard bounds with one slack per component) have no form here yet: asked for by
+Z``; the terminal ellipsoid; output bounds at every step). MUP's other keys (``huang``, ``zhang``,
+``wan_huang``, ``mao_huang``, ``wan_zhang``) have no form here yet: asked for by
 name they are refused with the nearest option the toolkit has.
 """
 
@@ -43,7 +61,7 @@ from typing import Any
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
-__all__ = ["METHODS", "NOT_YET", "Method", "method_options"]
+__all__ = ["METHODS", "NOT_YET", "SOFT_CON_KEYS", "Method", "method_options"]
 
 
 @dataclass(frozen=True)
@@ -74,25 +92,30 @@ METHODS: MappingProxyType = MappingProxyType({m.key: m for m in (
     Method("shi", "Shi, Su & Chu (2013)",
            MappingProxyType({"lyapunov": "vertex_pairs", "saturation": "auxiliary"}),
            MappingProxyType({"horizon": 3})),
+    _method("kothare_soft_con", "Kothare et al. (1996) with Oravec & Bakosova's soft constraints (2016)"),
+    _method("wan_soft_con", "Wan & Kothare (2003) with Oravec & Bakosova's soft constraints (2016)",
+            cost="nominal"),
+    _method("cao_soft_con", "Cao & Lin (2005) with Oravec & Bakosova's soft constraints (2016)",
+            saturation="auxiliary"),
+    _method("wan_cao_soft_con", "Wan & Kothare (2003) with Cao & Lin (2005) and Oravec & Bakosova's soft "
+            "constraints (2016)", cost="nominal", saturation="auxiliary"),
+    _method("ding", "Ding, Xi, Cychowski & O'Mahony (2007)", cost="nominal", lyapunov="vertex_pairs"),
 )})
+
+#: MUP's soft-constrained keys: the caller gives the soft limits (``soft`` with ``"u_limit"``
+#: and/or ``"y_limit"``).
+SOFT_CON_KEYS: frozenset[str] = frozenset(
+    {"kothare_soft_con", "wan_soft_con", "cao_soft_con", "wan_cao_soft_con"}
+)
 
 #: MUP's keys without a form here yet, with the nearest option the toolkit has.
 NOT_YET: MappingProxyType = MappingProxyType({
-    "ding": "cost='nominal' with lyapunov='vertex_pairs' (Ding et al. 2007) is not a form yet; "
-            "nearest: 'wan' or 'mao'",
     "huang": "the weighted unsaturated blocks of Huang et al. (2011) are not a form yet; nearest: 'cao'",
     "zhang": "the saturation-dependent Lyapunov function of Zhang et al. (2013) is not a form yet; "
              "nearest: 'cao'",
     "wan_huang": "huang is not a form yet; nearest: 'wan_cao'",
     "mao_huang": "huang is not a form yet; nearest: 'mao_cao'",
     "wan_zhang": "zhang is not a form yet; nearest: 'wan_cao'",
-    "kothare_soft_con": "MUP's soft limits (separate from the hard bounds, one slack per component) "
-                        "are not a form yet; nearest: 'kothare' with soft={'u': w_u, 'y': w_y} (the "
-                        "bounds themselves softened, one slack per family)",
-    "wan_soft_con": "MUP's per-component soft limits are not a form yet; nearest: 'wan' with soft=...",
-    "cao_soft_con": "MUP's per-component soft limits are not a form yet; nearest: 'cao' with soft=...",
-    "wan_cao_soft_con": "MUP's per-component soft limits are not a form yet; "
-                        "nearest: 'wan_cao' with soft=...",
 })
 
 
@@ -120,4 +143,18 @@ def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
                 name, f"{value!r} (method {key!r} sets it) or no {name} argument", repr(given[name])
             )
     merged = {"input_constraint": "peak", **METHODS[key].defaults, **given, **options}
+    _check_soft_con(key, merged.get("soft"))
     return merged
+
+
+def _check_soft_con(key: str, soft: Any) -> None:
+    """MUP's ``*_soft_con`` keys need the caller's soft limits (the weights and limits themselves
+    are checked by :func:`lmi.forms.options.form_options`)."""
+    if key not in SOFT_CON_KEYS:
+        return
+    if not isinstance(soft, dict) or not ({"u_limit", "y_limit"} & set(soft)):
+        raise InvalidArgumentError(
+            "soft", f"MUP's soft limits for {key!r}: {{'u': [w_1, ..., w_m], 'u_limit': [l_1, ..., l_m]}} "
+            "and/or {'y': [...], 'y_limit': [...]} (a weight and a limit per component, 0 and 0 where not "
+            "softened)",
+            repr(soft))

@@ -37,6 +37,15 @@ def input_constraint_kind(input_constraint: str | None, u_max: ArrayLike) -> str
     return input_constraint
 
 
+def _output_rows(output_matrix: ArrayLike | None) -> int | None:
+    """The bounded outputs (rows of ``output_matrix``) where its shape says so, else ``None`` (its
+    own check then names it)."""
+    if output_matrix is None:
+        return None
+    shape = np.shape(output_matrix)
+    return int(shape[0]) if len(shape) == 2 else None
+
+
 def rmpc_arguments(design: Design, partial: bool = False) -> dict[str, Any]:
     """The keyword arguments of :class:`RMPC` (all but the plant) read from a saved design.
 
@@ -126,7 +135,7 @@ class RMPC(Saveable):
         every sample).
     cost : {"worst_case", "nominal"}
         The cost bound over every vertex, or on ``plant.nominal`` with robust invariance on
-        every vertex (``lyapunov="common"`` only).
+        every vertex (with the vertex Lyapunov forms: Ding et al.'s form).
     free_moves : {0, 1}
         With 1 the first move ``u(k)`` is a free variable (applied by :meth:`step`) and the
         feedback law acts from ``k + 1`` on.
@@ -135,7 +144,9 @@ class RMPC(Saveable):
         auxiliary gain ``H`` that carries the bound; :meth:`step` applies the saturated input.
     soft : dict, optional
         ``{"u": w_u, "y": w_y}``: soft input and output bounds, their squared excess paid at
-        these weights.
+        these weights; per component ``{"u": [w_1, ..., w_m], "y": [...]}`` (one slack per
+        component whose weight is ``> 0``, ``0`` keeps it hard), with ``"u_limit"``/``"y_limit"``
+        soft limits separate from the hard bounds (MUP's ``*_soft_con`` methods).
     disturbance : (E, w_max) or (E, w_max, lam), optional
         ``x+ = A x + B u + E w`` with ``||w|| <= w_max``; the ellipsoid is kept invariant under
         it (``lam``, the S-procedure's contraction factor, searched when not given).
@@ -245,7 +256,8 @@ class RMPC(Saveable):
         self.form = form_options(
             n_states=plant.n_states, input_constraint=input_constraint, has_output=output_matrix is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance, horizon=horizon, step_gains=step_gains,
+            disturbance=disturbance, horizon=horizon, step_gains=step_gains, n_inputs=plant.n_inputs,
+            n_outputs=_output_rows(output_matrix),
         )
         self.problem: KothareProblem | FormProblem
         if self.form.is_kothare:
@@ -352,11 +364,11 @@ class RMPC(Saveable):
     def from_method(cls, key: str, plant: PolytopicModel, **options: Any) -> RMPC:
         """The robust MPC of the literature's method ``key`` (MUP's method keys).
 
-        ``key`` is one of :data:`rmpc.mpc.methods.METHODS` (``"kothare"``, ``"cuzzola"``,
-        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``, ``"li"``, ``"shi"``), which
-        sets the form's options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other
-        arguments of :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per
-        component (``input_constraint="peak"``) unless ``input_constraint`` is given.
+        ``key`` is one of MUP's method keys, :data:`rmpc.mpc.methods.METHODS` (the table there says
+        which options each key sets; the ``*_soft_con`` keys need ``soft`` with MUP's soft limits);
+        ``options`` are the other arguments of :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in
+        MUP the input bound is per component (``input_constraint="peak"``) unless
+        ``input_constraint`` is given.
 
         Examples
         --------
