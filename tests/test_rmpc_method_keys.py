@@ -67,8 +67,8 @@ def test_refusals_name_the_argument() -> None:
     kw = {"Q": p.Q, "R": p.R}
     with pytest.raises(InvalidArgumentError, match=r"key: .*'kothare'.*found 'kotare'"):
         RMPC.from_method("kotare", p.plant, **kw)
-    with pytest.raises(InvalidArgumentError, match=r"key: .*found 'li'.*nearest"):
-        RMPC.from_method("li", p.plant, **kw)
+    with pytest.raises(InvalidArgumentError, match=r"key: .*found 'huang'.*nearest"):
+        RMPC.from_method("huang", p.plant, **kw)
     with pytest.raises(ArgumentTypeError, match="key"):
         RMPC.from_method(1, p.plant, **kw)
     with pytest.raises(InvalidArgumentError, match=r"lyapunov: expected 'vertex'.*found 'common'"):
