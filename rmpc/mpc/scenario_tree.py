@@ -38,9 +38,9 @@ __all__ = ["MAX_VARIABLES", "ScenarioTree", "check_tree_size", "tree_size"]
 
 #: Default bound on the QP variables of a tree (inputs and states of all its nodes). Measured
 #: with Clarabel on paper P's satellite (``dev/multistage_timing.py``, docs/multistage.rst): 8
-#: vertices, robust horizon 3 and horizon 10 make 35 979 variables, built in about 1 s and solved
-#: in about 1.2 s per sample on a shared 2-core machine; the solve time grew about linearly with
-#: the variables from there, so 50 000 variables stand for a step of 1-2 s.
+#: vertices, robust horizon 3 and horizon 10 make 35 979 variables, built in about 0.6 s and
+#: solved in 1.7 s per sample on a shared 2-core machine at a load of 7 (5067 variables: 0.18 s,
+#: so about linear in the variables), so 50 000 variables stand for a step of 2-3 s.
 #: ``MultiStageMPC(..., max_variables=N)`` lifts it.
 MAX_VARIABLES = 50_000
 
