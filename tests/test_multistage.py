@@ -214,6 +214,18 @@ def test_an_infeasible_tree_is_a_status_and_the_input_stays_in_its_bounds() -> N
     assert abs(u[0]) <= 0.5
 
 
+def test_status_at_solves_without_a_step() -> None:
+    """The region of attraction's test: the status at a state, ``last`` and the plan untouched."""
+    box = (np.vstack((np.eye(2), -np.eye(2))), np.array([10.0, 1.0, 10.0, 1.0]))
+    ctrl = MultiStageMPC(_di(), np.eye(2), np.eye(1), horizon=5, u_max=0.5, state_constraints=box)
+    u = ctrl.step([2.0, 0.5])
+    last, plan = ctrl.last, ctrl._plan.copy()
+    assert ctrl.status_at([9.5, 3.0]) == "infeasible"
+    assert ctrl.status_at([-2.0, 0.0]) == "optimal"
+    assert ctrl.last is last and np.array_equal(ctrl._plan, plan)
+    np.testing.assert_allclose(ctrl.step([2.0, 0.5]), u, atol=1e-8)
+
+
 def _failing_once(ctrl: MultiStageMPC, monkeypatch: pytest.MonkeyPatch) -> None:
     real = ctrl.backend.solve
     calls = {"n": 0}

@@ -179,7 +179,7 @@ class MultiStageMPC(Saveable):
     horizon : int
         Prediction horizon ``N`` in samples (default 10).
     robust_horizon : int
-        Stages that branch, ``1 <= robust_horizon <= horizon`` (default 1, do-mpc's default too).
+        Stages that branch, ``1 <= robust_horizon <= horizon`` (default 1).
     u_max : float, (m,) array_like or None
         ``|u_i| <= u_max_i`` at every input node; ``None`` for no bound.
     input_constraint : {"peak"}
@@ -417,6 +417,39 @@ class MultiStageMPC(Saveable):
         lo, up = self._rhs(x)
         return QP(H=self._H, g=np.zeros(self._H.shape[0]), C=self._C, l=lo, u=up, lb=self._lb, ub=self._ub)
 
+    def status_at(self, x: ArrayLike) -> Status:
+        """Solve the tree at ``x`` and return the back-end's status, without a step.
+
+        ``last`` and the plan of the fallback are kept; for a region of attraction (the states
+        where the status is ``"optimal"``). A back-end with a warm start starts its next solve
+        from this one.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from models import PolytopicModel
+        >>> from rmpc import MultiStageMPC
+        >>> A = np.array([[1.0, 1.0], [0.0, 1.0]])
+        >>> plant = PolytopicModel([(A, [[0.5], [1.0]]), (A, [[0.4], [0.8]])], dt=1.0)
+        >>> box = (np.vstack((np.eye(2), -np.eye(2))), [10, 2, 10, 2])
+        >>> ms = MultiStageMPC(plant, np.eye(2), np.eye(1), horizon=5, u_max=0.5, state_constraints=box)
+        >>> ms.status_at([0.0, 1.0]), ms.status_at([9.5, 2.0]), ms.last is None
+        ('optimal', 'infeasible', True)
+        """
+        x = as_vector(x, "x", self._n)
+        return self._solve(x).status
+
+    def _solve(self, x: np.ndarray) -> Any:
+        """The back-end's answer at ``x`` (set up on the first call, vectors updated after)."""
+        lo, up = self._rhs(x)
+        if not self._setup_done:
+            h, c = (self._H.toarray(), self._C.toarray()) if self._dense else (self._H, self._C)
+            self.backend.setup(QP(H=h, g=np.zeros(h.shape[0]), C=c, l=lo, u=up, lb=self._lb, ub=self._ub))
+            self._setup_done = True
+        else:
+            self.backend.update(l=lo, u=up)
+        return self.backend.solve()
+
     def _rhs(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         lo, up = self._l.copy(), self._u.copy()
         first = self._first_a @ x
@@ -461,14 +494,7 @@ class MultiStageMPC(Saveable):
         start = time.perf_counter()
         check_step_inputs(inputs, self.accepts, self.name)
         x = as_vector(x, "x", self._n)
-        lo, up = self._rhs(x)
-        if not self._setup_done:
-            h, c = (self._H.toarray(), self._C.toarray()) if self._dense else (self._H, self._C)
-            self.backend.setup(QP(H=h, g=np.zeros(h.shape[0]), C=c, l=lo, u=up, lb=self._lb, ub=self._ub))
-            self._setup_done = True
-        else:
-            self.backend.update(l=lo, u=up)
-        res = self.backend.solve()
+        res = self._solve(x)
         status, fallback = res.status, False
         m = self._m
         if res.status == Status.OPTIMAL:
