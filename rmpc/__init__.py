@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from rmpc.mpc.crmpc import CRMPC
     from rmpc.mpc.gipc import GIPC
     from rmpc.mpc.lqr import LQR
+    from rmpc.mpc.multistage import MultiStageMPC
     from rmpc.mpc.offline import OfflineRMPC
     from rmpc.mpc.robust_mpc import RMPC
     from rmpc.mpc.scheduled import ScheduledRMPC
@@ -66,6 +67,7 @@ _EXPORTS = {
     "rmpc.mpc.crmpc": ("CRMPC",),
     "rmpc.mpc.gipc": ("GIPC",),
     "rmpc.mpc.lqr": ("LQR",),
+    "rmpc.mpc.multistage": ("MultiStageMPC",),
     "rmpc.mpc.offline": ("OfflineRMPC",),
     "rmpc.mpc.robust_mpc": ("RMPC",),
     "rmpc.mpc.scheduled": ("ScheduledRMPC",),
@@ -94,6 +96,7 @@ __all__ = [
     "Controller",
     "FlexibleHybrid",
     "MappedController",
+    "MultiStageMPC",
     "NonlinearPD",
     "OfflineRMPC",
     "RobustAVC",

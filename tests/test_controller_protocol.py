@@ -38,6 +38,7 @@ from rmpc import (
     Controller,
     FlexibleHybrid,
     MappedController,
+    MultiStageMPC,
     NonlinearPD,
     OfflineRMPC,
     RobustAVC,
@@ -89,6 +90,8 @@ CONTROLLERS: dict[str, tuple[Callable[[], tuple[Any, np.ndarray]], str]] = {
     "LQR": (lambda: _rigid_with(lambda p: LQR(p, Q_RIGID, np.eye(3))), "LQR"),
     "GIPC": (lambda: _rigid_with(GIPC), "GIPC"),
     "RMPC": (lambda: _rigid_with(lambda p: RMPC(p, Q_RIGID, np.eye(3), u_max=1.0)), "RMPC"),
+    "MultiStageMPC": (lambda: _rigid_with(lambda p: MultiStageMPC(p, Q_RIGID, 0.01 * np.eye(3), u_max=1.0)),
+                      "MultiStageMPC"),
     "ScheduledRMPC": (
         lambda: (
             ScheduledRMPC.for_satellite(RigidSatellite.paper_p(), 0.01, 0.3, Q_RIGID, np.eye(3), u_max=1.0),

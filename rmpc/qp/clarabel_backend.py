@@ -144,11 +144,14 @@ class ClarabelBackend(QPBackend):
         n = qp.n_vars
         self._rows()
         self._key = self._structure()
-        eye = np.eye(n)
         ce, cu, cl = self._sel["C"]
         be, bu, bl = self._sel["box"]
-        blocks = [qp.C[ce], eye[be], qp.C[cu], eye[bu], -qp.C[cl], -eye[bl]]
-        a = sp.csc_matrix(np.vstack(blocks)) if sum(b.shape[0] for b in blocks) else sp.csc_matrix((0, n))
+        if qp.is_sparse:  # a large structured QP stays sparse (see rmpc.qp.problem.QP)
+            cmat, eye, stack = sp.csr_matrix(qp.C), sp.identity(n, format="csr"), sp.vstack
+        else:
+            cmat, eye, stack = qp.C, np.eye(n), np.vstack
+        blocks = [cmat[ce], eye[be], cmat[cu], eye[bu], -cmat[cl], -eye[bl]]
+        a = sp.csc_matrix(stack(blocks)) if sum(b.shape[0] for b in blocks) else sp.csc_matrix((0, n))
         n_eq = ce.size + be.size
         n_in = cu.size + bu.size + cl.size + bl.size
         cones: list[Any] = []
