@@ -71,6 +71,9 @@ class LMISolution:
         The back-end's own dual bound on the optimal ``gamma`` (Clarabel's dual objective; with
         ``gamma`` it brackets the optimum to the accuracy the solver actually reached, whatever
         its status says); ``None`` where the back-end reports none.
+    gamma_s : float or None
+        Huang et al.'s bound on the unsaturated sign pattern's cost (``unsaturated_weight`` of
+        :mod:`lmi.forms`, ``gamma_s <= gamma``); ``None`` in every other form.
     """
 
     status: str
@@ -92,6 +95,7 @@ class LMISolution:
     slack: dict[str, float] | None = field(default=None, repr=False)
     lam: float | None = field(default=None, repr=False)
     gamma_dual: float | None = field(default=None, repr=False)
+    gamma_s: float | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

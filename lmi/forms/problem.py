@@ -25,7 +25,7 @@ from scipy import sparse
 from lmi.affine import svec_matrix
 from lmi.certificate import Certificate
 from lmi.data import InputConstraint, KothareData, build_kothare_data
-from lmi.forms.lmis import FormData, declare, objective, write
+from lmi.forms.lmis import FormData, declare, lyapunov_count, objective, write
 from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
 from lmi.infeasibility import InfeasibilityCertificate, check_farkas
@@ -91,7 +91,7 @@ class FormProblem:
         As for :class:`lmi.KothareProblem` (checked the same way).
     nominal : (A0, B0), optional
         The nominal model, needed by ``cost="nominal"``.
-    lyapunov, cost, free_moves, saturation, soft, disturbance
+    lyapunov, cost, free_moves, saturation, soft, disturbance, unsaturated_weight
         The form (:func:`lmi.forms.options.form_options`; the LMIs: the page "The field's robust
         MPC forms" of the docs).
     backend : {"ipm", "clarabel", "cvxpy"}
@@ -143,6 +143,7 @@ class FormProblem:
         saturation: str | None = None,
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
+        unsaturated_weight: float | None = None,
         backend: str = "ipm",
         solver_options: dict[str, Any] | None = None,
         certificate_tol: float = 1e-7,
@@ -155,7 +156,7 @@ class FormProblem:
         self.options: FormOptions = form_options(
             n_states=data.n, input_constraint=data.input_constraint, has_output=data.C_out is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance,
+            disturbance=disturbance, unsaturated_weight=unsaturated_weight, n_inputs=data.m,
         )
         if backend not in _BACKENDS:
             raise InvalidArgumentError("backend", "'ipm', 'clarabel' or 'cvxpy'", repr(backend))
@@ -656,7 +657,8 @@ class FormProblem:
         h_mat = None if g_inv is None or "Z" not in values else values["Z"] @ g_inv
         q_vertices = None
         if opts.vertex_lyapunov:
-            q_vertices = tuple(s2 * values[f"Q{j}"] for j in range(self.data.n_vertices))
+            count = lyapunov_count(opts, self.data.n_vertices, self.data.m)
+            q_vertices = tuple(s2 * values[f"Q{j}"] for j in range(count))
             q_mat = _inner_ellipsoid(q_vertices)
         else:
             q_mat = s2 * values["Q"]
@@ -674,6 +676,7 @@ class FormProblem:
             G=s2 * g_mat if opts.vertex_lyapunov else None, Q_vertices=q_vertices,
             u0=scale * values["u0"][:, 0] if "u0" in values else None,
             H=h_mat, slack=slack, lam=lam if dist is not None and w_max > 0.0 else None,
+            gamma_s=s2 * float(values["gamma_s"][0, 0]) if "gamma_s" in values else None,
         )
 
     def _original(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -54,6 +54,8 @@ def rmpc_arguments(design: Design, partial: bool = False) -> dict[str, Any]:
         "free_moves": Design.integer, "saturation": lambda d, k: d.optional_text(k),
         "soft": lambda d, k: d.optional_mapping(k), "disturbance": _disturbance,
         "offset_free": Design.flag,
+        # absent from designs saved before Huang et al.'s form: None, the form they had
+        "unsaturated_weight": lambda d, k: d.optional_number(k) if d.has(k) else None,
     }
     return {name: read(design, name) for name, read in readers.items() if not partial or design.has(name)}
 
@@ -116,13 +118,14 @@ class RMPC(Saveable):
         Passed to :class:`lmi.KothareProblem` (with the default form) or
         :class:`lmi.forms.FormProblem` (any other form: ``backend`` ``"ipm"``, ``"clarabel"`` or
         ``"cvxpy"``, ``formulation`` and ``solver`` unused).
-    lyapunov : {"common", "vertex", "vertex_pairs"}
+    lyapunov : {"common", "vertex", "vertex_pairs", "saturation_dependent"}
         One quadratic Lyapunov function (Kothare), one ``Q_j`` per vertex with a slack ``G``
         (uncertainty constant in time), or every vertex pair (uncertainty that may change at
-        every sample).
+        every sample); ``"saturation_dependent"``: one ``Q_k`` per sign pattern of the auxiliary
+        saturation (Zhang, Wang & Li 2013; only with ``saturation="auxiliary"``).
     cost : {"worst_case", "nominal"}
         The cost bound over every vertex, or on ``plant.nominal`` with robust invariance on
-        every vertex (``lyapunov="common"`` only).
+        every vertex (``lyapunov="common"`` or ``"saturation_dependent"``).
     free_moves : {0, 1}
         With 1 the first move ``u(k)`` is a free variable (applied by :meth:`step`) and the
         feedback law acts from ``k + 1`` on.
@@ -137,6 +140,10 @@ class RMPC(Saveable):
         it (``lam``, the S-procedure's contraction factor, searched when not given).
         The LMIs of every form and the combinations that exist: the page "The field's robust MPC
         forms" of the docs (:mod:`lmi.forms`). The defaults give Kothare's problem.
+    unsaturated_weight : float, optional
+        ``beta >= 0`` of Huang, Li, Lin & Xi (2011): the cost LMIs of the unsaturated sign pattern
+        are bounded by ``gamma_s <= gamma`` and the objective is ``gamma + beta gamma_s`` (only with
+        ``saturation="auxiliary"``; ``None``, the default, is Cao & Lin's form, and so is 0).
     offset_free : bool
         Offset-free action on a constant input disturbance: every :meth:`step` takes the
         disturbance estimate ``StepInputs(d_hat=...)`` (from an estimator with
@@ -211,13 +218,14 @@ class RMPC(Saveable):
         on_failure: Literal["fallback", "raise"] = "fallback",
         hold_radius: float = 1e-9,
         resolve_threshold: float = 1.0,
-        lyapunov: Literal["common", "vertex", "vertex_pairs"] = "common",
+        lyapunov: Literal["common", "vertex", "vertex_pairs", "saturation_dependent"] = "common",
         cost: Literal["worst_case", "nominal"] = "worst_case",
         free_moves: int = 0,
         saturation: Literal["auxiliary"] | None = None,
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
         offset_free: bool = False,
+        unsaturated_weight: float | None = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             hint = ""
@@ -230,7 +238,7 @@ class RMPC(Saveable):
         self.form = form_options(
             n_states=plant.n_states, input_constraint=input_constraint, has_output=output_matrix is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance,
+            disturbance=disturbance, unsaturated_weight=unsaturated_weight, n_inputs=plant.n_inputs,
         )
         self.problem: KothareProblem | FormProblem
         if self.form.is_kothare:
@@ -250,6 +258,7 @@ class RMPC(Saveable):
                 output_matrix=output_matrix, y_max=y_max, nominal=plant.nominal, lyapunov=lyapunov,
                 cost=cost, free_moves=free_moves, saturation=saturation, soft=soft, disturbance=disturbance,
                 backend=backend, solver_options=solver_options, certificate_tol=certificate_tol,
+                unsaturated_weight=unsaturated_weight,
             )
         self.certified = CertifiedGain("RMPC", on_failure, hold_radius)
         self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
@@ -284,6 +293,7 @@ class RMPC(Saveable):
             "disturbance": (None if disturbance is None
                             else (disturbance.E, disturbance.w_max, disturbance.lam)),
             "offset_free": self.offset_free,
+            "unsaturated_weight": unsaturated_weight,
         })
 
     # -- save and load ---------------------------------------------------------------------
@@ -329,8 +339,10 @@ class RMPC(Saveable):
         """The robust MPC of the literature's method ``key`` (MUP's method keys).
 
         ``key`` is one of :data:`rmpc.mpc.methods.METHODS` (``"kothare"``, ``"cuzzola"``,
-        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``), which sets the form's
-        options (:mod:`rmpc.mpc.methods` has the table); ``options`` are the other arguments of
+        ``"mao"``, ``"wan"``, ``"cao"``, ``"mao_cao"``, ``"wan_cao"``, ``"huang"``, ``"zhang"``,
+        ``"wan_huang"``, ``"mao_huang"``, ``"wan_zhang"``; Huang et al.'s keys need
+        ``unsaturated_weight``), which sets the form's options (:mod:`rmpc.mpc.methods` has the
+        table); ``options`` are the other arguments of
         :class:`RMPC` (``Q``, ``R``, ``u_max``, ...). As in MUP the input bound is per component
         (``input_constraint="peak"``) unless ``input_constraint`` is given.
 
