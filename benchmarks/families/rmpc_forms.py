@@ -1,7 +1,8 @@
 """The robust MPC's forms as settings of a scenario: their defaults, their checks, the keyword arguments.
 
-:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by six keyword arguments,
-``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft`` and ``disturbance``, and takes
+:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by seven keyword arguments,
+``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft``, ``disturbance`` and
+``unsaturated_weight`` (Huang et al.'s ``beta``, a number; left out for none), and takes
 ``certificate_tol`` and ``on_failure``; a sweep file sets them as ``settings.<name>`` of a
 family's controller ``"RMPC"`` (every shipped family: :class:`RMPCForms` holds what a family
 needs, its state count and whether its RMPC has output bounds). Each value is checked by the
@@ -48,7 +49,8 @@ __all__ = [
 #: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
 FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
     {"lyapunov": "common", "cost": "worst_case", "free_moves": 0, "saturation": None, "soft": None,
-     "disturbance": None}
+     "disturbance": None,
+     "unsaturated_weight": None}
 )
 #: Every setting of this module with its default: the forms and the solve's three options.
 FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
@@ -78,7 +80,9 @@ def _path(argument: str, where: str) -> str:
 
 
 def _lyapunov(value: Any, where: str, n: int, out: bool) -> str:
-    return _python_check(where, n, out, lyapunov=value).lyapunov
+    # alone as if with its saturation (the combinations: check_case)
+    sat = "auxiliary" if value == "saturation_dependent" else None
+    return _python_check(where, n, out, lyapunov=value, saturation=sat).lyapunov
 
 
 def _cost(value: Any, where: str, n: int, out: bool) -> str:
@@ -175,9 +179,18 @@ def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
     return value
 
 
+def _unsaturated_weight(value: Any, where: str, n: int, out: bool) -> float:
+    """Huang et al.'s ``beta``, alone as if with ``saturation = "auxiliary"`` (the combination:
+    :meth:`RMPCForms.check_case`)."""
+    if value is None:
+        raise ConfigError(where, "a weight >= 0 (leave the setting out for none)", "None")
+    return _python_check(where, n, out, saturation="auxiliary", unsaturated_weight=value).unsaturated_weight
+
+
 _CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
     {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
-     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options}
+     "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options,
+     "unsaturated_weight": _unsaturated_weight}
 )
 
 
@@ -191,6 +204,7 @@ def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
     )
     options = settings.get("solver_options")
     out["solver_options"] = None if options is None else dict(options)
+    out["unsaturated_weight"] = settings.get("unsaturated_weight")
     return out
 
 

@@ -223,8 +223,13 @@ def form_options(
 #: The largest weight ``beta`` of Huang et al.'s objective ``gamma + beta gamma_s``
 #: (``unsaturated_weight``); a larger one is refused, as :data:`MAX_SOFT_WEIGHT` for the same
 #: reason: the objective spans ``beta`` from ``gamma``'s coefficient 1, and the solvers lose
-#: ``gamma`` beside ``beta gamma_s``.
-MAX_UNSATURATED_WEIGHT = MAX_SOFT_WEIGHT
+#: ``gamma`` beside ``beta gamma_s``. Measured with huang, wan_huang and mao_huang on Kothare's
+#: examples 1 and 2 and MUP's demo system: certified ``"optimal"`` at every weight from 1e3 to
+#: 1e14 (``gamma`` growing as ``sqrt(beta)`` while ``gamma_s`` settles at its own minimum); the
+#: first failures at 1e16 (example 2, all three; MUP's demo, huang and wan_huang: ``numerical_error``,
+#: then phase one's point, ``"inaccurate"``, ``gamma_s`` 2.5 to 260 times its minimum). 1e14 keeps
+#: a factor of 100 from them.
+MAX_UNSATURATED_WEIGHT = 1e14
 
 #: The most inputs ``lyapunov="saturation_dependent"`` takes: its LMIs hold ``2^m`` Lyapunov
 #: matrices and ``N 4^m`` cost blocks (``m`` inputs, ``N`` vertices), 1024 per vertex at ``m = 5``.
@@ -244,7 +249,8 @@ def _unsaturated_weight(weight: Any) -> float | None:
     if weight > MAX_UNSATURATED_WEIGHT:
         raise InvalidArgumentError(
             "unsaturated_weight",
-            f"a weight <= MAX_UNSATURATED_WEIGHT = {MAX_UNSATURATED_WEIGHT:g} (beyond it the solvers cannot resolve gamma next to beta gamma_s; see the page on the forms)", repr(weight))
+            f"a weight <= MAX_UNSATURATED_WEIGHT = {MAX_UNSATURATED_WEIGHT:g} (beyond it the solvers cannot "
+            "resolve gamma next to beta gamma_s; see the page on the forms)", repr(weight))
     return float(weight)
 
 
