@@ -31,7 +31,6 @@ from rmpc import RMPC
 from toolkit_common.errors import ArgumentTypeError, ConfigError, InvalidArgumentError
 
 
-
 def mup_demo_y4() -> dict:
     """MUP's demo with ``|x_i| <= 4`` instead of 10: the output bounds are active at its state
     (zhang's gamma 45.98 instead of 43.25)."""
