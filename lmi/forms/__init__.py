@@ -8,7 +8,9 @@ cost, a free first move, saturation-aware gains, soft bounds and bounded disturb
 from lmi.forms.options import (
     COSTS,
     LYAPUNOV_FORMS,
+    MAX_SATURATION_INPUTS,
     MAX_SOFT_WEIGHT,
+    MAX_UNSATURATED_WEIGHT,
     SATURATIONS,
     Disturbance,
     FormOptions,
@@ -17,6 +19,14 @@ from lmi.forms.options import (
 from lmi.forms.problem import FormProblem
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "MAX_SOFT_WEIGHT", "SATURATIONS", "Disturbance", "FormOptions", "FormProblem",
+    "COSTS",
+    "LYAPUNOV_FORMS",
+    "MAX_SATURATION_INPUTS",
+    "MAX_SOFT_WEIGHT",
+    "MAX_UNSATURATED_WEIGHT",
+    "SATURATIONS",
+    "Disturbance",
+    "FormOptions",
+    "FormProblem",
     "form_options",
 ]
