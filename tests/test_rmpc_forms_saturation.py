@@ -158,6 +158,24 @@ def test_kothare_example_2_meets_the_references_lmis(key):
     _check_reference("kothare_2", key, agree=False)
 
 
+@pytest.mark.parametrize("key", ["huang", "zhang"])
+@pytest.mark.parametrize("backend", ["clarabel", "cvxpy"])
+def test_the_other_back_ends_solve_the_same_program(backend, key):
+    """Clarabel's API and cvxpy take the same Program as the ipm (MUP's demo, where Clarabel is
+    accurate): the same objective."""
+    problem = mup_demo()
+    A, B = problem["A"], problem["B"]
+    plant = PolytopicModel(list(zip(A, B, strict=True)), dt=0.1, nominal=(A[-1], B[-1]))
+    answers = []
+    for name in ("ipm", backend):
+        ctrl = RMPC(plant, problem["Q1"], problem["R"], u_max=problem["u_max"], input_constraint="peak",
+                    backend=name, **_options(key), **problem["extra"])
+        sol = ctrl.solve(problem["x"])
+        assert sol.certificate is not None and sol.F is not None
+        answers.append(sol.gamma + (BETA * sol.gamma_s if sol.gamma_s is not None else 0.0))
+    assert answers[1] == pytest.approx(answers[0], rel=1e-5)
+
+
 # -- the guarantee ---------------------------------------------------------------------------------
 @pytest.mark.parametrize("key", ["huang", "mao_huang", "zhang"])
 @pytest.mark.parametrize("name", ["kothare_1", "mup_demo"])
