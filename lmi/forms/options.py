@@ -227,7 +227,7 @@ def form_options(
 #: examples 1 and 2 and MUP's demo system: certified ``"optimal"`` at every weight from 1e3 to
 #: 1e14 (``gamma`` growing as ``sqrt(beta)`` while ``gamma_s`` settles at its own minimum); the
 #: first failures at 1e16 (example 2, all three; MUP's demo, huang and wan_huang: ``numerical_error``,
-#: then phase one's point, ``"inaccurate"``, ``gamma_s`` 2.5 to 260 times its minimum). 1e14 keeps
+#: then phase one's point, ``"inaccurate"``, ``gamma_s`` 2.3 to 260 times its minimum). 1e14 keeps
 #: a factor of 100 from them.
 MAX_UNSATURATED_WEIGHT = 1e14
 
