@@ -75,6 +75,9 @@ class LMISolution:
         The forms with steps (:mod:`lmi.forms.steps`): the later steps' variables by name
         (``"Y@2"``, ``"G@2"``, ``"Q0@2"``, Li et al.'s second-step gains ``"Y@v0"``, ...), at the
         scale of ``Y`` and ``Q``; the first step's are ``Q``, ``Y``, ``G``, ``Q_vertices``, ``H``.
+    gamma_s : float or None
+        Huang et al.'s bound on the unsaturated sign pattern's cost (``unsaturated_weight`` of
+        :mod:`lmi.forms`, ``gamma_s <= gamma``); ``None`` in every other form.
     """
 
     status: str
@@ -97,6 +100,7 @@ class LMISolution:
     lam: float | None = field(default=None, repr=False)
     gamma_dual: float | None = field(default=None, repr=False)
     steps: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    gamma_s: float | None = field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:

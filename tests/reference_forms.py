@@ -419,6 +419,7 @@ def solution_values(sol: Any) -> dict[str, Any]:
     return {
         "gamma": sol.gamma, "Y": sol.Y, "Q": sol.Q, "G": sol.G, "Q_vertices": sol.Q_vertices,
         "Z": None if sol.H is None else sol.H @ G, "u0": sol.u0, "slack": sol.slack, "lam": sol.lam,
+        "gamma_s": getattr(sol, "gamma_s", None),
     }
 
 
@@ -814,3 +815,146 @@ def mup_reference_upper(*args: Any, rtol: float = 1e-6, max_steps: int = 40, **k
         else:
             lo = mid
     return hi
+
+
+# -- MUP's saturation methods: huang, wan_huang, mao_huang, zhang, wan_zhang ----------------------
+#
+# Written from MUP's rmpc_methods/sdp_<key>.m (Oravec & Bakosova's toolbox) and the papers it cites:
+# Huang, Li, Lin & Xi, "An improved robust model predictive control design in the presence of
+# actuator saturation", Automatica 47, 2011; Zhang, Wang & Li, "Min-max MPC for LPV systems subject
+# to actuator saturation by a saturation-dependent Lyapunov function", Chinese Control Conference,
+# 2013. MUP's sign patterns: u_var holds the binary numbers 0 .. 2^m - 1 (a column each, the first
+# input the most significant bit), E_j = diag(u_var(:, nj + 1 - j)) and Et_j = diag(u_var(:, j)),
+# so that j = 1 is the unsaturated pattern (E_1 = I). As in this module's other forms (and unlike
+# MUP's code): no trace(X) in the objective, non-strict LMIs, the peak bound one input at a time.
+# Zhang's form as docs/rmpc_forms.rst states it (one matrix Q_j per sign pattern, MUP's W_j and
+# Q_j being one family there: see the page for why).
+
+SATURATION_METHODS = ("huang", "wan_huang", "mao_huang", "zhang", "wan_zhang")
+
+
+def _mup_sign_patterns(m: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    nj = 2**m
+    u_var = np.array([[int(bit) for bit in np.binary_repr(k, m)] for k in range(nj)], float).T
+    return [(np.diag(u_var[:, nj - 1 - j]), np.diag(u_var[:, j])) for j in range(nj)]
+
+
+def reference_saturation(
+    A_list: list[np.ndarray], B_list: list[np.ndarray], Q1: np.ndarray, R: np.ndarray, x: np.ndarray, *,
+    method: str, u_max: float | np.ndarray, beta: float | None = None,
+    nominal: tuple[np.ndarray, np.ndarray] | None = None, output_matrix: np.ndarray | None = None,
+    y_max: float | np.ndarray | None = None, at: dict[str, Any] | None = None, solver: str = "CLARABEL",
+) -> tuple[str, float, dict[str, Any]]:
+    """One of MUP's saturation methods in cvxpy from raw matrices (peak input bound).
+
+    ``at``: do not solve, evaluate every LMI at ``gamma``, ``gamma_s``, ``Y``, ``Z`` and ``Q``
+    (common) or ``G`` and ``Q_vertices``; returns ``"evaluated"`` with ``residual`` (the worst
+    relative smallest eigenvalue). Otherwise returns cvxpy's status, ``gamma`` and the variables
+    with ``objective`` and ``residual`` at Clarabel's point.
+    """
+    if method not in SATURATION_METHODS:
+        raise ValueError(method)
+    A_list = [np.atleast_2d(np.asarray(a, float)) for a in A_list]
+    B_list = [np.asarray(b, float).reshape(A_list[0].shape[0], -1) for b in B_list]
+    n, m = B_list[0].shape
+    nv = len(A_list)
+    x = np.asarray(x, float).reshape(n, 1)
+    Wx, Wu = _psd_sqrt(np.atleast_2d(np.asarray(Q1, float))), _psd_sqrt(np.atleast_2d(np.asarray(R, float)))
+    umax = np.broadcast_to(np.asarray(u_max, float), (m,))
+    patterns = _mup_sign_patterns(m)
+    huang = "huang" in method
+    g = cp.Variable(name="g")
+    gs = cp.Variable(name="gs") if huang else g
+    Y = cp.Variable((m, n), name="Y")
+    Z = cp.Variable((m, n), name="Z")
+    if method in ("huang", "wan_huang"):
+        X = cp.Variable((n, n), symmetric=True, name="X")
+        lyap = [X]
+    else:  # mao_huang: a Q_v per vertex; zhang, wan_zhang: a Q_j per sign pattern
+        X = cp.Variable((n, n), name="X")
+        lyap = [cp.Variable((n, n), symmetric=True, name=f"Q{k}")
+                for k in range(nv if method == "mao_huang" else len(patterns))]
+
+    def top(k: int) -> Any:
+        return X if len(lyap) == 1 else X + X.T - lyap[k]
+
+    def u_of(j: int) -> Any:
+        E, Et = patterns[j]
+        return E @ Y + Et @ Z
+
+    def conv(A: np.ndarray, B: np.ndarray, t: Any, nxt: Any, j: int, gamma: Any | None) -> Any:
+        M = A @ X + B @ u_of(j)
+        if gamma is None:  # invariance only
+            return cp.bmat([[t, M.T], [M, nxt]])
+        return cp.bmat([
+            [t, M.T, (Wx @ X).T, (Wu @ u_of(j)).T],
+            [M, nxt, np.zeros((n, n)), np.zeros((n, m))],
+            [Wx @ X, np.zeros((n, n)), gamma * np.eye(n), np.zeros((n, m))],
+            [Wu @ u_of(j), np.zeros((m, n)), np.zeros((m, n)), gamma * np.eye(m)],
+        ])
+
+    lmis: list[Any] = []
+    bound_g = [g - gs] if huang else []  # MUP's g - gs >= ZERO
+    for j in range(len(patterns)):
+        gam = gs if j == 0 else g
+        if method == "huang":
+            lmis += [conv(A_list[v], B_list[v], X, X, j, gam) for v in range(nv)]
+        elif method == "mao_huang":
+            lmis += [conv(A_list[v], B_list[v], top(v), lyap[vp], j, gam)
+                     for v in range(nv) for vp in range(nv)]
+        elif method == "zhang":
+            lmis += [conv(A_list[v], B_list[v], top(j), lyap[jp], j, gam)
+                     for v in range(nv) for jp in range(len(patterns))]
+        else:  # the nominal cost, invariance at every vertex
+            A0, B0 = np.asarray(nominal[0], float), np.asarray(nominal[1], float).reshape(n, m)
+            nexts = range(len(lyap))
+            lmis += [conv(A0, B0, top(j if method == "wan_zhang" else 0), lyap[jp], j, gam) for jp in nexts]
+            lmis += [conv(A_list[v], B_list[v], top(j if method == "wan_zhang" else 0), lyap[jp], j, None)
+                     for v in range(nv) for jp in nexts]
+    # the state in every ellipsoid; the auxiliary gain's rows inside every T
+    lmis += [cp.bmat([[np.ones((1, 1)), x.T], [x, q]]) for q in lyap]
+    for k in range(len(lyap)):
+        for ell in range(m):
+            z_row = _r(Z[ell, :], (1, n))
+            lmis.append(cp.bmat([[np.full((1, 1), umax[ell] ** 2), z_row], [z_row.T, top(k)]]))
+    if output_matrix is not None:
+        C = np.atleast_2d(np.asarray(output_matrix, float))
+        ymax = np.broadcast_to(np.asarray(y_max, float), (C.shape[0],))
+        for r in range(C.shape[0]):
+            for v in range(nv):
+                for j in range(len(patterns)):
+                    row = _r(C[r] @ (A_list[v] @ X + B_list[v] @ u_of(j)), (1, n))
+                    t = top(j) if method in ("zhang", "wan_zhang") else top(v if method == "mao_huang" else 0)
+                    lmis.append(cp.bmat([[np.full((1, 1), ymax[r] ** 2), row], [row.T, t]]))
+    objective = g + (float(beta) * gs if huang else 0.0)
+    if at is not None:
+        g.value = float(at["gamma"])
+        if huang:
+            gs.value = float(at["gamma_s"])
+        Y.value, Z.value = np.asarray(at["Y"], float), np.asarray(at["Z"], float)
+        if len(lyap) == 1:
+            X.value = _symmetrised(at["Q"])
+        else:
+            X.value = np.asarray(at["G"], float)
+            for q, val in zip(lyap, at["Q_vertices"], strict=True):
+                q.value = _symmetrised(val)
+        values = [np.asarray(M.value) for M in lmis] + [np.array([[float(b.value)]]) for b in bound_g]
+        scale = max(1.0, abs(float(at["gamma"])))
+        residual = min([relative_min_eig(M) for M in values[: len(lmis)]]
+                       + [float(v[0, 0]) / scale for v in values[len(lmis):]])
+        return "evaluated", float(at["gamma"]), {"residual": residual}
+    problem = cp.Problem(cp.Minimize(objective), [_sym(M) >> 0 for M in lmis] + [b >= 0 for b in bound_g])
+    try:
+        problem.solve(solver=solver)
+        status = problem.status
+    except cp.error.SolverError as exc:  # pragma: no cover - reported, not raised
+        status = f"solver_error: {exc}"
+    if status not in ("optimal", "optimal_inaccurate"):
+        return status, float("nan"), {"objective": float("nan"), "residual": -np.inf}
+    values = [np.asarray(M.value) for M in lmis]
+    residual = min([relative_min_eig(M) for M in values]
+                   + [float(b.value) / max(1.0, abs(float(g.value))) for b in bound_g])
+    return status, float(g.value), {
+        "gamma_s": float(gs.value), "objective": float(objective.value), "residual": residual,
+        "F": np.asarray(Y.value) @ np.linalg.inv(np.asarray(X.value)),
+    }

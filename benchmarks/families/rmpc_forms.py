@@ -1,8 +1,9 @@
 """The robust MPC's forms as settings of a scenario: their defaults, their checks, the keyword arguments.
 
-:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by eight keyword arguments,
-``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft``, ``disturbance``, ``horizon`` and
-``step_gains``, and takes
+:class:`rmpc.RMPC` selects the field's robust MPC forms (:mod:`lmi.forms`) by nine keyword arguments,
+``lyapunov``, ``cost``, ``free_moves``, ``saturation``, ``soft``, ``disturbance``, ``horizon``,
+``step_gains`` and ``unsaturated_weight`` (Huang et al.'s ``beta``, a number; left out for none),
+and takes
 ``certificate_tol`` and ``on_failure``; a sweep file sets them as ``settings.<name>`` of a
 family's controller ``"RMPC"`` (every shipped family: :class:`RMPCForms` holds what a family
 needs, its state count and whether its RMPC has output bounds). Each value is checked by the
@@ -51,7 +52,7 @@ __all__ = [
 #: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
 FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
     {"lyapunov": "common", "cost": "worst_case", "free_moves": 0, "saturation": None, "soft": None,
-     "disturbance": None, "horizon": 1, "step_gains": "common"}
+     "disturbance": None, "horizon": 1, "step_gains": "common", "unsaturated_weight": None}
 )
 #: Every setting of this module with its default: the forms and the solve's three options.
 FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
@@ -82,7 +83,9 @@ def _path(argument: str, where: str) -> str:
 
 
 def _lyapunov(value: Any, where: str, n: int, out: bool) -> str:
-    return _python_check(where, n, out, lyapunov=value).lyapunov
+    # alone as if with its saturation (the combinations: check_case)
+    sat = "auxiliary" if value == "saturation_dependent" else None
+    return _python_check(where, n, out, lyapunov=value, saturation=sat).lyapunov
 
 
 def _cost(value: Any, where: str, n: int, out: bool) -> str:
@@ -188,12 +191,18 @@ def _step_gains(value: Any, where: str, n: int, out: bool) -> str:
     # check judges the combination with the case's own horizon)
     horizon = 2 if value == "vertex" else 1
     return _python_check(where, n, out, step_gains=value, horizon=horizon).step_gains
+def _unsaturated_weight(value: Any, where: str, n: int, out: bool) -> float:
+    """Huang et al.'s ``beta``, alone as if with ``saturation = "auxiliary"`` (the combination:
+    :meth:`RMPCForms.check_case`)."""
+    if value is None:
+        raise ConfigError(where, "a weight >= 0 (leave the setting out for none)", "None")
+    return _python_check(where, n, out, saturation="auxiliary", unsaturated_weight=value).unsaturated_weight
 
 
 _CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
     {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
      "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options,
-     "horizon": _horizon, "step_gains": _step_gains}
+     "horizon": _horizon, "step_gains": _step_gains, "unsaturated_weight": _unsaturated_weight}
 )
 
 
@@ -208,6 +217,7 @@ def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
     )
     options = settings.get("solver_options")
     out["solver_options"] = None if options is None else dict(options)
+    out["unsaturated_weight"] = settings.get("unsaturated_weight")
     return out
 
 

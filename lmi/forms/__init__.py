@@ -9,7 +9,9 @@ from lmi.forms.options import (
     COSTS,
     LYAPUNOV_FORMS,
     MAX_HORIZON,
+    MAX_SATURATION_INPUTS,
     MAX_SOFT_WEIGHT,
+    MAX_UNSATURATED_WEIGHT,
     SATURATIONS,
     STEP_GAINS,
     Disturbance,
@@ -19,6 +21,16 @@ from lmi.forms.options import (
 from lmi.forms.problem import FormProblem
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "MAX_HORIZON", "MAX_SOFT_WEIGHT", "SATURATIONS", "STEP_GAINS", "Disturbance",
-    "FormOptions", "FormProblem", "form_options",
+    "COSTS",
+    "LYAPUNOV_FORMS",
+    "MAX_HORIZON",
+    "MAX_SATURATION_INPUTS",
+    "MAX_SOFT_WEIGHT",
+    "MAX_UNSATURATED_WEIGHT",
+    "SATURATIONS",
+    "STEP_GAINS",
+    "Disturbance",
+    "FormOptions",
+    "FormProblem",
+    "form_options",
 ]

@@ -20,7 +20,7 @@ from lmi.forms.options import FormOptions
 from lmi.forms.program import Layout, Program
 from lmi.forms.soft import bound_slack, limit_slacks, soft_slacks
 
-__all__ = ["FormData", "declare", "delta_congruence", "objective", "pairs", "write"]
+__all__ = ["FormData", "declare", "delta_congruence", "lyapunov_count", "objective", "pairs", "write"]
 
 
 @dataclass(frozen=True)
@@ -64,8 +64,12 @@ class FormData:
         return self.A.shape[0]
 
 
-def pairs(opts: FormOptions, n_vertices: int) -> list[tuple[int, int]]:
-    """The ``(i, j)`` pairs of the cost and invariance LMIs: plant ``i`` now, ``Q_j`` next."""
+def pairs(opts: FormOptions, n_vertices: int, n_inputs: int = 1) -> list[tuple[int, int]]:
+    """The ``(i, j)`` pairs of the cost and invariance LMIs: plant ``i`` now, ``Q_j`` next (with
+    ``lyapunov="saturation_dependent"``: every vertex ``i`` and every sign pattern's ``Q_j`` of the
+    ``2^m``, ``m = n_inputs``)."""
+    if opts.saturation_dependent:
+        return list(itertools.product(range(n_vertices), range(2**n_inputs)))
     if opts.lyapunov == "common":
         return [(i, 0) for i in range(n_vertices)]
     if opts.lyapunov == "vertex":
@@ -73,8 +77,16 @@ def pairs(opts: FormOptions, n_vertices: int) -> list[tuple[int, int]]:
     return list(itertools.product(range(n_vertices), repeat=2))
 
 
-def _lyapunov_names(opts: FormOptions, n_vertices: int) -> list[str]:
-    return ["Q"] if opts.lyapunov == "common" else [f"Q{j}" for j in range(n_vertices)]
+def _lyapunov_names(opts: FormOptions, n_vertices: int, n_inputs: int) -> list[str]:
+    count = lyapunov_count(opts, n_vertices, n_inputs)
+    return ["Q"] if opts.lyapunov == "common" else [f"Q{j}" for j in range(count)]
+
+
+def lyapunov_count(opts: FormOptions, n_vertices: int, n_inputs: int) -> int:
+    """How many Lyapunov matrices the form has: 1, one per vertex, or one per sign pattern (``2^m``)."""
+    if opts.lyapunov == "common":
+        return 1
+    return 2**n_inputs if opts.saturation_dependent else n_vertices
 
 
 def declare(opts: FormOptions, fd: FormData) -> Layout:
@@ -83,16 +95,18 @@ def declare(opts: FormOptions, fd: FormData) -> Layout:
     n, m = fd.n, fd.m
     lay = Layout()
     lay.full("gamma", 1, 1)
-    for name in _lyapunov_names(opts, fd.n_vertices):
+    for name in _lyapunov_names(opts, fd.n_vertices, m):
         lay.symmetric(name, n)
     if opts.vertex_lyapunov:
         lay.full("G", n, n)
     lay.full("Y", m, n)
     if opts.saturation == "auxiliary":
         lay.full("Z", m, n)
-    if shares_cost(opts, fd.n_vertices):
+    if shares_cost(opts, fd.n_vertices, m):
         for k in range(len(_signs(opts, m))):
             lay.symmetric(f"W{k}", n)
+    if opts.unsaturated_weight is not None:
+        lay.full("gamma_s", 1, 1)
     if opts.free_moves:
         lay.full("u0", m, 1)
         lay.full("s0", 1, 1)
@@ -101,24 +115,29 @@ def declare(opts: FormOptions, fd: FormData) -> Layout:
     return lay
 
 
-def shares_cost(opts: FormOptions, n_vertices: int) -> bool:
+def shares_cost(opts: FormOptions, n_vertices: int, n_inputs: int = 1) -> bool:
     """Whether the cost LMIs share their ``Q1``/``R`` part through a variable ``W`` (more than one
     cost LMI per input sign): ``[[dt W, G' Q1h', Y_s' Rh'], [Q1h G, gamma I, 0], [Rh Y_s, 0, gamma
     I]] >= 0`` once, and ``[[T_i - dt W, M'], [M, Q_j]] >= 0`` per pair: by a Schur complement the
     same set of ``(G, Q_j, Y, gamma)`` (the best ``W`` is ``(G' Q1 G + Y_s' R Y_s) / (dt gamma)``),
     with each pair's block of order ``2n`` instead of ``2n + p + m`` (as Kothare's "delta_shared").
     With the nominal cost and the vertex Lyapunov forms (Ding et al.) the pairs' blocks hold the
-    nominal model ``M = A_0 G + B_0 Y_s``; the nominal cost with one ``Q`` stays one block."""
-    several = len(pairs(opts, n_vertices)) > 1
-    return several and (opts.cost == "worst_case" or opts.vertex_lyapunov)
+    nominal model ``M = A_0 G + B_0 Y_s``; the nominal cost with one ``Q`` stays one block, and
+    with the saturation-dependent function (Zhang et al.) one block per pattern pair."""
+    several = len(pairs(opts, n_vertices, n_inputs)) > 1
+    ding = opts.vertex_lyapunov and not opts.saturation_dependent
+    return several and (opts.cost == "worst_case" or ding)
 
 
 def objective(opts: FormOptions, lay: Layout) -> np.ndarray:
-    """``c`` of ``min c'z``: ``gamma`` (+ ``s0``) + the soft constraints' penalties."""
+    """``c`` of ``min c'z``: ``gamma`` (+ ``s0``) (+ ``beta gamma_s``) + the soft constraints'
+    penalties."""
     c = np.zeros(lay.size)
     c[lay.index("gamma")] = 1.0
     if "s0" in lay:
         c[lay.index("s0")] = 1.0
+    if "gamma_s" in lay:  # Huang et al.'s gamma + beta gamma_s
+        c[lay.index("gamma_s")] = float(opts.unsaturated_weight or 0.0)
     for slack in soft_slacks(opts.soft):
         c[lay.index(slack.name)] = slack.weight
     return c
@@ -133,7 +152,7 @@ def _signs(opts: FormOptions, m: int) -> list[np.ndarray | None]:
 def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
     """Add every block of the form to ``prog`` (names say which LMI and which vertex)."""
     m, nv = fd.m, fd.n_vertices
-    lyap = [prog.var(name) for name in _lyapunov_names(opts, nv)]
+    lyap = [prog.var(name) for name in _lyapunov_names(opts, nv, m)]
     common = opts.lyapunov == "common"
     g_var = lyap[0] if common else prog.var("G")
 
@@ -152,13 +171,19 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
         assert z_var is not None
         return y_var.lmul(np.diag(sign)) + z_var.lmul(np.diag(1.0 - sign))
 
-    gamma = prog.var("gamma")
+    gamma_all = prog.var("gamma")
+    # Huang et al.: the unsaturated sign pattern (D_s = I, the first) bounded by gamma_s <= gamma
+    gamma_s = prog.var("gamma_s") if opts.unsaturated_weight is not None else gamma_all
+    if opts.unsaturated_weight is not None:
+        # diag(gamma - gamma_s, gamma) >= 0: gamma_s <= gamma, with gamma as the block's own scale (a
+        # 1 x 1 block's relative margin would be its sign alone)
+        prog.add("unsaturated_bound", prog.bmat([[gamma_all - gamma_s, None], [None, gamma_all]]))
     signs = _signs(opts, m)
     q1h, rh = fd.Q1h, fd.Rh
     p = q1h.shape[0]
 
     def cost_block(a: np.ndarray, b: np.ndarray, t: AffineMatrix, qn: AffineMatrix,
-                   ys: AffineMatrix) -> AffineMatrix:
+                   ys: AffineMatrix, gamma: AffineMatrix) -> AffineMatrix:
         mid = g_var.lmul(a) + ys.lmul(b)
         u_eye = prog.times(gamma, np.eye(m))
         if p == 0:  # Q1 = 0: no state cost rows
@@ -191,13 +216,18 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
         return delta_congruence(n, extra, fd.dt, rest_scale)
 
     cost_delta = delta(p + m, math.sqrt(fd.dt))
-    vertex_pairs = pairs(opts, nv)
+    vertex_pairs = pairs(opts, nv, m)
     disturbed = fd.E is not None and fd.w_max > 0.0
-    shared = shares_cost(opts, nv)
+    shared = shares_cost(opts, nv, m)
     root = math.sqrt(fd.dt)
     for k, sign in enumerate(signs):
         tag = "" if sign is None else f"_s{k}"
         ys = y_sign(sign)
+        gamma = gamma_s if k == 0 else gamma_all
+
+        def now(i: int, k: int = k) -> int:  # the index of T: the vertex, or the sign pattern
+            return k if opts.saturation_dependent else i
+
         if shared and prog.wants(f"cost_shared{tag}"):
             w_dt = prog.var(f"W{k}") * fd.dt
             cost_rows = [g_var.T.rmul(q1h.T), ys.T.rmul(rh.T)] if p else [ys.T.rmul(rh.T)]
@@ -219,29 +249,35 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
                 a, b = (fd.A0, fd.B0) if nominal else (fd.A[i], fd.B[i])
                 assert a is not None and b is not None
                 mid = g_var.lmul(a) + ys.lmul(b)
-                block = prog.bmat([[top(i) - w_dt, mid.T], [mid, q_next(j)]])
+                block = prog.bmat([[top(now(i)) - w_dt, mid.T], [mid, q_next(j)]])
                 prog.add(name, block, congruence=delta(0, 1.0))
         elif opts.cost == "worst_case":
             for i, j in vertex_pairs:
                 if prog.wants(f"cost_{i}_{j}{tag}"):
-                    prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(i), q_next(j), ys),
+                    prog.add(f"cost_{i}_{j}{tag}", cost_block(fd.A[i], fd.B[i], top(now(i)), q_next(j), ys,
+                                                              gamma), congruence=cost_delta)
+        elif opts.saturation_dependent:  # the nominal cost from T_k to every Q_j
+            assert fd.A0 is not None and fd.B0 is not None
+            for j in range(len(lyap)):
+                if prog.wants(f"cost_nominal_{j}{tag}"):
+                    prog.add(f"cost_nominal_{j}{tag}", cost_block(fd.A0, fd.B0, top(k), q_next(j), ys, gamma),
                              congruence=cost_delta)
         elif not opts.vertex_lyapunov:
             if prog.wants(f"cost_nominal{tag}"):
                 assert fd.A0 is not None and fd.B0 is not None
-                prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys),
+                prog.add(f"cost_nominal{tag}", cost_block(fd.A0, fd.B0, lyap[0], lyap[0], ys, gamma),
                          congruence=cost_delta)
         else:  # the nominal cost with one vertex Lyapunov matrix: one pair, (0, 0)
             assert fd.A0 is not None and fd.B0 is not None
             for i, j in vertex_pairs:
                 if prog.wants(f"cost_nominal_{i}_{j}{tag}"):
                     prog.add(f"cost_nominal_{i}_{j}{tag}",
-                             cost_block(fd.A0, fd.B0, top(i), q_next(j), ys), congruence=cost_delta)
+                             cost_block(fd.A0, fd.B0, top(i), q_next(j), ys, gamma), congruence=cost_delta)
         if disturbed or opts.cost == "nominal":
             for i, j in vertex_pairs:
                 if not prog.wants(f"invariance_{i}_{j}{tag}"):
                     continue
-                block = invariance_block(fd.A[i], fd.B[i], top(i), q_next(j), ys)
+                block = invariance_block(fd.A[i], fd.B[i], top(now(i)), q_next(j), ys)
                 prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
     if fd.q_outer is not None:  # Wan & Kothare's nesting, Q_outer - Q >= 0
         prog.add("nesting", prog.const(fd.q_outer) - lyap[0])
@@ -362,7 +398,8 @@ def _bound_blocks(prog: Program, opts: FormOptions, fd: FormData, top, y_sign, s
                 ys = y_sign(sign)
                 out = (g_var.lmul(fd.A[i]) + ys.lmul(fd.B[i])).lmul(c_row[None, :])
                 square = _soft_square(prog, square_bound, bound_slack(opts.soft, "y", r))
-                prog.add(f"output_{r}_{i}{tag}", prog.bmat([[square, out], [out.T, top(i)]]))
+                t_out = top(k) if opts.saturation_dependent else top(i)  # T of the sign pattern itself
+                prog.add(f"output_{r}_{i}{tag}", prog.bmat([[square, out], [out.T, t_out]]))
             if opts.free_moves:
                 u0 = prog.var("u0")
                 pred = (u0.lmul(fd.B[i]) + prog.const((fd.A[i] @ fd.x)[:, None])).lmul(c_row[None, :])

@@ -20,14 +20,15 @@ from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_real_array
 
 __all__ = [
-    "COSTS", "LYAPUNOV_FORMS", "MAX_HORIZON", "MAX_SOFT_WEIGHT", "SATURATIONS", "STEP_GAINS", "Disturbance",
-    "FormOptions", "form_options",
+    "COSTS", "LYAPUNOV_FORMS", "MAX_HORIZON", "MAX_SATURATION_INPUTS", "MAX_SOFT_WEIGHT",
+    "MAX_UNSATURATED_WEIGHT", "SATURATIONS", "STEP_GAINS", "Disturbance", "FormOptions", "form_options",
 ]
 
 #: ``"common"``: one quadratic Lyapunov function (Kothare 1996); ``"vertex"``: one ``Q_j`` per
 #: vertex and a slack ``G`` (uncertainty constant in time); ``"vertex_pairs"``: every vertex pair
-#: (uncertainty that may change at every sample).
-LYAPUNOV_FORMS: tuple[str, ...] = ("common", "vertex", "vertex_pairs")
+#: (uncertainty that may change at every sample); ``"saturation_dependent"``: one ``Q_k`` per sign
+#: pattern of the auxiliary saturation and a slack ``G`` (Zhang, Wang & Li 2013).
+LYAPUNOV_FORMS: tuple[str, ...] = ("common", "vertex", "vertex_pairs", "saturation_dependent")
 #: The cost bound over every vertex, or on the nominal model with robust invariance.
 COSTS: tuple[str, ...] = ("worst_case", "nominal")
 #: ``None`` (the law ``F x`` meets the bound) or ``"auxiliary"`` (``sat(F x)`` with an auxiliary gain).
@@ -48,7 +49,7 @@ class Disturbance:
 class FormOptions:
     """A validated choice of form (see :func:`form_options`)."""
 
-    lyapunov: Literal["common", "vertex", "vertex_pairs"] = "common"
+    lyapunov: Literal["common", "vertex", "vertex_pairs", "saturation_dependent"] = "common"
     cost: Literal["worst_case", "nominal"] = "worst_case"
     free_moves: int = 0
     saturation: Literal["auxiliary"] | None = None
@@ -58,13 +59,14 @@ class FormOptions:
     disturbance: Disturbance | None = None
     horizon: int = 1
     step_gains: Literal["common", "vertex"] = "common"
+    unsaturated_weight: float | None = None
 
     @property
     def is_kothare(self) -> bool:
         """Whether these are Kothare's LMIs (the defaults; a zero disturbance counts as none)."""
         return (
             self.lyapunov == "common" and self.cost == "worst_case" and self.free_moves == 0
-            and self.saturation is None and self.soft is None
+            and self.saturation is None and self.soft is None and self.unsaturated_weight is None
             and (self.disturbance is None or self.disturbance.w_max == 0.0)
             and not self.has_steps
         )
@@ -76,8 +78,13 @@ class FormOptions:
 
     @property
     def vertex_lyapunov(self) -> bool:
-        """One ``Q_j`` per vertex and a slack ``G``."""
+        """One ``Q_j`` per vertex (or per sign pattern) and a slack ``G``."""
         return self.lyapunov != "common"
+
+    @property
+    def saturation_dependent(self) -> bool:
+        """One ``Q_k`` per sign pattern of the auxiliary saturation (Zhang, Wang & Li 2013)."""
+        return self.lyapunov == "saturation_dependent"
 
 
 def _choice(value: Any, allowed: tuple, name: str) -> Any:
@@ -146,13 +153,15 @@ def form_options(
     disturbance: Any = None,
     horizon: Any = 1,
     step_gains: Any = "common",
+    unsaturated_weight: Any = None,
     n_inputs: int | None = None,
     n_outputs: int | None = None,
 ) -> FormOptions:
     """Check every option and every combination; return the :class:`FormOptions`.
 
     ``n_inputs``/``n_outputs``: the plant's inputs and bounded outputs, the lengths of per-component
-    soft weights and limits (:mod:`lmi.forms.soft`; ``None``: not checked here).
+    soft weights and limits (:mod:`lmi.forms.soft`; ``None``: not checked here); ``n_inputs`` is
+    also checked against :data:`MAX_SATURATION_INPUTS` with ``lyapunov="saturation_dependent"``.
 
     Raises
     ------
@@ -172,6 +181,15 @@ def form_options(
     dist = _disturbance(disturbance, n_states)
     steps = _steps(horizon, step_gains)
     _step_combinations(steps, lyapunov, cost, free_moves, saturation, soft_weights, dist)
+    weight = _unsaturated_weight(unsaturated_weight)
+    _saturation_combinations(lyapunov, saturation, weight, free_moves, dist, n_inputs)
+    if steps[0] > 1 and (lyapunov == "saturation_dependent" or weight is not None):
+        name, value = (("lyapunov", lyapunov) if lyapunov == "saturation_dependent"
+                       else ("unsaturated_weight", weight))
+        raise InvalidArgumentError(
+            f"horizon, {name}", f"horizon=1 with {name}={value!r} (the forms with steps are written for "
+            "one Lyapunov matrix per vertex and Cao & Lin's saturation)",
+            f"horizon={steps[0]!r}, {name}={value!r}")
     if saturation == "auxiliary" and input_constraint != "peak":
         raise InvalidArgumentError(
             "saturation, input_constraint",
@@ -187,6 +205,7 @@ def form_options(
     return FormOptions(
         str(lyapunov), str(cost), int(free_moves), saturation, soft_weights, dist,  # type: ignore[arg-type]
         *steps,  # type: ignore[arg-type]
+        weight,
     )
 
 
@@ -250,3 +269,76 @@ def _step_combinations(steps: tuple[int, str], lyapunov: Any, cost: Any, free_mo
                 f"horizon, {name}", f"horizon=1 with {name}={value!r} (the forms with steps bound the "
                 f"worst-case cost, with no free move, soft bound or disturbance), or {name}={default!r}",
                 f"horizon={horizon!r}, {name}={value!r}")
+
+
+#: The largest weight ``beta`` of Huang et al.'s objective ``gamma + beta gamma_s``
+#: (``unsaturated_weight``); a larger one is refused, as :data:`MAX_SOFT_WEIGHT` for the same
+#: reason: the objective spans ``beta`` from ``gamma``'s coefficient 1, and the solvers lose
+#: ``gamma`` beside ``beta gamma_s``. Measured with huang, wan_huang and mao_huang on Kothare's
+#: examples 1 and 2 and MUP's demo system: certified ``"optimal"`` at every weight from 1e3 to
+#: 1e14 (``gamma`` growing as ``sqrt(beta)`` while ``gamma_s`` settles at its own minimum); the
+#: first failures at 1e16 (example 2, all three; MUP's demo, huang and wan_huang: ``numerical_error``,
+#: then phase one's point, ``"inaccurate"``, ``gamma_s`` 2.3 to 260 times its minimum). 1e14 keeps
+#: a factor of 100 from them.
+MAX_UNSATURATED_WEIGHT = 1e14
+
+#: The most inputs ``lyapunov="saturation_dependent"`` takes: its LMIs hold ``2^m`` Lyapunov
+#: matrices and ``N 4^m`` cost blocks (``m`` inputs, ``N`` vertices), 1024 per vertex at ``m = 5``.
+#: The size guard of :class:`lmi.forms.FormProblem` (:data:`lmi.forms.problem.MAX_COEFFICIENT_BYTES`)
+#: refuses smaller forms whose blocks do not fit.
+MAX_SATURATION_INPUTS = 5
+
+
+def _unsaturated_weight(weight: Any) -> float | None:
+    if weight is None:
+        return None
+    number = int | float | np.floating | np.integer
+    if isinstance(weight, bool | np.bool_) or not isinstance(weight, number):
+        raise ArgumentTypeError("unsaturated_weight", "None or a number >= 0", type(weight).__name__)
+    if not (np.isfinite(weight) and weight >= 0.0):
+        raise InvalidArgumentError("unsaturated_weight", "a finite weight >= 0", repr(weight))
+    if weight > MAX_UNSATURATED_WEIGHT:
+        raise InvalidArgumentError(
+            "unsaturated_weight",
+            f"a weight <= MAX_UNSATURATED_WEIGHT = {MAX_UNSATURATED_WEIGHT:g} (beyond it the solvers cannot "
+            "resolve gamma next to beta gamma_s; see the page on the forms)", repr(weight))
+    return float(weight)
+
+
+def _saturation_combinations(lyapunov: Any, saturation: Any, weight: float | None, free_moves: Any,
+                             dist: Disturbance | None, n_inputs: int | None) -> None:
+    """Huang et al.'s weight and Zhang et al.'s Lyapunov function: only with the auxiliary
+    saturation, whose sign patterns they are written on."""
+    if weight is not None and saturation != "auxiliary":
+        raise InvalidArgumentError(
+            "unsaturated_weight, saturation",
+            "unsaturated_weight with saturation='auxiliary' (it weighs the cost bound of the unsaturated "
+            "sign pattern)", f"unsaturated_weight={weight!r}, saturation={saturation!r}",
+        )
+    if lyapunov != "saturation_dependent":
+        return
+    if saturation != "auxiliary":
+        raise InvalidArgumentError(
+            "lyapunov, saturation",
+            "lyapunov='saturation_dependent' with saturation='auxiliary' (one Lyapunov matrix per sign "
+            "pattern of the saturation)", f"lyapunov={lyapunov!r}, saturation={saturation!r}",
+        )
+    if free_moves:
+        raise InvalidArgumentError(
+            "lyapunov, free_moves",
+            "free_moves=0 with lyapunov='saturation_dependent' (the free move's prediction is not "
+            "written for this form)", f"lyapunov={lyapunov!r}, free_moves={free_moves!r}",
+        )
+    if dist is not None and dist.w_max > 0.0:
+        raise InvalidArgumentError(
+            "lyapunov, disturbance",
+            "no disturbance with lyapunov='saturation_dependent' (its S-procedure is not written for "
+            "this form)", f"lyapunov={lyapunov!r}, w_max={dist.w_max!r}",
+        )
+    if n_inputs is not None and n_inputs > MAX_SATURATION_INPUTS:
+        raise InvalidArgumentError(
+            "lyapunov, plant",
+            f"at most MAX_SATURATION_INPUTS = {MAX_SATURATION_INPUTS} inputs with "
+            "lyapunov='saturation_dependent' (2^m Lyapunov matrices, N 4^m cost blocks)",
+            f"{n_inputs} inputs",
+        )

@@ -25,7 +25,7 @@ from scipy import sparse
 from lmi.affine import svec_matrix
 from lmi.certificate import Certificate
 from lmi.data import InputConstraint, KothareData, build_kothare_data
-from lmi.forms.lmis import FormData, objective
+from lmi.forms.lmis import FormData, lyapunov_count, objective
 from lmi.forms.options import FormOptions, form_options
 from lmi.forms.program import Layout, Program
 from lmi.forms.soft import soft_slacks
@@ -96,7 +96,7 @@ class FormProblem:
         As for :class:`lmi.KothareProblem` (checked the same way).
     nominal : (A0, B0), optional
         The nominal model, needed by ``cost="nominal"``.
-    lyapunov, cost, free_moves, saturation, soft, disturbance
+    lyapunov, cost, free_moves, saturation, soft, disturbance, unsaturated_weight
         The form (:func:`lmi.forms.options.form_options`; the LMIs: the page "The field's robust
         MPC forms" of the docs).
     backend : {"ipm", "clarabel", "cvxpy"}
@@ -152,6 +152,7 @@ class FormProblem:
         saturation: str | None = None,
         soft: dict[str, float] | None = None,
         disturbance: Any = None,
+        unsaturated_weight: float | None = None,
         backend: str = "ipm",
         solver_options: dict[str, Any] | None = None,
         certificate_tol: float = 1e-7,
@@ -167,7 +168,7 @@ class FormProblem:
             n_states=data.n, input_constraint=data.input_constraint, has_output=data.C_out is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
             disturbance=disturbance, horizon=horizon, step_gains=step_gains,
-            n_inputs=data.m,
+            unsaturated_weight=unsaturated_weight, n_inputs=data.m,
             n_outputs=None if data.C_out is None else data.C_out.shape[0],
         )
         if backend not in _BACKENDS:
@@ -703,7 +704,8 @@ class FormProblem:
         h_mat = None if g_inv is None or "Z" not in values else values["Z"] @ g_inv
         q_vertices = None
         if opts.vertex_lyapunov:
-            q_vertices = tuple(s2 * values[f"Q{j}"] for j in range(self.data.n_vertices))
+            count = lyapunov_count(opts, self.data.n_vertices, self.data.m)
+            q_vertices = tuple(s2 * values[f"Q{j}"] for j in range(count))
             q_mat = _inner_ellipsoid(q_vertices)
         else:
             q_mat = s2 * values["Q"]
@@ -722,6 +724,7 @@ class FormProblem:
             u0=scale * values["u0"][:, 0] if "u0" in values else None,
             H=h_mat, slack=slack, lam=lam if dist is not None and w_max > 0.0 else None,
             steps={name: s2 * val for name, val in values.items() if "@" in name} if opts.has_steps else None,
+            gamma_s=s2 * float(values["gamma_s"][0, 0]) if "gamma_s" in values else None,
         )
 
     def _original(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

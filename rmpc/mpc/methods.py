@@ -26,7 +26,23 @@ key            method                                                 options
                                                                       ``saturation="auxiliary"``
 ``ding``       Ding, Xi, Cychowski & O'Mahony (2007)                  ``cost="nominal"``,
                                                                       ``lyapunov="vertex_pairs"``
+``huang``      Huang, Li, Lin & Xi (2011)                             ``saturation="auxiliary"``,
+                                                                      ``unsaturated_weight`` (given)
+``zhang``      Zhang, Wang & Li (2013)                                ``saturation="auxiliary"``,
+                                                                      ``lyapunov="saturation_dependent"``
+``wan_huang``  Wan & Kothare (2003) with Huang et al. (2011)          ``cost="nominal"``,
+                                                                      ``saturation="auxiliary"``,
+                                                                      ``unsaturated_weight`` (given)
+``mao_huang``  Mao (2003) with Huang et al. (2011)                    ``lyapunov="vertex_pairs"``,
+                                                                      ``saturation="auxiliary"``,
+                                                                      ``unsaturated_weight`` (given)
+``wan_zhang``  Wan & Kothare (2003) with Zhang et al. (2013)          ``cost="nominal"``,
+                                                                      ``saturation="auxiliary"``,
+                                                                      ``lyapunov="saturation_dependent"``
 =============  =====================================================  =================================
+
+Huang et al.'s keys take the weight ``beta`` as ``unsaturated_weight`` from the caller (MUP's own
+code stops with "Parameter BETA was not defined" without it; its demo sets ``beta = 1e3``).
 
 MUP's four soft-constrained keys (Oravec & Bakošová, 2016) stand for the form of their base key
 with soft limits the caller gives; the hard bounds stay hard:
@@ -46,11 +62,12 @@ output of ``output_matrix``; a weight ``0`` and a limit ``0`` for a component no
 :mod:`lmi.forms.soft`).
 
 As in MUP, the input bound is per component (``input_constraint="peak"``) unless the caller
-gives ``input_constraint``. ``li`` and ``shi`` differ from MUP's own code where the docs' page on
-the forms says (``Y - E_j Z`` of MUP's ``sdp_shi.m`` is the auxiliary saturation with ``H = Y -
-Z``; the terminal ellipsoid; output bounds at every step). MUP's other keys (``huang``, ``zhang``,
-``wan_huang``, ``mao_huang``, ``wan_zhang``) have no form here yet: asked for by
-name they are refused with the nearest option the toolkit has.
+gives ``input_constraint``. Every one of MUP's 19 keys has a form here; where the toolkit's LMIs
+differ from MUP's own code (``trace(X)`` in MUP's objectives, its strictness margins, the
+terminal ellipsoid of ``shi``, ``Y - E_j Z`` of MUP's ``sdp_shi.m`` as the auxiliary saturation
+with ``H = Y - Z``, output bounds at every step and vertex, one family of Lyapunov matrices for
+``zhang``, no ``C_v`` factor in ``ding``'s invariance blocks, one block per component for the
+soft limits) the page on the forms says so, form by form.
 """
 
 from __future__ import annotations
@@ -61,7 +78,7 @@ from typing import Any
 
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
-__all__ = ["METHODS", "NOT_YET", "SOFT_CON_KEYS", "Method", "method_options"]
+__all__ = ["METHODS", "NEEDS", "NOT_YET", "SOFT_CON_KEYS", "Method", "method_options"]
 
 
 @dataclass(frozen=True)
@@ -100,6 +117,14 @@ METHODS: MappingProxyType = MappingProxyType({m.key: m for m in (
     _method("wan_cao_soft_con", "Wan & Kothare (2003) with Cao & Lin (2005) and Oravec & Bakosova's soft "
             "constraints (2016)", cost="nominal", saturation="auxiliary"),
     _method("ding", "Ding, Xi, Cychowski & O'Mahony (2007)", cost="nominal", lyapunov="vertex_pairs"),
+    _method("huang", "Huang, Li, Lin & Xi (2011)", saturation="auxiliary"),
+    _method("zhang", "Zhang, Wang & Li (2013)", saturation="auxiliary", lyapunov="saturation_dependent"),
+    _method("wan_huang", "Wan & Kothare (2003) with Huang et al. (2011)", cost="nominal",
+            saturation="auxiliary"),
+    _method("mao_huang", "Mao (2003) with Huang et al. (2011)", lyapunov="vertex_pairs",
+            saturation="auxiliary"),
+    _method("wan_zhang", "Wan & Kothare (2003) with Zhang et al. (2013)", cost="nominal",
+            saturation="auxiliary", lyapunov="saturation_dependent"),
 )})
 
 #: MUP's soft-constrained keys: the caller gives the soft limits (``soft`` with ``"u_limit"``
@@ -108,15 +133,13 @@ SOFT_CON_KEYS: frozenset[str] = frozenset(
     {"kothare_soft_con", "wan_soft_con", "cao_soft_con", "wan_cao_soft_con"}
 )
 
-#: MUP's keys without a form here yet, with the nearest option the toolkit has.
-NOT_YET: MappingProxyType = MappingProxyType({
-    "huang": "the weighted unsaturated blocks of Huang et al. (2011) are not a form yet; nearest: 'cao'",
-    "zhang": "the saturation-dependent Lyapunov function of Zhang et al. (2013) is not a form yet; "
-             "nearest: 'cao'",
-    "wan_huang": "huang is not a form yet; nearest: 'wan_cao'",
-    "mao_huang": "huang is not a form yet; nearest: 'mao_cao'",
-    "wan_zhang": "zhang is not a form yet; nearest: 'wan_cao'",
+#: The keys whose tuning parameter the caller gives (MUP's code has no default either).
+NEEDS: MappingProxyType = MappingProxyType({
+    "huang": "unsaturated_weight", "wan_huang": "unsaturated_weight", "mao_huang": "unsaturated_weight",
 })
+
+#: MUP's keys without a form here (none: every key has one; kept for callers that look keys up).
+NOT_YET: MappingProxyType = MappingProxyType({})
 
 
 def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
@@ -126,8 +149,8 @@ def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
     ------
     InvalidArgumentError
         For a key that is not MUP's (the message lists the keys), a key without a form here yet
-        (with the nearest option), or an option in ``given`` that the key already sets
-        differently.
+        (with the nearest option), an option in ``given`` that the key already sets
+        differently, or a tuning parameter the key needs (:data:`NEEDS`) not given.
     """
     if not isinstance(key, str):
         raise ArgumentTypeError("key", "a method key (str)", type(key).__name__)
@@ -142,6 +165,11 @@ def method_options(key: Any, given: dict[str, Any]) -> dict[str, Any]:
             raise InvalidArgumentError(
                 name, f"{value!r} (method {key!r} sets it) or no {name} argument", repr(given[name])
             )
+    needed = NEEDS.get(key)
+    if needed is not None and given.get(needed) is None:
+        raise InvalidArgumentError(
+            needed, f"a value for method {key!r} (e.g. {needed}=1e3, MUP's demo; 0 gives 'cao')", "none given"
+        )
     merged = {"input_constraint": "peak", **METHODS[key].defaults, **given, **options}
     _check_soft_con(key, merged.get("soft"))
     return merged

@@ -63,6 +63,8 @@ def rmpc_arguments(design: Design, partial: bool = False) -> dict[str, Any]:
         "free_moves": Design.integer, "saturation": lambda d, k: d.optional_text(k),
         "soft": lambda d, k: d.optional_mapping(k), "disturbance": _disturbance,
         "offset_free": Design.flag,
+        # absent from designs saved before Huang et al.'s form: None, the form they had
+        "unsaturated_weight": lambda d, k: d.optional_number(k) if d.has(k) else None,
     }
     out = {name: read(design, name) for name, read in readers.items() if not partial or design.has(name)}
     # the forms with steps: written only when set (a design saved before them has neither)
@@ -129,13 +131,15 @@ class RMPC(Saveable):
         Passed to :class:`lmi.KothareProblem` (with the default form) or
         :class:`lmi.forms.FormProblem` (any other form: ``backend`` ``"ipm"``, ``"clarabel"`` or
         ``"cvxpy"``, ``formulation`` and ``solver`` unused).
-    lyapunov : {"common", "vertex", "vertex_pairs"}
+    lyapunov : {"common", "vertex", "vertex_pairs", "saturation_dependent"}
         One quadratic Lyapunov function (Kothare), one ``Q_j`` per vertex with a slack ``G``
         (uncertainty constant in time), or every vertex pair (uncertainty that may change at
-        every sample).
+        every sample); ``"saturation_dependent"``: one ``Q_k`` per sign pattern of the auxiliary
+        saturation (Zhang, Wang & Li 2013; only with ``saturation="auxiliary"``).
     cost : {"worst_case", "nominal"}
         The cost bound over every vertex, or on ``plant.nominal`` with robust invariance on
-        every vertex (with the vertex Lyapunov forms: Ding et al.'s form).
+        every vertex (with the vertex Lyapunov forms: Ding et al.'s form; with
+        ``"saturation_dependent"``: Zhang et al.'s nominal form).
     free_moves : {0, 1}
         With 1 the first move ``u(k)`` is a free variable (applied by :meth:`step`) and the
         feedback law acts from ``k + 1`` on.
@@ -161,6 +165,10 @@ class RMPC(Saveable):
     step_gains : {"common", "vertex"}
         ``"vertex"``: the second step's gain depends on the first step's vertex (Li, Shi, Sun &
         Wang 2008: with ``horizon=2`` and ``lyapunov="common"`` only).
+    unsaturated_weight : float, optional
+        ``beta >= 0`` of Huang, Li, Lin & Xi (2011): the cost LMIs of the unsaturated sign pattern
+        are bounded by ``gamma_s <= gamma`` and the objective is ``gamma + beta gamma_s`` (only with
+        ``saturation="auxiliary"``; ``None``, the default, is Cao & Lin's form, and so is 0).
     offset_free : bool
         Offset-free action on a constant input disturbance: every :meth:`step` takes the
         disturbance estimate ``StepInputs(d_hat=...)`` (from an estimator with
@@ -235,7 +243,7 @@ class RMPC(Saveable):
         on_failure: Literal["fallback", "raise"] = "fallback",
         hold_radius: float = 1e-9,
         resolve_threshold: float = 1.0,
-        lyapunov: Literal["common", "vertex", "vertex_pairs"] = "common",
+        lyapunov: Literal["common", "vertex", "vertex_pairs", "saturation_dependent"] = "common",
         cost: Literal["worst_case", "nominal"] = "worst_case",
         free_moves: int = 0,
         saturation: Literal["auxiliary"] | None = None,
@@ -244,6 +252,7 @@ class RMPC(Saveable):
         offset_free: bool = False,
         horizon: int = 1,
         step_gains: Literal["common", "vertex"] = "common",
+        unsaturated_weight: float | None = None,
     ) -> None:
         if not isinstance(plant, PolytopicModel):
             hint = ""
@@ -256,7 +265,8 @@ class RMPC(Saveable):
         self.form = form_options(
             n_states=plant.n_states, input_constraint=input_constraint, has_output=output_matrix is not None,
             lyapunov=lyapunov, cost=cost, free_moves=free_moves, saturation=saturation, soft=soft,
-            disturbance=disturbance, horizon=horizon, step_gains=step_gains, n_inputs=plant.n_inputs,
+            disturbance=disturbance, horizon=horizon, step_gains=step_gains,
+            unsaturated_weight=unsaturated_weight, n_inputs=plant.n_inputs,
             n_outputs=_output_rows(output_matrix),
         )
         self.problem: KothareProblem | FormProblem
@@ -278,6 +288,7 @@ class RMPC(Saveable):
                 cost=cost, free_moves=free_moves, saturation=saturation, soft=soft, disturbance=disturbance,
                 backend=backend, solver_options=solver_options, certificate_tol=certificate_tol,
                 horizon=horizon, step_gains=step_gains,
+                unsaturated_weight=unsaturated_weight,
             )
         self.certified = CertifiedGain("RMPC", on_failure, hold_radius)
         self.resolve_threshold = check_positive(resolve_threshold, "resolve_threshold")
@@ -320,6 +331,7 @@ class RMPC(Saveable):
             # the forms with steps, only when set (the designs of the other forms stay as they were)
             **({"horizon": self.form.horizon, "step_gains": self.form.step_gains}
                if self.form.has_steps else {}),
+            "unsaturated_weight": unsaturated_weight,
         })
 
     # -- save and load ---------------------------------------------------------------------
