@@ -165,3 +165,48 @@ def test_the_ranking_is_read_from_the_records():
     assert "largest region (hard bounds): vertex (2.000 x kothare's, geometric mean) (tied" in line
     assert "(tied within 0.1%: free_move)" in line
     assert "lowest closed-loop cost: nominal 4" in line
+
+
+def test_mup_keys_take_the_demo_parameters_and_the_peak_bound():
+    """The bench runs MUP's keys with the options of :data:`rmpc.mpc.methods.METHODS` and MUP's demo's
+    parameters (beta = 1e3, N = 3); a saturation method on an ``||u||_2`` problem is not comparable."""
+    p = build_problem("paper_p_2v")  # bounds ||u||_2
+    options, reason, comparable = method_options(p, "huang")
+    assert reason is None and not comparable
+    assert options == {"saturation": "auxiliary", "unsaturated_weight": 1e3, "input_constraint": "peak"}
+    options, _, comparable = method_options(p, "shi")
+    assert comparable is False and options["horizon"] == 3 and options["lyapunov"] == "vertex_pairs"
+    options, _, comparable = method_options(p, "ding")
+    assert comparable and options == {"cost": "nominal", "lyapunov": "vertex_pairs"}
+
+
+def test_new_methods_run_beside_the_forms(tmp_path):
+    outcome = run_methods(tmp_path, short=True, problems=["kothare_ex1"], methods=["ding", "multistage"],
+                          progress=False)
+    assert not outcome.failures
+    recs = {r["method"]: r for r in outcome.records}
+    assert recs["ding"]["status"] == "optimal" and recs["ding"]["gamma"] > 0
+    assert recs["multistage"]["status"] == "optimal" and recs["multistage"]["gamma"] is None
+    assert recs["multistage"]["cvxpy_time_p50"] is None and "QP family" in recs["multistage"]["cvxpy_error"]
+    for rec in recs.values():
+        assert rec["violation_samples"] == rec["violation_runs"] * rec["closed_loop_steps"] > 0
+        assert rec["violations"] == 0, rec  # both keep |u| <= 2 on every vertex sequence
+
+
+def test_violations_count_the_samples_that_break_a_bound():
+    p = build_problem("mup_demo")  # |u| <= 10 and |x_i| <= 10
+
+    class TooStrong:
+        last = None
+
+        def reset(self):
+            pass
+
+        def step(self, x):
+            return np.array([2.0 * p.u_max])  # every input beyond the bound
+
+    settings = MethodsSettings.short()
+    out = suite._violations(TooStrong(), p, 5, settings)
+    assert out["violation_runs"] == settings.violation_runs
+    assert out["violations_input"] == out["violation_samples"] == 5 * settings.violation_runs
+    assert out["violations_state"] > 0  # u = 20 drives the states out of |x_i| <= 10

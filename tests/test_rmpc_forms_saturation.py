@@ -227,7 +227,6 @@ def _form(**options):
       "disturbance": (np.ones((2, 1)), 0.1)}, "lyapunov, disturbance", "no disturbance"),
     ({"lyapunov": "saturation_dependent", "saturation": "auxiliary", "n_inputs": MAX_SATURATION_INPUTS + 1},
      "lyapunov, plant", "MAX_SATURATION_INPUTS"),
-    ({"lyapunov": "vertex", "cost": "nominal"}, "cost, lyapunov", "cost='nominal'"),
 ])
 def test_bad_options_are_refused_naming_the_arguments(options, argument, words):
     with pytest.raises(InvalidArgumentError) as info:

@@ -43,6 +43,7 @@ from benchmarks.core.progress import CaseProgress
 from benchmarks.core.publish import published_paths, staged_reports
 from benchmarks.core.suite import SuiteOutcome
 from benchmarks.suites.methods_problems import PROBLEMS, SHORT_PROBLEMS, MethodsProblem, build_problem
+from benchmarks.suites.methods_qp import QP_METHODS, qp_method, state_box
 from benchmarks.suites.methods_report import write_methods_report
 from benchmarks.suites.methods_store import case_path, load_case, store_case
 from rmpc.analysis import TimeBudgetExceeded, boundary_along
@@ -70,6 +71,7 @@ METHODS: dict[str, str] = {
     "wan_huang": "Wan & Kothare 2003 with Huang et al. 2011 (nominal cost)",
     "mao_huang": "Mao 2003 with Huang et al. 2011 (vertex-pair Lyapunov matrices)",
     "wan_zhang": "Wan & Kothare 2003 with Zhang et al. 2013 (nominal cost)",
+    **QP_METHODS,
 }
 
 #: The methods of :data:`METHODS` that are MUP's method keys beyond the eight forms: their options
@@ -88,7 +90,7 @@ MUP_PARAMETERS: Mapping[str, Mapping[str, Any]] = MappingProxyType({
 SOFT_WEIGHT: float = 1e3
 
 #: Version of the record layout; a stored case of another version is run again.
-RECORD_VERSION = 1
+RECORD_VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -112,7 +114,10 @@ class MethodsSettings:
         ipm starts cold) and is left out of the medians when there are more states.
     slow_solve_s : float
         A method whose solve at ``x0`` takes longer skips the region and the closed loop (recorded).
-    region_budget_s, loop_budget_s, cvxpy_budget_s : float
+    violation_runs : int
+        Seeded switching-vertex runs (each the closed loop's length) whose bound violations are
+        counted (``violations``), within ``violation_budget_s``.
+    region_budget_s, loop_budget_s, cvxpy_budget_s, violation_budget_s : float
         Wall-time budgets of the region, the two closed loops together and the cvxpy solves: a
         phase that runs past its budget stops, and the record says where (``notes``; a region or a
         cost that is not complete is ``None``).
@@ -130,6 +135,8 @@ class MethodsSettings:
     region_budget_s: float = 240.0
     loop_budget_s: float = 240.0
     cvxpy_budget_s: float = 60.0
+    violation_runs: int = 20
+    violation_budget_s: float = 120.0
     seed: int = 0
 
     @classmethod
@@ -146,6 +153,8 @@ class MethodsSettings:
             region_budget_s=15.0,
             loop_budget_s=15.0,
             cvxpy_budget_s=10.0,
+            violation_runs=2,
+            violation_budget_s=10.0,
         )
 
     def as_dict(self) -> dict[str, Any]:
@@ -197,7 +206,7 @@ def _mup_options(problem: MethodsProblem, key: str) -> tuple[dict[str, Any], Non
     with the auxiliary saturation runs with the peak bound, as ``auxiliary_saturation``."""
     from rmpc.mpc.methods import METHODS as MUP
 
-    options = {**dict(MUP[key].options), **MUP_PARAMETERS.get(key, {})}
+    options = {**dict(MUP[key].defaults), **dict(MUP[key].options), **MUP_PARAMETERS.get(key, {})}
     comparable = True
     if options.get("saturation") is not None:
         comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
@@ -393,20 +402,25 @@ def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) ->
     start_case = time.perf_counter()
     rec = _base_record(problem, method, settings)
     extra: dict[str, Any] = {}
-    options, reason, comparable = method_options(problem, method)
+    qp_family = method in QP_METHODS
+    if qp_family:
+        ctrl, reason, comparable, options = qp_method(problem, method)
+    else:
+        options, reason, comparable = method_options(problem, method)
     rec["comparable"] = comparable
-    if options is None:
+    if options is None or reason is not None:
         rec["status"], rec["skip_reason"] = "skipped", reason
         return rec, extra
     rec["settings"]["options"] = _options_json(options)
     if not comparable:
         rec["notes"].append("runs with the peak bound |u_l| <= u_max: not the problem's ||u||_2 bound")
-    try:
-        ctrl = _controller(problem, options)
-    except (TypeError, ValueError) as err:
-        rec["status"] = "skipped"
-        rec["skip_reason"] = f"RMPC does not take these options: {type(err).__name__}: {err}"
-        return rec, extra
+    if not qp_family:
+        try:
+            ctrl = _controller(problem, options)
+        except (TypeError, ValueError) as err:
+            rec["status"] = "skipped"
+            rec["skip_reason"] = f"RMPC does not take these options: {type(err).__name__}: {err}"
+            return rec, extra
     start = time.perf_counter()
     sol = ctrl.solve(problem.x0)
     x0_time = time.perf_counter() - start
@@ -466,6 +480,11 @@ def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) ->
             counts[k] = counts.get(k, 0) + v
     rec["status_counts"] = counts
     extra["trajectory"] = fixed["states"].tolist()
+    rec.update(_violations(ctrl, problem, steps, settings))
+    if qp_family:  # no LMIs: nothing for cvxpy to solve the same way
+        rec["cvxpy_error"] = "a QP family: no LMIs to solve through cvxpy + Clarabel"
+        rec["case_time_s"] = time.perf_counter() - start_case
+        return rec, extra
     # cvxpy + Clarabel on the first states of the closed loop
     cv_states = list(fixed["states"][: max(1, settings.cvxpy_states)])
     cv = _cvxpy_times(problem, options, cv_states, time.perf_counter() + settings.cvxpy_budget_s)
@@ -474,6 +493,33 @@ def evaluate(problem: MethodsProblem, method: str, settings: MethodsSettings) ->
         rec["cvxpy_ratio"] = rec["cvxpy_time_p50"] / rec["ipm_time_same_states_p50"]
     rec["case_time_s"] = time.perf_counter() - start_case
     return rec, extra
+
+
+def _violations(ctrl: Any, problem: MethodsProblem, steps: int, settings: MethodsSettings) -> dict[str, Any]:
+    """Bound violations over seeded switching-vertex runs (:func:`rmpc.mpc.switching_runs.switching_runs`):
+    run ``r`` draws its vertices with seed ``settings.seed + r``; runs stop at the budget.
+
+    The input bound is checked per component (``|u_l| <= u_max``; on a problem that bounds
+    ``||u||_2`` that is a necessary condition only), the state bound where the problem has output
+    bounds (``|C x| <= y_max``).
+    """
+    from rmpc.mpc.switching_runs import switching_runs
+
+    state = state_box(problem)
+    deadline = time.perf_counter() + settings.violation_budget_s
+    out = {"violations": 0, "violation_runs": 0, "violation_samples": 0, "violations_input": 0,
+           "violations_state": 0}
+    for r in range(settings.violation_runs):
+        if r and time.perf_counter() > deadline:
+            break
+        run = switching_runs(ctrl, problem.plant, problem.x0, steps=steps, runs=1, seed=settings.seed + r,
+                             u_max=float(problem.u_max), state_constraints=state, Q=problem.Q, R=problem.R)
+        out["violations"] += run["violations"]
+        out["violations_input"] += run["input_violations"]
+        out["violations_state"] += run["state_violations"]
+        out["violation_samples"] += run["samples"]
+        out["violation_runs"] += 1
+    return out
 
 
 def _region(
