@@ -236,8 +236,9 @@ def _add_methods(bsub: Any) -> None:
         help="the robust MPC forms head to head on the field's test problems",
         description="Solve every test problem (Kothare's examples 1 and 2, MUP's demo system, paper P's "
         "satellite at 2 and 8 vertices, paper W's wheel satellite, the 14-state flexible model) with every "
-        "form of RMPC (" + ", ".join(METHODS) + "): gamma at the start state, the feasible region along "
-        "fixed directions, the closed-loop cost, solve times next to cvxpy + Clarabel, statuses. Writes "
+        "method (" + ", ".join(METHODS) + "): gamma at the start state, the feasible region along "
+        "fixed directions, the closed-loop cost, bound violations over seeded switching runs, solve times "
+        "next to cvxpy + Clarabel, statuses. Writes "
         "results.json, results.md, results.csv, run.json, figures/*.png and cases/*.json (each finished "
         "case; re-running the same command resumes). Exit status: 0 all done, 1 some cases failed, "
         "2 bad input, 130 interrupted.",
