@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from rmpc.mpc.offline import OfflineRMPC
     from rmpc.mpc.robust_mpc import RMPC
     from rmpc.mpc.scheduled import ScheduledRMPC
+    from rmpc.mpc.tube import TubeMPC
     from rmpc.sim.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
     from rmpc.sim.simulate import simulate
     from rmpc.sim.trajectory import Trajectory
@@ -69,6 +70,7 @@ _EXPORTS = {
     "rmpc.mpc.offline": ("OfflineRMPC",),
     "rmpc.mpc.robust_mpc": ("RMPC",),
     "rmpc.mpc.scheduled": ("ScheduledRMPC",),
+    "rmpc.mpc.tube": ("TubeMPC",),
     "rmpc.sim.disturbances": ("ConstantDisturbance", "SineDisturbance", "StepDisturbance"),
     "rmpc.sim.simulate": ("simulate",),
     "rmpc.sim.trajectory": ("Trajectory",),
@@ -105,6 +107,7 @@ __all__ = [
     "StepInfo",
     "StepInputs",
     "Trajectory",
+    "TubeMPC",
     "TuningFunctionAB",
     "export_c",
     "flexible_lqr",

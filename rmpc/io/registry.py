@@ -27,6 +27,7 @@ KINDS: MappingProxyType[str, str] = MappingProxyType({
     "CRMPC": "rmpc.mpc.crmpc:CRMPC",
     "GIPC": "rmpc.mpc.gipc:GIPC",
     "LQR": "rmpc.mpc.lqr:LQR",
+    "TubeMPC": "rmpc.mpc.tube:TubeMPC",
     "Luenberger": "rmpc.estimators.linear:Luenberger",
     "KalmanFilter": "rmpc.estimators.linear:KalmanFilter",
     "RobustObserver": "rmpc.estimators.robust:RobustObserver",
