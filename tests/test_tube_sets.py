@@ -157,3 +157,23 @@ def test_polytope_rejects_bad_sets() -> None:
         Polytope(np.array([[1.0], [-1.0]]), np.array([-1.0, -1.0]), "W")
     with pytest.raises(ValueError, match="K: expected a gain with A \\+ B K Schur stable"):
         mrpi_outer(A, Polytope.box([0.1, 0.1]))
+
+
+def test_a_cddlib_failure_is_a_toolkit_error_naming_the_set(monkeypatch) -> None:
+    """cddlib's floating-point arithmetic can give up (it did on a six-state terminal set:
+    "Numerical inconsistency is found"); that surfaces as a PolytopeError naming the set."""
+    import cdd
+
+    from rmpc.sets import PolytopeError
+
+    def give_up(*args, **kwargs):
+        raise RuntimeError("*Error: Numerical inconsistency is found.")
+
+    monkeypatch.setattr(cdd, "copy_generators", give_up)
+    with pytest.raises(PolytopeError, match="could not enumerate the vertices of terminal set"):
+        Polytope(np.vstack([np.eye(2), -np.eye(2)]), np.ones(4), "terminal set")
+
+
+def test_a_sum_too_large_is_refused_before_it_is_built() -> None:
+    with pytest.raises(ValueError, match="W: expected a Minkowski sum of at most max_vertices = 10"):
+        mrpi_outer(A_K, Polytope.box([0.1, 0.1]), epsilon=1e-3, max_vertices=10)

@@ -154,6 +154,13 @@ def mrpi_outer(A: np.ndarray, W: Polytope, epsilon: float = 1e-3, s_max: int = 2
     vertices = W.vertices
     for term in range(1, s):
         power = A @ power
+        if vertices.shape[0] * W.vertices.shape[0] > 20 * max_vertices:     # refuse before a slow hull
+            raise InvalidArgumentError(
+                "W", f"a Minkowski sum of at most max_vertices = {max_vertices} vertices "
+                "(use kind='tightening', which needs no explicit set)",
+                f"{vertices.shape[0]} vertices after {term} of {s} terms, "
+                f"{vertices.shape[0] * W.vertices.shape[0]} points in the next sum",
+            )
         vertices = minkowski_vertices(vertices, W.vertices @ power.T)
         if vertices.shape[0] > max_vertices:
             raise InvalidArgumentError(

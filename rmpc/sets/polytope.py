@@ -57,7 +57,7 @@ def _canonical_rows(h_mat: np.ndarray, h_vec: np.ndarray) -> tuple[np.ndarray, n
     mat = cdd.matrix_from_array(np.hstack([h_vec[:, None], -h_mat]), rep_type=cdd.RepType.INEQUALITY)
     try:
         cdd.matrix_canonicalize(mat)
-    except RuntimeError as err:
+    except RuntimeError as err:      # cddlib's floating-point arithmetic gave up
         raise PolytopeError(f"cddlib could not remove the redundant inequalities: {err}") from None
     arr = np.array(mat.array, dtype=float).reshape(-1, h_mat.shape[1] + 1)
     if mat.lin_set:  # equality rows: the set is not full-dimensional
@@ -91,10 +91,14 @@ class Polytope:
         h_mat = as_matrix(H, f"{name} (H)")
         h_vec = as_vector(h, f"{name} (h)", h_mat.shape[0])
         n = h_mat.shape[1]
-        poly = cdd.polyhedron_from_matrix(
-            cdd.matrix_from_array(np.hstack([h_vec[:, None], -h_mat]), rep_type=cdd.RepType.INEQUALITY)
-        )
-        gen = np.array(cdd.copy_generators(poly).array, dtype=float).reshape(-1, n + 1)
+        try:
+            poly = cdd.polyhedron_from_matrix(
+                cdd.matrix_from_array(np.hstack([h_vec[:, None], -h_mat]), rep_type=cdd.RepType.INEQUALITY)
+            )
+            gen = np.array(cdd.copy_generators(poly).array, dtype=float).reshape(-1, n + 1)
+        except RuntimeError as err:      # cddlib's floating-point arithmetic gave up
+            raise PolytopeError(f"cddlib could not enumerate the vertices of {name} "
+                                f"({h_mat.shape[0]} inequalities in R^{n}): {err}") from None
         if gen.shape[0] == 0:
             raise InvalidArgumentError(name, "a non-empty polytope", "inequalities no point satisfies")
         rays = gen[gen[:, 0] == 0, 1:]
