@@ -47,6 +47,19 @@ def test_zero_violations_over_seeded_sequences(tube: TubeMPC) -> None:
     assert runs.max_excess > -1e-3
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_target_zero_violations_over_1000_sequences(kind: str) -> None:
+    """The double integrator's target: 1,000 seeded 50-step sequences, no violation, no failed
+    step (the solve times are measured by ``python -m dev.tube_targets``, not asserted)."""
+    tube = TubeMPC((A, B), **P["controller"], kind=kind)
+    rng = np.random.default_rng(2005)
+    x0s, _ = feasible_initial_states(tube, [10.0, 10.0], 1000, rng)
+    runs = disturbance_runs(tube, x0s, steps=50, rng=rng)
+    assert runs.runs == 1000
+    assert runs.violations == 0 and runs.failed_steps == 0
+
+
 def test_rigid_tube_holds_the_error_in_Z() -> None:
     """x - z0 in Z at every step, z0 the QP's nominal state (Mayne et al.'s tube)."""
     tube = TubeMPC((A, B), **P["controller"], kind="rigid")
