@@ -174,6 +174,11 @@ class TubeMPC(Saveable):
         The gain, terminal weight and sets.
     Z : Polytope or None
         The rigid tube's cross-section.
+    X, U : tuple
+        The state and input constraints as ``(H, h, names)``: all rows ``H x <= h`` (boxes
+        first) and the argument names they came from.
+    W : Polytope
+        The disturbance set.
     last : StepInfo or None
         The back-end's status (``"bound_violation"`` when an answer breaks its rows), the solve
         time, ``fallback`` and ``extra`` (``z0``, ``c``, ``objective``, ``backend``, ``raw_status``).
