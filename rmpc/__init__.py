@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from rmpc.mpc.offline import OfflineRMPC
     from rmpc.mpc.robust_mpc import RMPC
     from rmpc.mpc.scheduled import ScheduledRMPC
+    from rmpc.mpc.tube import TubeMPC
     from rmpc.sim.disturbances import ConstantDisturbance, SineDisturbance, StepDisturbance
     from rmpc.sim.simulate import simulate
     from rmpc.sim.trajectory import Trajectory
@@ -71,6 +72,7 @@ _EXPORTS = {
     "rmpc.mpc.offline": ("OfflineRMPC",),
     "rmpc.mpc.robust_mpc": ("RMPC",),
     "rmpc.mpc.scheduled": ("ScheduledRMPC",),
+    "rmpc.mpc.tube": ("TubeMPC",),
     "rmpc.sim.disturbances": ("ConstantDisturbance", "SineDisturbance", "StepDisturbance"),
     "rmpc.sim.simulate": ("simulate",),
     "rmpc.sim.trajectory": ("Trajectory",),
@@ -108,6 +110,7 @@ __all__ = [
     "StepInfo",
     "StepInputs",
     "Trajectory",
+    "TubeMPC",
     "TuningFunctionAB",
     "export_c",
     "flexible_lqr",

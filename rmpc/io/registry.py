@@ -28,6 +28,7 @@ KINDS: MappingProxyType[str, str] = MappingProxyType({
     "GIPC": "rmpc.mpc.gipc:GIPC",
     "LQR": "rmpc.mpc.lqr:LQR",
     "MultiStageMPC": "rmpc.mpc.multistage:MultiStageMPC",
+    "TubeMPC": "rmpc.mpc.tube:TubeMPC",
     "Luenberger": "rmpc.estimators.linear:Luenberger",
     "KalmanFilter": "rmpc.estimators.linear:KalmanFilter",
     "RobustObserver": "rmpc.estimators.robust:RobustObserver",
