@@ -17,6 +17,7 @@ from benchmarks.suites.methods import (
 )
 from benchmarks.suites.methods_problems import build_problem
 from benchmarks.suites.methods_report import least_conservative
+from toolkit_common.errors import InvalidArgumentError
 
 API_FIELDS = (
     "problem",
@@ -210,3 +211,39 @@ def test_violations_count_the_samples_that_break_a_bound():
     assert out["violation_runs"] == settings.violation_runs
     assert out["violations_input"] == out["violation_samples"] == 5 * settings.violation_runs
     assert out["violations_state"] > 0  # u = 20 drives the states out of |x_i| <= 10
+
+
+def test_tube_runs_on_the_double_integrator_and_is_skipped_on_a_polytope(tmp_path):
+    outcome = run_methods(tmp_path, short=True, problems=["double_integrator", "kothare_ex1"],
+                          methods=["tube", "tube_tightening"], progress=False)
+    assert not outcome.failures
+    recs = {(r["problem"], r["method"]): r for r in outcome.records}
+    for kind in ("tube", "tube_tightening"):
+        rec = recs[("double_integrator", kind)]
+        assert rec["status"] == "optimal" and rec["violations"] == 0 and rec["violation_samples"] > 0
+        assert rec["settings"]["options"]["kind"] == ("rigid" if kind == "tube" else "tightening")
+        skipped = recs[("kothare_ex1", kind)]
+        assert skipped["status"] == "skipped" and "additive disturbance set W" in skipped["skip_reason"]
+
+
+def test_switching_runs_push_by_the_disturbance_box():
+    from models import PolytopicModel
+    from rmpc.mpc.switching_runs import switching_runs
+
+    plant = PolytopicModel([(np.eye(2), np.ones((2, 1)))], dt=1.0)
+
+    class Zero:
+        last = None
+
+        def reset(self):
+            pass
+
+        def step(self, x):
+            return np.zeros(1)
+
+    calm = switching_runs(Zero(), plant, [0.0, 0.0], steps=7, runs=1, seed=3)
+    pushed = switching_runs(Zero(), plant, [0.0, 0.0], steps=7, runs=1, seed=3, w_max=[0.1, 0.2])
+    assert calm["final_norm"] == 0.0
+    assert 0.0 < pushed["final_norm"] <= 7 * np.hypot(0.1, 0.2) + 1e-12
+    with pytest.raises(InvalidArgumentError, match="w_max"):
+        switching_runs(Zero(), plant, [0.0, 0.0], steps=1, runs=1, seed=0, w_max=[-0.1, 0.1])

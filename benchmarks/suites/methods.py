@@ -501,7 +501,8 @@ def _violations(ctrl: Any, problem: MethodsProblem, steps: int, settings: Method
 
     The input bound is checked per component (``|u_l| <= u_max``; on a problem that bounds
     ``||u||_2`` that is a necessary condition only), the state bound where the problem has output
-    bounds (``|C x| <= y_max``).
+    bounds (``|C x| <= y_max``); a problem with an additive disturbance box pushes every sample by
+    a vertex of it.
     """
     from rmpc.mpc.switching_runs import switching_runs
 
@@ -513,7 +514,8 @@ def _violations(ctrl: Any, problem: MethodsProblem, steps: int, settings: Method
         if r and time.perf_counter() > deadline:
             break
         run = switching_runs(ctrl, problem.plant, problem.x0, steps=steps, runs=1, seed=settings.seed + r,
-                             u_max=float(problem.u_max), state_constraints=state, Q=problem.Q, R=problem.R)
+                             u_max=float(problem.u_max), state_constraints=state, Q=problem.Q, R=problem.R,
+                             w_max=problem.w_box)
         out["violations"] += run["violations"]
         out["violations_input"] += run["input_violations"]
         out["violations_state"] += run["state_violations"]

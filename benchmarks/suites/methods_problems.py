@@ -55,6 +55,10 @@ class MethodsProblem:
         Per-state scale of the region's directions (directions are uniform in scaled coordinates).
     output_matrix, y_max : ndarray or None
         Output bounds ``|C x| <= y_max``, where the problem has them.
+    w_box : ndarray or None
+        An additive disturbance ``x+ = A x + B u + w``, ``|w_i| <= w_box_i`` (the tube's ``W``, the
+        violation runs' pushes and, as the ellipsoid ``||w|| <= ||w_box||``, the "disturbance"
+        method's bound), where the problem has one.
     """
 
     name: str
@@ -72,6 +76,7 @@ class MethodsProblem:
     output_matrix: np.ndarray | None = None
     y_max: np.ndarray | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    w_box: np.ndarray | None = None
 
     @property
     def n_states(self) -> int:
@@ -80,7 +85,10 @@ class MethodsProblem:
 
     @property
     def disturbance(self) -> tuple[np.ndarray, float]:
-        """``(E, w_max)`` of the "disturbance" method: the nominal ``B`` and a fraction of ``u_max``."""
+        """``(E, w_max)`` of the "disturbance" method: the nominal ``B`` and a fraction of ``u_max``;
+        with an additive box ``w_box``, ``E = I`` and the ball around the box."""
+        if self.w_box is not None:
+            return np.eye(self.n_states), float(np.linalg.norm(self.w_box))
         return np.asarray(self.plant.nominal[1]), DISTURBANCE_FRACTION * float(self.u_max)
 
 
@@ -250,6 +258,33 @@ def _flexible() -> MethodsProblem:
     )
 
 
+def _double_integrator() -> MethodsProblem:
+    from models import PolytopicModel
+    from rmpc.mpc.tube_runs import double_integrator
+
+    data = double_integrator()
+    a, b = data["A"], data["B"]
+    plant = PolytopicModel([(a, b)], dt=1.0, nominal=(a, b))
+    return MethodsProblem(
+        name="double_integrator",
+        title="The double integrator of the tube literature: |u| <= 1, |x_i| <= 10, |w_i| <= 0.1",
+        source="Mayne, Seron & Rakovic, Automatica 41(2), 2005 (weights, horizon); the box |x_i| <= 10",
+        plant=plant,
+        Q=np.eye(2),
+        R=np.array([[0.01]]),
+        u_max=1.0,
+        input_constraint="peak",
+        x0=np.array([-5.0, -2.0]),
+        true_plant=(a, b),
+        steps=30,
+        region_scale=np.array([1.0, 1.0]),
+        output_matrix=np.eye(2),
+        y_max=np.array([10.0, 10.0]),
+        w_box=np.array([0.1, 0.1]),
+        notes=("one plant with an additive disturbance: the LMI forms' polytope has one vertex",),
+    )
+
+
 #: Problem name -> builder, in the report's order.
 PROBLEMS: dict[str, Callable[[], MethodsProblem]] = {
     "kothare_ex1": _kothare_ex1,
@@ -259,10 +294,13 @@ PROBLEMS: dict[str, Callable[[], MethodsProblem]] = {
     "paper_p_8v": lambda: _paper_p("box"),
     "paper_w": _paper_w,
     "flexible_8v": _flexible,
+    "double_integrator": _double_integrator,
 }
 
 #: The problems of ``--short``.
-SHORT_PROBLEMS: tuple[str, ...] = ("kothare_ex1", "kothare_ex2", "mup_demo", "paper_p_2v")
+SHORT_PROBLEMS: tuple[str, ...] = (
+    "kothare_ex1", "kothare_ex2", "mup_demo", "paper_p_2v", "double_integrator",
+)
 
 
 def build_problem(name: str) -> MethodsProblem:

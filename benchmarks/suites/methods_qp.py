@@ -27,9 +27,15 @@ __all__ = ["QP_METHODS", "QPAnswer", "QPMethod", "qp_method", "state_box"]
 
 #: The QP families' methods (name -> what it is).
 QP_METHODS: Mapping[str, str] = MappingProxyType({
+    "tube": "Mayne, Seron & Rakovic 2005: the rigid tube around a nominal plan (one plant, additive W)",
+    "tube_tightening": "Chisci, Rossiter & Zappa 2001: constraints tightened along the horizon (one plant, "
+                       "additive W)",
     "multistage": "Lucia, Finkler & Engell 2013: a scenario tree over the vertices, robust horizon 1, "
                   "one QP (Clarabel)",
 })
+
+#: The tube's prediction horizon in the suite (samples; Mayne, Seron & Rakovic's example).
+TUBE_HORIZON = 9
 
 #: The multi-stage tree's prediction horizon in the suite (samples).
 MULTISTAGE_HORIZON = 10
@@ -60,8 +66,14 @@ class QPMethod:
         self.ctrl = ctrl
 
     def solve(self, x: np.ndarray) -> QPAnswer:
-        """The status of the controller's QP at ``x``, without a step."""
-        return QPAnswer(str(self.ctrl.status_at(x)))
+        """The status of the controller's QP at ``x`` (``status_at``, or a step from a reset)."""
+        if hasattr(self.ctrl, "status_at"):
+            return QPAnswer(str(self.ctrl.status_at(x)))
+        self.ctrl.reset()
+        self.ctrl.step(x)
+        status = str(self.ctrl.last.status)
+        self.ctrl.reset()
+        return QPAnswer(status)
 
     def step(self, x: np.ndarray) -> np.ndarray:
         """The controller's step."""
@@ -103,9 +115,22 @@ def qp_method(
     options : dict
         The controller's settings, for the record.
     """
-    from rmpc import MultiStageMPC
+    from rmpc import MultiStageMPC, TubeMPC
 
     comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
+    if method in ("tube", "tube_tightening"):
+        if problem.w_box is None or problem.plant.n_vertices != 1 or problem.output_matrix is None:
+            return None, ("tube MPC takes one plant with an additive disturbance set W and a state "
+                          "polytope; this problem is a polytope of plants without W (on paper P's "
+                          "6-state satellite the mRPI approximation needs 169 terms: not built)"), True, {}
+        kind = "rigid" if method == "tube" else "tightening"
+        box = state_box(problem)
+        ctrl = TubeMPC(problem.true_plant, problem.Q, problem.R, horizon=TUBE_HORIZON, kind=kind,
+                       u_max=float(problem.u_max), state_constraints=box, w_max=problem.w_box)
+        options = {"kind": kind, "horizon": TUBE_HORIZON, "u_max": float(problem.u_max),
+                   "w_max": problem.w_box.tolist(), "state_constraints": "|C x| <= y_max",
+                   "backend": "clarabel"}
+        return QPMethod(ctrl), None, comparable, options
     if method == "multistage":
         options = {"horizon": MULTISTAGE_HORIZON, "robust_horizon": 1, "u_max": float(problem.u_max),
                    "input_constraint": "peak", "backend": "clarabel"}

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from toolkit_common.errors import ArgumentTypeError
+from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 from toolkit_common.validation import as_matrix, as_optional_limits, as_vector, check_count
 
 __all__ = ["VIOLATION_TOL", "switching_runs"]
@@ -54,6 +54,7 @@ def switching_runs(
     state_constraints: tuple[ArrayLike, ArrayLike] | None = None,
     Q: ArrayLike | None = None,
     R: ArrayLike | None = None,
+    w_max: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Run ``ctrl`` ``runs`` times for ``steps`` samples on seeded switching vertices of ``plant``.
 
@@ -75,6 +76,10 @@ def switching_runs(
         The state polytope ``H x <= h`` checked at every state after the start.
     Q, R : array_like, optional
         Weights of the closed-loop cost ``sum x'Qx + u'Ru`` (default identities).
+    w_max : (n,) array_like, optional
+        An additive disturbance ``x+ = A_j x + B_j u + w`` with ``w`` a vertex of the box
+        ``|w_i| <= w_max_i`` drawn at every sample (after the vertex sequence of the run, from the
+        same generator); ``None`` (the default) for none.
 
     Returns
     -------
@@ -99,6 +104,9 @@ def switching_runs(
         h_vec = as_vector(state_constraints[1], "state_constraints h", h_mat.shape[0])
     q = np.eye(n) if Q is None else as_matrix(Q, "Q", (n, n))
     r = np.eye(m) if R is None else as_matrix(R, "R", (m, m))
+    w_box = None if w_max is None else as_vector(w_max, "w_max", n)
+    if w_box is not None and not np.all(w_box >= 0.0):
+        raise InvalidArgumentError("w_max", "bounds >= 0", repr(w_box.tolist()))
     vertices = [plant.vertex(j) for j in range(plant.n_vertices)]
     rng = np.random.default_rng(seed)
     out: dict[str, Any] = {"samples": steps * runs, "violations": 0, "input_violations": 0,
@@ -108,9 +116,11 @@ def switching_runs(
     costs, finals = [], []
     for _ in range(runs):
         sequence = rng.integers(0, len(vertices), size=steps)
+        pushes = (np.zeros((steps, n)) if w_box is None
+                  else w_box * rng.choice((-1.0, 1.0), size=(steps, n)))
         ctrl.reset()
         x, cost = x_start.copy(), 0.0
-        for j in sequence:
+        for j, w in zip(sequence, pushes, strict=True):
             u = np.asarray(ctrl.step(x), dtype=float)
             info = ctrl.last
             if info is not None:
@@ -120,7 +130,7 @@ def switching_runs(
                 out["fallbacks"] += bool(info.fallback)
             cost += float(x @ q @ x + u @ r @ u)
             a, b = vertices[int(j)]
-            x = a @ x + b @ u
+            x = a @ x + b @ u + w
             broken = False
             if bound is not None:
                 over = np.abs(u) - bound
