@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import ConfigError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = [
     "REQUIRED_FIELDS",
@@ -249,12 +250,12 @@ class PlantFamily:
         if isinstance(default, bool):
             return check_bool(value, where)
         if isinstance(default, int):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            if not is_integer(value) or value < 1:
                 raise ConfigError(where, "a positive integer", repr(value))
-            return value
+            return int(value)
         if isinstance(default, float):
             zero_ok = where.rsplit(".", 1)[-1] in self.zero_allowed
-            number = not isinstance(value, bool) and isinstance(value, int | float) and np.isfinite(value)
+            number = is_real(value) and np.isfinite(value)
             if not number or value < 0 or (value == 0 and not zero_ok):
                 raise ConfigError(where, "a number >= 0" if zero_ok else "a number > 0", repr(value))
             return float(value)
@@ -263,7 +264,7 @@ class PlantFamily:
                 isinstance(value, list | tuple)
                 and len(value) == len(default)
                 and all(
-                    isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) and v >= 0
+                    is_real(v) and np.isfinite(v) and v >= 0
                     for v in value
                 )
             )
@@ -349,7 +350,7 @@ def check_choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
 
 def check_number(value: Any, where: str) -> float:
     """``value`` as a float if it is a finite number (not a bool)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if not is_real(value) or not math.isfinite(value):
         raise ConfigError(where, "a finite number", repr(value))
     return float(value)
 

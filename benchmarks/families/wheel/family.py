@@ -86,6 +86,7 @@ from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = ["WHEEL", "case_faults", "misaligned_axes", "simulate_case"]
 
@@ -103,21 +104,21 @@ def _optional_positive(value: Any, where: str) -> float | None:
 
 
 def _duration(value: Any, where: str) -> float:
-    if isinstance(value, int | float) and not isinstance(value, bool) and value == math.inf:
+    if is_real(value) and value == math.inf:
         return math.inf
     return _positive(value, where)
 
 
 def _wheel(value: Any, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 4:
+    if not is_integer(value) or not 1 <= value <= 4:
         raise ConfigError(where, "a wheel number 1..4 (wheel 4 is the skew wheel)", repr(value))
-    return value
+    return int(value)
 
 
 def _seed(value: Any, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+    if not is_integer(value) or value < 0:
         raise ConfigError(where, "an integer >= 0", repr(value))
-    return value
+    return int(value)
 
 
 def _spread(value: Any, where: str) -> float | None:
