@@ -233,7 +233,9 @@ class FormProblem:
                                       "phase_one": True, "rebalance": True, "tol_gap_abs": 1e-12,
                                       "max_iter": 100}
             merged.update(opts)
-            return merged
+            from lmi.backends.ipm import check_ipm_values
+
+            return check_ipm_values(merged)  # the values: the one check Kothare's problem uses too
         from lmi.backends.clarabel import clarabel_settings
 
         clarabel_settings(opts)  # unknown names raise here
