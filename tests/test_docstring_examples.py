@@ -20,7 +20,6 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.compare",
     "benchmarks.core.executors",
     "benchmarks.core.family",
-    "benchmarks.core.interrupts",
     "benchmarks.core.folders",
     "benchmarks.core.jsonable",
     "benchmarks.core.metrics",
@@ -58,6 +57,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.timing.common",
     "benchmarks.timing.config",
     "benchmarks.timing.cpg_attempt",
+    "lmi.backends.ipm",
     "lmi.data",
     "lmi.forms.problem",
     "lmi.ipm.kernels.notice",
@@ -141,6 +141,7 @@ MODULES_WITH_EXAMPLES = (
     "rmpc.sim.rhs",
     "rmpc.sim.simulate",
     "rmpc.wrappers",
+    "toolkit_common.interrupts",
     "toolkit_common.status",
     "toolkit_common.validation",
 )
