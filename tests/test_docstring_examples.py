@@ -25,6 +25,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.core.metrics",
     "benchmarks.core.registry",
     "benchmarks.families.controller_options",
+    "benchmarks.families.crmpc_options",
     "benchmarks.families.rmpc_forms",
     "benchmarks.core.scenario",
     "benchmarks.core.store",

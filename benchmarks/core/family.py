@@ -216,6 +216,10 @@ class PlantFamily:
         ``controller_defaults(controller) -> {field: default}``: defaults that depend on the
         controller (e.g. ``saturation = "limiter"`` for a controller without a constraint),
         used where the scenario does not set the field.
+    not_settings : mapping of str to str
+        Constructor keywords of the family's controllers that a sweep cannot set, each with why
+        (the family's target, a field that sets it): a sweep file that names one is refused
+        with that reason instead of "an unknown name".
     """
 
     name: str
@@ -233,6 +237,7 @@ class PlantFamily:
     setting_checks: Mapping[str, Callable[[Any, str], Any]] = field(default_factory=dict)
     quiet_settings: frozenset[str] = frozenset()
     case_check: Callable[[dict[str, Any], str, Mapping[str, Any], Callable[[str], str]], None] | None = None
+    not_settings: Mapping[str, str] = field(default_factory=dict)
 
     def default(self, key: str, controller: str) -> Any:
         """The default of field ``key`` for ``controller``."""
@@ -285,6 +290,7 @@ class PlantFamily:
         """Check one setting's value against the controller(s) that have it; return it normalised."""
         owners = [spec.defaults for spec in self.controllers.values() if key in spec.defaults]
         if not owners:
+            self._refuse_not_setting(key, where)
             expected = f"a controller setting ({', '.join(self.setting_names())})"
             raise ConfigError(where, expected, "an unknown name")
         return self._check_value(owners[0][key], value, where, key)
@@ -304,6 +310,7 @@ class PlantFamily:
             if key not in defaults:
                 if lenient and any(key in spec.defaults for spec in self.controllers.values()):
                     continue
+                self._refuse_not_setting(key, f"{where}.{key}")
                 raise ConfigError(
                     f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
                 )
@@ -311,6 +318,12 @@ class PlantFamily:
         if self.settings_check is not None:
             self.settings_check(controller, out, where)
         return out
+
+    def _refuse_not_setting(self, key: str, where: str) -> None:
+        """A keyword the family's controllers take but a sweep cannot set: refused, saying why."""
+        why = self.not_settings.get(key)
+        if why is not None:
+            raise ConfigError(where, f"no {key} in a sweep file ({why})", f"{key} given")
 
     def unsupported(self, controller: str, saturation: str) -> str | None:
         """Why ``controller`` cannot run with ``saturation`` (``None`` if it can)."""
