@@ -138,3 +138,35 @@ def test_bench_methods_says_interrupted_once(tmp_path, monkeypatch, capsys):
     assert status == 130
     lines = [line for line in err.splitlines() if "interrupted" in line]
     assert lines == ["rmpc: interrupted; 2 cases not run; re-run the same command to resume"], err
+
+
+_OFFLINE_SCS_DRIVER = textwrap.dedent("""
+    import os, signal, threading, time
+    import numpy as np
+    from models import RigidSatellite
+    from rmpc import OfflineRMPC
+
+    x0 = np.array([0.3, -0.2, 0.25, 0.0, 0.0, 0.0])
+    poly = RigidSatellite.paper_p().polytope(x0, 0.05, 0.3, "box")
+    threading.Timer(4.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    start = time.perf_counter()
+    try:
+        ctrl = OfflineRMPC(poly, np.eye(6), np.eye(3), u_max=1.0, backend="cvxpy", solver="SCS",
+                           n_ellipsoids=3, x_design=x0,
+                           solver_options={"eps_abs": 1e-12, "eps_rel": 1e-12, "max_iters": 10_000_000})
+        ctrl.step(x0)
+    except KeyboardInterrupt:
+        print(f"KeyboardInterrupt after {time.perf_counter() - start:.2f} s")
+    else:
+        print(f"returned after {time.perf_counter() - start:.2f} s")
+""")
+
+
+def test_ctrl_c_during_an_offline_design_with_scs_raises_keyboard_interrupt():
+    """The off-line table's nested problems call cvxpy themselves (lmi.offline); before the fix an
+    interrupted SCS solve ended the design as a failed solve and the controller was built anyway."""
+    done = subprocess.run([sys.executable, "-c", _OFFLINE_SCS_DRIVER], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr
+    last = done.stdout.strip().splitlines()[-1]
+    assert "interrupted" in done.stdout and last.startswith("KeyboardInterrupt"), done.stdout

@@ -67,11 +67,12 @@ class CvxpyKothare(KothareBackend):
         self.name = f"cvxpy:{solver}"
         self.solver = solver
         # SCS catches SIGINT while it solves: its interface that hands it back (a solver object)
-        self._solver_arg: Any = solver
+        self.solver_arg: Any = solver
+        """What ``Problem.solve(solver=...)`` is given: the name, or SCS's interruptible interface."""
         if solver == "SCS":
             from lmi.backends.scs_signal import InterruptibleSCS
 
-            self._solver_arg = InterruptibleSCS()
+            self.solver_arg = InterruptibleSCS()
         self.options = _solver_options(solver, options)
         self.data = data
         n, m = data.n, data.m
@@ -147,7 +148,7 @@ class CvxpyKothare(KothareBackend):
             self.inv_y.value = 1.0 / y_max
         start = time.perf_counter()
         try:
-            self.problem.solve(solver=self._solver_arg, **self.options)
+            self.problem.solve(solver=self.solver_arg, **self.options)
         except cp.error.SolverError as err:
             return RawResult(SOLVER_ERROR, str(err), np.nan, None, None, None, time.perf_counter() - start)
         elapsed = time.perf_counter() - start
