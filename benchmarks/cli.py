@@ -128,7 +128,12 @@ def _cmd_bench_paper(args: argparse.Namespace) -> int:
     return _report_suite("paper", outcome, args.out)
 
 
-def _report_suite(name: str, outcome: Any, out: str) -> int:
+def _report_suite(name: str, outcome: Any, out: str, resumable: bool = False) -> int:
+    """Print a suite's summary and failures; one line when it was interrupted. Returns the exit status.
+
+    ``resumable``: the suite keeps its finished cases and a re-run resumes (``bench methods``), so
+    the interrupted line says how many cases did not run and how to resume.
+    """
     ex = outcome.execution
     done, failed = len(outcome.records), len(outcome.failures)
     print(
@@ -138,7 +143,11 @@ def _report_suite(name: str, outcome: Any, out: str) -> int:
     for failure in outcome.failures:
         print(f"  failed: {failure['key']}: {failure['error']}", file=sys.stderr)
     if ex is not None and ex.interrupted:
-        print("rmpc: interrupted; the files hold the cases that finished", file=sys.stderr)
+        if resumable:
+            line = f"{len(ex.unfinished)} cases not run; re-run the same command to resume"
+        else:
+            line = "the files hold the cases that finished"
+        print(f"rmpc: interrupted; {line}", file=sys.stderr)
         return 130
     return 1 if failed or (ex is not None and ex.unfinished) else 0
 
@@ -218,13 +227,7 @@ def _cmd_bench_methods(args: argparse.Namespace) -> int:
         progress=None if not args.no_progress else False,
         fresh=args.fresh,
     )
-    ex = outcome.execution
-    if ex is not None and ex.interrupted:
-        print(
-            f"rmpc: interrupted; {len(ex.unfinished)} cases not run; re-run the same command to resume",
-            file=sys.stderr,
-        )
-    return _report_suite("methods", outcome, args.out)
+    return _report_suite("methods", outcome, args.out, resumable=True)
 
 
 def _add_methods(bsub: Any) -> None:

@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks.core.publish import STAGING_PREFIX
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_positive
 
@@ -207,6 +208,12 @@ def _load(folder: Path) -> tuple[list[dict[str, Any]], bool]:
         raise InvalidArgumentError(
             str(folder), "a run's output folder (with results.json or timing.json)",
             "a file" if folder.exists() else "nothing there",
+        )
+    if folder.resolve().name.startswith(STAGING_PREFIX):
+        raise InvalidArgumentError(
+            str(folder), "a run's output folder (with results.json or timing.json)",
+            "the unfinished reports of a run killed while writing them (the next run into that "
+            "output folder removes them)",
         )
     for name, timing in (("results.json", False), ("timing.json", True)):
         path = folder / name

@@ -410,7 +410,7 @@ class NestedKothareProblem:
             with warnings.catch_warnings():
                 # cvxpy warns on "optimal_inaccurate"; the status and the certificate record it.
                 warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-                problem.solve(solver=base.solver, **base.options)
+                problem.solve(solver=base.solver_arg, **base.options)  # SCS: Ctrl-C handed back
         except cp.error.SolverError as err:
             return NestedEllipsoid(
                 SOLVER_ERROR, x, np.nan, None, None, None, None, np.nan,

@@ -17,7 +17,7 @@ from benchmarks.core.scenario import Scenario
 from benchmarks.core.sweep import run_sweep
 from benchmarks.core.sweep_spec import SHIPPED, expand, load_sweep, parse_sweep
 from benchmarks.families.rigid.defaults import CONTROLLER_DEFAULTS
-from benchmarks.families.rmpc_forms import FORM_DEFAULTS
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, OUTPUT_DEFAULTS
 from models import RigidSatellite
 from toolkit_common.errors import ConfigError, ToolkitError
 
@@ -204,7 +204,7 @@ def test_a_form_setting_of_another_controller_is_refused():
 def test_the_forms_left_at_their_defaults_keep_the_records_and_case_ids():
     rmpc = Scenario.from_dict({"controller": "RMPC"})
     assert set(rmpc.to_dict()["settings"]) == set(CONTROLLER_DEFAULTS["RMPC"])
-    assert set(rmpc.settings) == set(CONTROLLER_DEFAULTS["RMPC"]) | set(FORM_DEFAULTS)
+    assert set(rmpc.settings) == set(CONTROLLER_DEFAULTS["RMPC"]) | set(FORM_DEFAULTS) | set(OUTPUT_DEFAULTS)
     soft = Scenario.from_dict({"controller": "RMPC", "settings": {"soft": {"u": 1}}})
     assert soft.to_dict()["settings"]["soft"] == {"u": 1.0} and soft.case_id != rmpc.case_id
     # a record's scenario read back (a resumed sweep) is the same case

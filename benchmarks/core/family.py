@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from toolkit_common.errors import ConfigError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = [
     "REQUIRED_FIELDS",
@@ -215,6 +216,10 @@ class PlantFamily:
         ``controller_defaults(controller) -> {field: default}``: defaults that depend on the
         controller (e.g. ``saturation = "limiter"`` for a controller without a constraint),
         used where the scenario does not set the field.
+    not_settings : mapping of str to str
+        Constructor keywords of the family's controllers that a sweep cannot set, each with why
+        (the family's target, a field that sets it): a sweep file that names one is refused
+        with that reason instead of "an unknown name".
     """
 
     name: str
@@ -232,6 +237,7 @@ class PlantFamily:
     setting_checks: Mapping[str, Callable[[Any, str], Any]] = field(default_factory=dict)
     quiet_settings: frozenset[str] = frozenset()
     case_check: Callable[[dict[str, Any], str, Mapping[str, Any], Callable[[str], str]], None] | None = None
+    not_settings: Mapping[str, str] = field(default_factory=dict)
 
     def default(self, key: str, controller: str) -> Any:
         """The default of field ``key`` for ``controller``."""
@@ -249,12 +255,12 @@ class PlantFamily:
         if isinstance(default, bool):
             return check_bool(value, where)
         if isinstance(default, int):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            if not is_integer(value) or value < 1:
                 raise ConfigError(where, "a positive integer", repr(value))
-            return value
+            return int(value)
         if isinstance(default, float):
             zero_ok = where.rsplit(".", 1)[-1] in self.zero_allowed
-            number = not isinstance(value, bool) and isinstance(value, int | float) and np.isfinite(value)
+            number = is_real(value) and np.isfinite(value)
             if not number or value < 0 or (value == 0 and not zero_ok):
                 raise ConfigError(where, "a number >= 0" if zero_ok else "a number > 0", repr(value))
             return float(value)
@@ -263,7 +269,7 @@ class PlantFamily:
                 isinstance(value, list | tuple)
                 and len(value) == len(default)
                 and all(
-                    isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v) and v >= 0
+                    is_real(v) and np.isfinite(v) and v >= 0
                     for v in value
                 )
             )
@@ -284,6 +290,7 @@ class PlantFamily:
         """Check one setting's value against the controller(s) that have it; return it normalised."""
         owners = [spec.defaults for spec in self.controllers.values() if key in spec.defaults]
         if not owners:
+            self._refuse_not_setting(key, where)
             expected = f"a controller setting ({', '.join(self.setting_names())})"
             raise ConfigError(where, expected, "an unknown name")
         return self._check_value(owners[0][key], value, where, key)
@@ -303,6 +310,7 @@ class PlantFamily:
             if key not in defaults:
                 if lenient and any(key in spec.defaults for spec in self.controllers.values()):
                     continue
+                self._refuse_not_setting(key, f"{where}.{key}")
                 raise ConfigError(
                     f"{where}.{key}", f"a setting of {controller} ({', '.join(defaults)})", "an unknown name"
                 )
@@ -310,6 +318,12 @@ class PlantFamily:
         if self.settings_check is not None:
             self.settings_check(controller, out, where)
         return out
+
+    def _refuse_not_setting(self, key: str, where: str) -> None:
+        """A keyword the family's controllers take but a sweep cannot set: refused, saying why."""
+        why = self.not_settings.get(key)
+        if why is not None:
+            raise ConfigError(where, f"no {key} in a sweep file ({why})", f"{key} given")
 
     def unsupported(self, controller: str, saturation: str) -> str | None:
         """Why ``controller`` cannot run with ``saturation`` (``None`` if it can)."""
@@ -349,7 +363,7 @@ def check_choice(value: Any, where: str, choices: tuple[str, ...]) -> str:
 
 def check_number(value: Any, where: str) -> float:
     """``value`` as a float if it is a finite number (not a bool)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    if not is_real(value) or not math.isfinite(value):
         raise ConfigError(where, "a finite number", repr(value))
     return float(value)
 

@@ -11,9 +11,11 @@ bytecode the main thread runs. Inside compiled code it does not always arrive as
 - a ``KeyboardInterrupt`` raised inside a finaliser (``__del__``) is printed as "Exception
   ignored" and lost;
 - a solver may catch SIGINT itself (OSQP installs its own handler while it solves and returns
-  the status ``interrupted``; :mod:`rmpc.qp.osqp_backend` hands the signal back).
+  the status ``interrupted``; :mod:`rmpc.qp.osqp_backend` hands the signal back; so does SCS,
+  whose solve :mod:`lmi.backends.scs_signal` hands it back).
 
-:func:`is_interrupt` recognises the first kind; :class:`Interrupts` is the handler every runner
+:func:`is_interrupt` (:mod:`toolkit_common.interrupts`, shared with :mod:`lmi`, which may not
+import this package) recognises the first kind; :class:`Interrupts` is the handler every runner
 installs (:func:`benchmarks.core.execute.execute` for the suites and sweeps,
 :func:`benchmarks.suites.methods.run_methods`). It counts each SIGINT, so an interrupt that was
 wrapped or swallowed on its way is still known, and after it has raised a
@@ -31,38 +33,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from toolkit_common.interrupts import is_interrupt
+
 __all__ = ["Interrupts", "is_interrupt"]
-
-
-def is_interrupt(err: BaseException | None) -> bool:
-    """Whether ``err`` is a ``KeyboardInterrupt`` or was raised because of one.
-
-    The chain of ``__cause__`` and ``__context__`` is followed (a numba dispatcher's
-    ``SystemError`` carries the interrupt as its cause).
-
-    Examples
-    --------
-    >>> try:
-    ...     try:
-    ...         raise KeyboardInterrupt
-    ...     except KeyboardInterrupt as ki:
-    ...         raise SystemError("returned a result with an exception set") from ki
-    ... except SystemError as err:
-    ...     wrapped = err
-    >>> is_interrupt(wrapped), is_interrupt(ValueError("x")), is_interrupt(None)
-    (True, False, False)
-    """
-    todo: list[BaseException] = [err] if err is not None else []
-    seen: set[int] = set()
-    while todo:
-        exc = todo.pop()
-        if id(exc) in seen:
-            continue
-        seen.add(id(exc))
-        if isinstance(exc, KeyboardInterrupt):
-            return True
-        todo.extend(e for e in (exc.__cause__, exc.__context__) if e is not None)
-    return False
 
 
 class Interrupts:

@@ -47,6 +47,7 @@ from benchmarks.core.family import PlantFamily
 from benchmarks.core.registry import get_family
 from benchmarks.core.scenario import DEFAULT_FAMILY, Scenario
 from toolkit_common.errors import ConfigError
+from toolkit_common.validation import is_integer
 
 __all__ = [
     "SHIPPED",
@@ -201,7 +202,7 @@ def parse_sweep(data: Mapping[str, Any], default_name: str = "sweep") -> SweepSp
 
 def _check_case_count(limit: Any, grid: Mapping[str, list[Any]], mc: Mapping[str, int] | None) -> None:
     """Refuse a sweep of more than ``limit`` cases before any is expanded."""
-    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+    if not is_integer(limit) or limit < 1:
         raise ConfigError("max_cases", "a positive integer", repr(limit))
     points = math.prod(len(values) for values in grid.values())
     count = points * (mc["n"] if mc else 1)
@@ -244,9 +245,9 @@ def _check_montecarlo(
         if key not in _MONTECARLO:
             raise ConfigError(f"montecarlo.{key}", "n or seed", "an unknown field")
     n, seed = mc.get("n"), mc.get("seed", 0)
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+    if not is_integer(n) or n < 1:
         raise ConfigError("montecarlo.n", "a positive integer number of draws", repr(n))
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+    if not is_integer(seed) or seed < 0:
         raise ConfigError("montecarlo.seed", "an integer >= 0", repr(seed))
     if family.montecarlo is None:
         raise ConfigError("montecarlo", f"no draws (family {family.name!r} has none)", "a [montecarlo] table")
@@ -254,7 +255,7 @@ def _check_montecarlo(
         if key in base or key in grid:
             expected = f"no {key} in [base] or [grid] (the draws set it)"
             raise ConfigError("montecarlo", expected, f"{key} given")
-    return {"n": n, "seed": seed}
+    return {"n": int(n), "seed": int(seed)}
 
 
 def _grid_points(spec: SweepSpec) -> tuple[list[Scenario], list[str]]:

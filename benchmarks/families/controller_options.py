@@ -7,10 +7,11 @@ error naming the key path ``settings.solver_options.<name>``. The table's own sh
 scalars) is checked by the setting check of :mod:`benchmarks.families.rmpc_forms`. Left out of a
 case's record at its default (``None``), so no case id changes.
 
-OfflineRMPC's ``backend`` (``"ipm"``, ``"clarabel"``, ``"cvxpy"``), ``solver_options`` and
-``certificate_tol`` (rigid and flexible families) are checked by :class:`rmpc.OfflineRMPC`
-itself (:func:`check_offline_options`) and left out of a record at the constructor's defaults
-(:data:`OFFLINE_DEFAULTS`).
+OfflineRMPC's ``backend`` (``"ipm"``, ``"clarabel"``, ``"cvxpy"``), ``solver`` (the cvxpy
+solver with ``backend = "cvxpy"``), ``solver_options``, ``certificate_tol`` and ``path``
+(``"ray"`` or ``"trajectory"``: how the design states are generated; not a file) (rigid and
+flexible families) are checked by :class:`rmpc.OfflineRMPC` itself (:func:`check_offline_options`)
+and left out of a record at the constructor's defaults (:data:`OFFLINE_DEFAULTS`).
 
 Examples
 --------
@@ -52,7 +53,11 @@ def options_path(argument: str, where: str) -> str | None:
 
 
 def check_gipc_solver_options(settings: Mapping[str, Any], where: str) -> None:
-    """``settings.solver_options`` checked by :class:`rmpc.GIPC` itself with the case's ``backend``.
+    """``settings.backend`` and ``settings.solver_options`` checked by :class:`rmpc.GIPC` itself.
+
+    The family's ``backend`` choices are shared with its RMPC (``"ipm"`` is one of them): a GIPC
+    with a back-end it does not take is refused here, when the sweep file is read, naming
+    ``<where>.backend``, not when its cases run.
 
     A GIPC is built on a one-vertex, one-state stand-in (the check of the options does not depend
     on the model); its error names the key path ``<where>.solver_options.<name>``.
@@ -63,15 +68,17 @@ def check_gipc_solver_options(settings: Mapping[str, Any], where: str) -> None:
         Naming the option the backend refuses.
     """
     options = settings.get("solver_options")
-    if options is None:
-        return
     from models import PolytopicModel
     from rmpc.mpc.gipc import GIPC
 
     stand_in = PolytopicModel([(np.array([[0.5]]), np.array([[1.0]]))], dt=1.0)
     try:
-        GIPC(stand_in, Np=2, Nc=1, backend=settings["backend"], solver_options=dict(options))
+        GIPC(stand_in, Np=2, Nc=1, backend=settings["backend"],
+             solver_options=None if options is None else dict(options))
     except (InvalidArgumentError, ArgumentTypeError) as err:
+        if err.argument == "backend":  # an LMI back-end ("ipm") the setting's choices share with RMPC's
+            expected = f"{err.expected} (GIPC's QP back-ends)"
+            raise ConfigError(f"{where}.backend", expected, err.found) from None
         path = options_path(err.argument, f"{where}.solver_options")
         if path is None:
             return  # not the options': the case's own build reports it
@@ -80,18 +87,20 @@ def check_gipc_solver_options(settings: Mapping[str, Any], where: str) -> None:
 
 #: OfflineRMPC's solve options with the constructor's defaults (left out of a record at them).
 OFFLINE_DEFAULTS: Mapping[str, Any] = MappingProxyType(
-    {"backend": "ipm", "solver_options": None, "certificate_tol": 1e-7}
+    {"backend": "ipm", "solver": None, "solver_options": None, "certificate_tol": 1e-7, "path": "ray"}
 )
 #: The family's ``quiet_settings`` entries of :data:`OFFLINE_DEFAULTS`.
 OFFLINE_QUIET: frozenset[str] = frozenset(f"OfflineRMPC.{key}" for key in OFFLINE_DEFAULTS)
 
 
 def check_offline_options(settings: Mapping[str, Any], where: str) -> None:
-    """OfflineRMPC's ``backend``, ``solver_options`` and ``certificate_tol`` checked by its constructor.
+    """OfflineRMPC's ``backend``, ``solver``, ``solver_options``, ``certificate_tol`` and ``path``
+    checked by its constructor.
 
     An :class:`rmpc.OfflineRMPC` is built (nothing is designed without ``x_design``) on a
     one-vertex, one-state stand-in; its error names the key path (``<where>.backend``,
-    ``<where>.certificate_tol``, ``<where>.solver_options.<name>``).
+    ``<where>.solver``, ``<where>.path``, ``<where>.certificate_tol``,
+    ``<where>.solver_options.<name>``).
 
     Raises
     ------
@@ -108,11 +117,11 @@ def check_offline_options(settings: Mapping[str, Any], where: str) -> None:
     try:
         OfflineRMPC(
             stand_in, np.eye(1), np.eye(1), u_max=1.0, backend=settings["backend"],
-            solver_options=None if options is None else dict(options),
-            certificate_tol=settings["certificate_tol"],
+            solver=settings["solver"], solver_options=None if options is None else dict(options),
+            certificate_tol=settings["certificate_tol"], path=settings["path"],
         )
     except (InvalidArgumentError, ArgumentTypeError) as err:
-        if err.argument in ("backend", "certificate_tol"):
+        if err.argument in ("backend", "certificate_tol", "path", "solver"):
             raise ConfigError(f"{where}.{err.argument}", err.expected, err.found) from None
         if not err.argument.startswith("solver_options"):
             return  # not the options': the case's own build reports it

@@ -20,7 +20,13 @@ Python argument. The values TOML cannot write as Python does:
 - ``saturation``: ``"auxiliary"``; Python's ``None`` (the default) is left out of the file;
 - ``solver_options``: a table of the back-end's settings (``{core = "numba", max_iter = 60}``),
   checked by :class:`rmpc.RMPC` itself with the case's ``backend``
-  (:func:`check_solver_options`), its error naming ``settings.solver_options.<name>``.
+  (:func:`check_solver_options`), its error naming ``settings.solver_options.<name>``;
+- ``output_matrix`` and ``y_max`` (rigid, wheel and MRP families, :data:`OUTPUT_DEFAULTS`): the
+  output bounds ``|(C x)_r| <= y_max_r``, ``C`` a list of rows of the RMPC's states (``[[1.0, 0,
+  0, 0, 0, 0]]`` bounds the roll angle), ``y_max`` a number > 0 or one per row, given together;
+  the flexible family's RMPC takes its output bounds from the field ``modal_bound`` instead;
+- ``solver``: the cvxpy solver with ``backend = "cvxpy"`` (``"SCS"``, ``"CLARABEL"``), checked the
+  same way (an error names ``settings.solver``); ``None`` (the default) is left out of the file.
 
 Each of them is left out of a case's record while it holds its default, so the records and case
 ids of the cases that do not set them are those they had before the forms were settings.
@@ -46,7 +52,8 @@ import numpy as np
 from toolkit_common.errors import ArgumentTypeError, ConfigError, InvalidArgumentError
 
 __all__ = [
-    "FORM_DEFAULTS", "FORM_SETTINGS", "RMPCForms", "changed_forms", "check_solver_options", "rmpc_kwargs",
+    "FORM_DEFAULTS", "FORM_SETTINGS", "OUTPUT_DEFAULTS", "RMPCForms", "changed_forms", "check_solver_options",
+    "rmpc_kwargs",
 ]
 
 #: The forms' settings with :class:`rmpc.RMPC`'s defaults (Kothare's problem).
@@ -56,9 +63,12 @@ FORM_SETTINGS: Mapping[str, Any] = MappingProxyType(
 )
 #: Every setting of this module with its default: the forms and the solve's three options.
 FORM_DEFAULTS: Mapping[str, Any] = MappingProxyType(
-    {**FORM_SETTINGS, "certificate_tol": 1e-7, "on_failure": "fallback", "solver_options": None}
+    {**FORM_SETTINGS, "certificate_tol": 1e-7, "on_failure": "fallback", "solver_options": None,
+     "solver": None}
 )
 _DISTURBANCE_KEYS = ("E", "w_max", "lam")
+_RMPC_BACKEND = "ipm"
+"""The default ``backend`` of :class:`rmpc.RMPC` (``tests/test_sweep_reach.py`` checks it is)."""
 
 
 def _python_check(where: str, n_states: int, has_output: bool, **options: Any) -> Any:
@@ -143,7 +153,9 @@ def _solver_options(value: Any, where: str, n: int, out: bool) -> Mapping[str, A
 
 
 def check_solver_options(settings: Mapping[str, Any], n_states: int, where: str) -> None:
-    """``settings.solver_options`` checked by :class:`rmpc.RMPC` itself with the case's ``backend``.
+    """``settings.backend``, ``settings.solver_options``, ``settings.solver`` and the output bounds
+    (``output_matrix`` with ``y_max``) checked by :class:`rmpc.RMPC` itself, when the sweep file is
+    read (a family's ``backend`` choices may include its QP controller's, ``"proxqp"``).
 
     An RMPC is built on a one-vertex stand-in of the case's ``n_states`` states (the check of the
     options does not depend on the model), with the forms' problem when a form is set, as the
@@ -154,24 +166,63 @@ def check_solver_options(settings: Mapping[str, Any], n_states: int, where: str)
     ConfigError
         Naming the option the backend refuses.
     """
-    options = settings.get("solver_options")
-    if options is None:
-        return
+    options, solver = settings.get("solver_options"), settings.get("solver")
+    outputs = _output_kwargs(settings) if "output_matrix" in settings else {}
+    given = options is not None or solver is not None or any(v is not None for v in outputs.values())
     from models import PolytopicModel
     from rmpc.mpc.robust_mpc import RMPC
 
-    stand_in = PolytopicModel([(0.5 * np.eye(n_states), np.ones((n_states, 1)))], dt=1.0)
+    if not given and settings["backend"] == _RMPC_BACKEND:
+        return  # the constructor's own defaults
+    # the states matter for the output matrix only (a 6-state ipm stand-in takes 45 ms to build)
+    n = n_states if outputs and outputs["output_matrix"] is not None else 1
+    stand_in = PolytopicModel([(0.5 * np.eye(n), np.ones((n, 1)))], dt=1.0)
     form = {"lyapunov": "vertex"} if changed_forms(settings) else {}
     try:
-        RMPC(stand_in, np.eye(n_states), np.eye(1), u_max=[1.0], input_constraint="peak",
-             backend=settings["backend"], solver_options=dict(options), **form)
+        RMPC(stand_in, np.eye(n), np.eye(1), u_max=[1.0], input_constraint="peak",
+             backend=settings["backend"], solver=solver,
+             solver_options=None if options is None else dict(options), **outputs, **form)
     except (InvalidArgumentError, ArgumentTypeError) as err:
+        if err.argument in ("solver", "output_matrix", "y_max", "backend"):
+            # backend: a family's choices are shared with its QP controller's ("proxqp")
+            raise ConfigError(f"{where}.{err.argument}", err.expected, err.found) from None
         if not err.argument.startswith("solver_options"):
             return  # not the options': the case's own build reports it
         raise ConfigError(
             _path(err.argument, f"{where}.solver_options"),
             f"{err.expected} (backend {settings['backend']!r})", err.found,
         ) from None
+
+
+def _output_matrix(value: Any, where: str, n: int, out: bool) -> tuple[tuple[float, ...], ...]:
+    """``C`` of the output bounds ``|(C x)_r| <= y_max_r``: a list of rows of ``n`` numbers."""
+    from toolkit_common.validation import as_matrix
+
+    rows = isinstance(value, list | tuple) and value and all(isinstance(row, list | tuple) for row in value)
+    if not rows:
+        raise ConfigError(where, f"a list of rows of {n} numbers (the output matrix C)", repr(value)[:80])
+    try:
+        mat = as_matrix(value, "output_matrix", (None, n))
+    except (InvalidArgumentError, ArgumentTypeError) as err:
+        raise ConfigError(where, err.expected, err.found) from None
+    return tuple(tuple(float(v) for v in row) for row in mat)
+
+
+def _y_max(value: Any, where: str, n: int, out: bool) -> tuple[float, ...]:
+    """The output bounds: one number > 0 per row of ``output_matrix`` (or one for all)."""
+    from toolkit_common.validation import is_real
+
+    values = value if isinstance(value, list | tuple) else [value]
+    if not values or not all(is_real(v) and np.isfinite(v) and v > 0 for v in values):
+        raise ConfigError(where, "a number > 0 or a list of them (one per row of output_matrix)", repr(value))
+    return tuple(float(v) for v in values)
+
+
+def _solver(value: Any, where: str, n: int, out: bool) -> str:
+    """A cvxpy solver's name; which ones the case's ``backend`` takes is checked by the constructor."""
+    if not isinstance(value, str):
+        raise ConfigError(where, "a cvxpy solver's name (with backend = 'cvxpy'), e.g. 'SCS'", repr(value))
+    return value
 
 
 def _on_failure(value: Any, where: str, n: int, out: bool) -> str:
@@ -202,8 +253,11 @@ def _unsaturated_weight(value: Any, where: str, n: int, out: bool) -> float:
 _CHECKS: Mapping[str, Callable[[Any, str, int, bool], Any]] = MappingProxyType(
     {"lyapunov": _lyapunov, "cost": _cost, "free_moves": _free_moves, "saturation": _saturation,
      "soft": _soft, "disturbance": _disturbance, "on_failure": _on_failure, "solver_options": _solver_options,
-     "horizon": _horizon, "step_gains": _step_gains, "unsaturated_weight": _unsaturated_weight}
+     "horizon": _horizon, "step_gains": _step_gains, "unsaturated_weight": _unsaturated_weight,
+     "output_matrix": _output_matrix, "y_max": _y_max, "solver": _solver}
 )
+#: The output bounds of an RMPC as settings (families whose RMPC has no output of its own).
+OUTPUT_DEFAULTS: Mapping[str, Any] = MappingProxyType({"output_matrix": None, "y_max": None})
 
 
 def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -218,7 +272,16 @@ def rmpc_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
     options = settings.get("solver_options")
     out["solver_options"] = None if options is None else dict(options)
     out["unsaturated_weight"] = settings.get("unsaturated_weight")
+    out["solver"] = settings.get("solver")
+    if "output_matrix" in settings:  # a family whose RMPC takes its output bounds as settings
+        out.update(_output_kwargs(settings))
     return out
+
+
+def _output_kwargs(settings: Mapping[str, Any]) -> dict[str, Any]:
+    matrix, bound = settings.get("output_matrix"), settings.get("y_max")
+    return {"output_matrix": None if matrix is None else np.array(matrix, dtype=float),
+            "y_max": None if bound is None else np.array(bound, dtype=float)}
 
 
 def _no_output(values: Mapping[str, Any]) -> bool:
@@ -236,6 +299,9 @@ class RMPCForms:
     has_output : callable
         ``has_output(values) -> bool``: whether the RMPC of a case (its scenario fields
         ``values``) has output bounds (then ``soft`` may weigh ``y``).
+    output_settings : bool
+        The RMPC takes its output bounds from the settings ``output_matrix`` and ``y_max``
+        (:data:`OUTPUT_DEFAULTS`; the families whose scenario fields bound no output).
 
     Examples
     --------
@@ -246,6 +312,7 @@ class RMPCForms:
 
     n_states: int
     has_output: Callable[[Mapping[str, Any]], bool] = _no_output
+    output_settings: bool = False
 
     def setting_checks(self) -> Mapping[str, Callable[[Any, str], Any]]:
         """The check of each form setting on its own (``check(value, where) -> normalised value``).
@@ -254,12 +321,13 @@ class RMPCForms:
         and, for ``soft``, output bounds if the family's RMPC can have them at all; the case check
         (:meth:`check_case`) then checks it with the case's own bounds.
         """
-        out = self.has_output is not _no_output
+        out = self.has_output is not _no_output or self.output_settings
 
         def bind(check: Callable[[Any, str, int, bool], Any]) -> Callable[[Any, str], Any]:
             return lambda value, where: check(value, where, self.n_states, out)
 
-        return MappingProxyType({key: bind(check) for key, check in _CHECKS.items()})
+        keys = [key for key in _CHECKS if self.output_settings or key not in OUTPUT_DEFAULTS]
+        return MappingProxyType({key: bind(_CHECKS[key]) for key in keys})
 
     def check_case(
         self, values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
@@ -282,9 +350,11 @@ class RMPCForms:
         constrained = values["saturation"] == "constraint"
         bound = settings["input_constraint"] if constrained else None
         try:
+            has_output = self.has_output(values) or settings.get("output_matrix") is not None
             form_options(
-                n_states=self.n_states, input_constraint=bound, has_output=self.has_output(values),
-                **{k: v for k, v in rmpc_kwargs(settings).items() if k != "solver_options"},
+                n_states=self.n_states, input_constraint=bound, has_output=has_output,
+                **{k: v for k, v in rmpc_kwargs(settings).items()
+                   if k not in ("solver_options", "solver", "output_matrix", "y_max")},
             )
         except (InvalidArgumentError, ArgumentTypeError) as err:
             parts = []

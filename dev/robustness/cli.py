@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from benchmarks.core.machine import machine_info
 from dev.robustness.api_cases import api_probes
 from dev.robustness.cli_cases import cli_probes
+from dev.robustness.close_cases import close_probes
 from dev.robustness.interrupt_cases import interrupt_probes
 from dev.robustness.probe import Probe
 from dev.robustness.runner import run_probes
@@ -63,7 +64,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     probes = [
         p
         for p in (api_probes() + solver_probes() + cli_probes() + store_probes() + interrupt_probes()
-                  + sweep_probes())
+                  + sweep_probes() + close_probes())
         if (args.only in (None, p.group)) and (args.match is None or args.match in p.id)
     ]
     os.makedirs(args.out, exist_ok=True)

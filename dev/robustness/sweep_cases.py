@@ -88,7 +88,7 @@ _CASES: tuple[tuple[str, str, tuple[str, ...], Expect], ...] = (
     ("solver_options unknown", "solver_options = {bogus = 1}",
      ("settings.solver_options: expected ipm settings",), "error"),
     ("solver_options max_iter 0", "solver_options = {max_iter = 0}",
-     ("settings.solver_options.max_iter: expected an integer > 0",), "error"),
+     ("settings.solver_options.max_iter: expected an integer >= 1",), "error"),
     ("solver_options number", "solver_options = 5", ("settings.solver_options: expected a table",), "error"),
     ("solver_options nested", "solver_options = {core = [1]}", ("settings.solver_options.core: expected",),
      "error"),

@@ -23,6 +23,7 @@ from lmi.data import KothareData
 from lmi.status import CLARABEL_STATUS_MAP, INFEASIBLE, SOLVER_ERROR, UNBOUNDED
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.interrupts import reraise_interrupt
 
 # RawResult is defined in lmi.backends.base; it stays importable from here.
 __all__ = ["DEFAULT_CLARABEL_OPTIONS", "ClarabelKothare", "RawResult", "clarabel_settings"]
@@ -117,8 +118,7 @@ class ClarabelKothare(KothareBackend):
                                                 self.settings)
                 sol = solver.solve()
         except BaseException as err:
-            if isinstance(err, KeyboardInterrupt):
-                raise
+            reraise_interrupt(err)  # Ctrl-C, bare or wrapped by the binding: not a failed solve
             return RawResult(SOLVER_ERROR, repr(err), np.nan, None, None, None, time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         raw = str(sol.status)

@@ -2,7 +2,9 @@
 
 Independent of :mod:`lmi.backends.conic` (a second implementation of the same problem, used
 to cross-check it). The problem is built once with parameters for the state and the bounds
-(DPP), so a re-solve skips cvxpy's canonicalisation.
+(DPP), so a re-solve skips cvxpy's canonicalisation. SCS runs through
+:class:`lmi.backends.scs_signal.InterruptibleSCS`, so Ctrl-C during an SCS solve reaches Python
+instead of ending the solve as a failure.
 """
 
 from __future__ import annotations
@@ -64,6 +66,13 @@ class CvxpyKothare(KothareBackend):
             raise InvalidArgumentError("solver", f"one of the installed solvers {installed}", repr(solver))
         self.name = f"cvxpy:{solver}"
         self.solver = solver
+        # SCS catches SIGINT while it solves: its interface that hands it back (a solver object)
+        self.solver_arg: Any = solver
+        """What ``Problem.solve(solver=...)`` is given: the name, or SCS's interruptible interface."""
+        if solver == "SCS":
+            from lmi.backends.scs_signal import InterruptibleSCS
+
+            self.solver_arg = InterruptibleSCS()
         self.options = _solver_options(solver, options)
         self.data = data
         n, m = data.n, data.m
@@ -139,7 +148,7 @@ class CvxpyKothare(KothareBackend):
             self.inv_y.value = 1.0 / y_max
         start = time.perf_counter()
         try:
-            self.problem.solve(solver=self.solver, **self.options)
+            self.problem.solve(solver=self.solver_arg, **self.options)
         except cp.error.SolverError as err:
             return RawResult(SOLVER_ERROR, str(err), np.nan, None, None, None, time.perf_counter() - start)
         elapsed = time.perf_counter() - start

@@ -42,7 +42,7 @@ from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import is_integer, is_real
 
-__all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare"]
+__all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "IPMKothare", "check_ipm_values"]
 
 #: A failed cold solve is retried in coordinates balanced on its last ``Q`` (option
 #: ``rebalance``) only if its relative primal and dual residuals came below this.
@@ -123,29 +123,58 @@ def _check_options(options: dict[str, Any]) -> dict[str, Any]:
             "solver_options", f"IPM settings ({', '.join(sorted(DEFAULT_IPM_OPTIONS))})",
             f"unknown setting(s) {unknown}",
         )
-    merged = {**DEFAULT_IPM_OPTIONS, **options}
-    for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel"):
+    return check_ipm_values({**DEFAULT_IPM_OPTIONS, **options})
+
+
+def check_ipm_values(options: dict[str, Any]) -> dict[str, Any]:
+    """The values of the interior-point settings in ``options`` checked, as numbers of the right kind.
+
+    The one check of an ``"ipm"`` back-end's ``solver_options`` values, for Kothare's problem and
+    the forms (:class:`lmi.forms.FormProblem`) alike; names it does not know are left alone (the
+    caller refuses the names it does not take).
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming the setting (``solver_options['max_iter']``), what was expected and what was found.
+
+    Examples
+    --------
+    >>> check_ipm_values({"max_iter": 0})  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    toolkit_common.errors.InvalidArgumentError: solver_options['max_iter']: expected an integer >= 1, ...
+    """
+    merged = dict(options)
+    for key in ("tol_feas", "tol_gap_abs", "tol_gap_rel", "warm_gap", "warm_feas"):
+        if key not in merged:
+            continue
         value = merged[key]
-        if not (is_real(value) and value > 0):
+        if not (is_real(value) and value > 0):  # NaN fails too
             raise InvalidArgumentError(f"solver_options[{key!r}]", "a number > 0", repr(value))
         merged[key] = float(value)
-    radius = merged["infeasibility_radius"]
-    if not (is_real(radius) and radius > 0):
-        raise InvalidArgumentError("solver_options['infeasibility_radius']", "a number > 0 (inf: no test)",
-                                   repr(radius))
+    if "infeasibility_radius" in merged:
+        radius = merged["infeasibility_radius"]
+        if not (is_real(radius) and radius > 0):
+            raise InvalidArgumentError("solver_options['infeasibility_radius']",
+                                       "a number > 0 (inf: no test)", repr(radius))
     for key in ("max_iter", "warm_max_iter"):
+        if key not in merged:
+            continue
         value = merged[key]
-        if not (is_integer(value) and value > 0):
-            raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer > 0", repr(value))
+        if not (is_integer(value) and value >= 1):
+            raise InvalidArgumentError(f"solver_options[{key!r}]", "an integer >= 1", repr(value))
         merged[key] = int(value)
     for key in ("warm_start", "fallback", "state_scaling", "phase_one", "rebalance"):
-        if not isinstance(merged[key], bool):
+        if key in merged and not isinstance(merged[key], bool):
             raise InvalidArgumentError(f"solver_options[{key!r}]", "True or False", repr(merged[key]))
-    if merged["core"] not in CORE_CHOICES:
-        raise InvalidArgumentError("solver_options['core']", f"one of {CORE_CHOICES}", repr(merged["core"]))
-    if merged["core"] == "c" and core_library() is None:
-        raise InvalidArgumentError("solver_options['core']", "'auto' or 'numba' (no C core here)",
-                                   f"'c': {core_status()}")
+    if "core" in merged:
+        if merged["core"] not in CORE_CHOICES:
+            raise InvalidArgumentError("solver_options['core']", f"one of {CORE_CHOICES}",
+                                       repr(merged["core"]))
+        if merged["core"] == "c" and core_library() is None:
+            raise InvalidArgumentError("solver_options['core']", "'auto' or 'numba' (no C core here)",
+                                       f"'c': {core_status()}")
     return merged
 
 

@@ -50,6 +50,7 @@ from lmi.status import (
 )
 from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.interrupts import reraise_interrupt
 from toolkit_common.validation import as_matrix, as_vector, check_positive
 
 __all__ = ["LAMBDA_GRID", "MAX_COEFFICIENT_BYTES", "FormProblem"]
@@ -267,7 +268,9 @@ class FormProblem:
                                       "phase_one": True, "rebalance": True, "tol_gap_abs": 1e-12,
                                       "max_iter": 100}
             merged.update(opts)
-            return merged
+            from lmi.backends.ipm import check_ipm_values
+
+            return check_ipm_values(merged)  # the values: the one check Kothare's problem uses too
         from lmi.backends.clarabel import clarabel_settings
 
         clarabel_settings(opts)  # unknown names raise here
@@ -597,8 +600,7 @@ class FormProblem:
                 )
                 sol = solver.solve()
         except BaseException as err:  # Clarabel raises its own panics as BaseException
-            if isinstance(err, KeyboardInterrupt):
-                raise
+            reraise_interrupt(err)  # Ctrl-C, bare or wrapped by the binding: not a failed solve
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
         raw = str(sol.status)
         status = CLARABEL_STATUS_MAP.get(raw, SOLVER_ERROR)
@@ -634,8 +636,9 @@ class FormProblem:
             with self._blas.limit():
                 problem.solve(solver="CLARABEL", **self._settings)
         except BaseException as err:  # cvxpy.error.SolverError, the solver's own errors and panics
-            if isinstance(err, KeyboardInterrupt | SystemExit):
+            if isinstance(err, SystemExit):
                 raise
+            reraise_interrupt(err)  # Ctrl-C, bare or wrapped by the binding: not a failed solve
             return _Solved(SOLVER_ERROR, repr(err), None, None, time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         status = CVXPY_STATUS_MAP.get(str(problem.status), SOLVER_ERROR)

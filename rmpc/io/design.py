@@ -31,6 +31,7 @@ import numpy as np
 
 from models import PolytopicModel
 from toolkit_common.errors import InvalidArgumentError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = ["Design", "DesignError", "encode", "plant_design", "snapshot"]
 
@@ -113,7 +114,7 @@ def _floats(value: Any, where: str) -> Any:
         return [_floats(item, where) for item in value]
     if isinstance(value, str) and value in _NON_FINITE:
         return _NON_FINITE[value]
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if not is_real(value):
         raise DesignError(where, "numbers (non-finite ones as 'inf', '-inf', 'nan')", repr(value)[:80])
     return float(value)
 
@@ -188,7 +189,7 @@ class Design:
 
     def integer(self, name: str) -> int:
         value = self.value(name)
-        if isinstance(value, bool) or not isinstance(value, int):
+        if not is_integer(value):
             self._bad(name, "an integer", value)
         return int(value)
 

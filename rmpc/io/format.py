@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from toolkit_common.errors import ArgumentTypeError, ControllerFileError
+from toolkit_common.validation import is_integer
 
 __all__ = ["FORMAT", "VERSION", "ControllerFile", "canonical", "checksum", "read_file", "write_file"]
 
@@ -176,7 +177,7 @@ def read_file(path: Any) -> ControllerFile:
         raise ControllerFileError(name, f"a controller file (format {FORMAT!r})",
                                   f"{found}: not a controller file")
     version = payload.get("version")
-    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+    if not is_integer(version) or version < 1:
         raise ControllerFileError(name, "a format version (an integer >= 1)", repr(version))
     if version > VERSION:
         writer = payload.get("toolkit_version", "unknown")

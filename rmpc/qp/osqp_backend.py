@@ -45,6 +45,7 @@ import scipy.sparse as sp
 from rmpc.qp.base import DEFAULT_TIME_LIMIT, BackendSettings, QPBackend
 from rmpc.qp.problem import QPResult, SolverResiduals
 from toolkit_common.status import Status
+from toolkit_common.validation import is_integer
 
 __all__ = ["OSQPBackend", "OSQPSettings"]
 
@@ -107,7 +108,7 @@ class OSQPSettings(BackendSettings):
         super().__post_init__()
         from toolkit_common.errors import InvalidArgumentError
 
-        if isinstance(self.scaling, bool) or not isinstance(self.scaling, int) or self.scaling < 0:
+        if not is_integer(self.scaling) or self.scaling < 0:
             raise InvalidArgumentError("OSQPSettings.scaling", "an integer >= 0", repr(self.scaling))
         if self.eps_abs == 0 and self.eps_rel == 0:
             raise InvalidArgumentError("OSQPSettings.eps_abs, eps_rel", "at least one > 0", "both 0")

@@ -307,8 +307,10 @@ def _offline(m: FlexibleModel, scenario: Any, s: Mapping[str, Any]) -> BuiltCont
         formulation=s["formulation"],
         cost=s["cost"],
         backend=s["backend"],
+        solver=s["solver"],
         solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
         certificate_tol=s["certificate_tol"],
+        path=s["path"],
     )
     law = _mapped(ctrl, m, "OfflineRMPC")
     if scenario.handover_deg is not None:

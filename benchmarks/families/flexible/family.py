@@ -68,6 +68,7 @@ from benchmarks.core.family import (
 )
 from benchmarks.core.metrics import step_timing
 from benchmarks.families.controller_options import OFFLINE_DEFAULTS, OFFLINE_QUIET, check_offline_options
+from benchmarks.families.crmpc_options import NOT_SETTINGS
 from benchmarks.families.flexible import defaults
 from benchmarks.families.flexible.controllers import (
     CONSTRAINED,
@@ -338,6 +339,11 @@ def _handover_time(ctrl: Any, traj: Any) -> float | None:
 
 #: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
 FORMS = RMPCForms(14, has_output=lambda values: values["modal_bound"] is not None)
+#: The RMPC's and OfflineRMPC's output bounds are the field modal_bound's (not settings).
+_OUTPUT_NOT_SETTINGS = {
+    key: "the flexible satellite's output bounds are its modal coordinates', set by the field modal_bound"
+    for key in ("output_matrix", "y_max")
+}
 
 
 
@@ -378,4 +384,5 @@ FLEXIBLE = PlantFamily(
     setting_checks=FORMS.setting_checks(),
     quiet_settings=frozenset(FORM_DEFAULTS) | OFFLINE_QUIET,
     case_check=_case_check,
+    not_settings={**NOT_SETTINGS, **_OUTPUT_NOT_SETTINGS},
 )

@@ -95,6 +95,7 @@ def _rmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
 
 
 def _crmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.crmpc_options import crmpc_rmpc_kwargs
     from rmpc import CRMPC
     from rmpc.mpc.adaptation import LyapunovRule
 
@@ -108,7 +109,7 @@ def _crmpc(m: MRPModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
         adaptation=LyapunovRule(gain=s["adaptation_gain"]),
         theta_bound=s["theta_fraction"] * scenario.u_max,
         torque_budget=s["torque_budget"] if constrained else "none",
-        rmpc_options={"backend": s["backend"]},
+        rmpc_options=crmpc_rmpc_kwargs(s, {"backend": s["backend"]}),
     )
     return BuiltController(_mapped(ctrl, m, "CRMPC"), scenario.saturation == "limiter")
 

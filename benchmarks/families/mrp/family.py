@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -56,9 +57,15 @@ from benchmarks.core.family import (
     controller_specs,
 )
 from benchmarks.core.metrics import step_timing, total_variation_rate
+from benchmarks.families.crmpc_options import (
+    CRMPC_DEFAULTS,
+    NOT_SETTINGS,
+    check_crmpc_options,
+    rmpc_options_check,
+)
 from benchmarks.families.mrp import defaults
 from benchmarks.families.mrp.controllers import CONSTRAINED, CONTROLLERS, MRPModel, settings_check
-from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, OUTPUT_DEFAULTS, RMPCForms
 from toolkit_common.errors import ConfigError
 
 __all__ = ["LATE_WINDOW_START", "MRP", "chattering", "late_window_start", "simulate_case"]
@@ -266,7 +273,23 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 
 
 #: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
-FORMS = RMPCForms(6)
+FORMS = RMPCForms(6, output_settings=True)
+#: The inner RMPC's keyword CRMPC's own setting sets (not in settings.rmpc_options).
+_OWN = ("backend",)
+_SETTING_CHECKS = MappingProxyType(
+    {**FORMS.setting_checks(), "rmpc_options": rmpc_options_check(FORMS.setting_checks(), _OWN)}
+)
+
+
+def _case_check(
+    values: dict[str, Any], controller: str, settings: Mapping[str, Any], name: Callable[[str], str]
+) -> None:
+    """The RMPC's forms with the case's bounds; CRMPC's rmpc_options by its constructor."""
+    if controller == "CRMPC":
+        own = {key: settings[key] for key in _OWN}
+        constrained = values["saturation"] == "constraint"
+        check_crmpc_options(settings, own, FORMS.n_states, constrained, name("settings"))
+    FORMS.check_case(values, controller, settings, name)
 
 
 MRP = PlantFamily(
@@ -275,7 +298,12 @@ MRP = PlantFamily(
     fields=FIELDS,
     controllers=controller_specs(
         CONTROLLERS,
-        {**defaults.CONTROLLER_DEFAULTS, "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS}},
+        {
+            **defaults.CONTROLLER_DEFAULTS,
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS, **OUTPUT_DEFAULTS},
+            # the inner RMPC's further keywords (left out of a record at their default, None)
+            "CRMPC": {**defaults.CONTROLLER_DEFAULTS["CRMPC"], **CRMPC_DEFAULTS},
+        },
         CONSTRAINED,
     ),
     simulate=simulate_case,
@@ -284,7 +312,8 @@ MRP = PlantFamily(
     setting_choices=defaults.SETTING_CHOICES,
     zero_allowed=frozenset({"adaptation_gain"}),
     settings_check=settings_check,
-    setting_checks=FORMS.setting_checks(),
-    quiet_settings=frozenset(FORM_DEFAULTS),
-    case_check=FORMS.check_case,
+    setting_checks=_SETTING_CHECKS,
+    quiet_settings=frozenset(FORM_DEFAULTS) | frozenset(OUTPUT_DEFAULTS) | frozenset(CRMPC_DEFAULTS),
+    case_check=_case_check,
+    not_settings=NOT_SETTINGS,
 )

@@ -76,6 +76,7 @@ def _crmpc_common(
     s: Mapping[str, Any],
     adaptation: Any,
 ) -> BuiltController:
+    from benchmarks.families.crmpc_options import crmpc_rmpc_kwargs
     from rmpc.mpc.crmpc import CRMPC
 
     q, r = _weights(s)
@@ -89,7 +90,7 @@ def _crmpc_common(
         input_constraint=s["input_constraint"] if constrained else None,
         theta_bound=s["theta_fraction"] * scenario.u_max,  # the projection is anti-windup in every mode
         torque_budget=budget,
-        rmpc_options={"resolve_threshold": s["resolve_threshold"]},
+        rmpc_options=crmpc_rmpc_kwargs(s, {"resolve_threshold": s["resolve_threshold"]}),
         adaptation=adaptation,
     )
     limiter = scenario.saturation == "limiter" or (
@@ -149,8 +150,10 @@ def _offline(poly: PolytopicModel, scenario: Any, s: Mapping[str, Any]) -> Built
         interpolate=s["interpolate"],
         cost=s["cost"],
         backend=s["backend"],
+        solver=s["solver"],
         solver_options=None if s["solver_options"] is None else dict(s["solver_options"]),
         certificate_tol=s["certificate_tol"],
+        path=s["path"],
     )
     return BuiltController(ctrl, scenario.saturation == "limiter")
 

@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -70,9 +71,15 @@ from benchmarks.families.controller_options import (
     check_gipc_solver_options,
     check_offline_options,
 )
+from benchmarks.families.crmpc_options import (
+    CRMPC_DEFAULTS,
+    NOT_SETTINGS,
+    check_crmpc_options,
+    rmpc_options_check,
+)
 from benchmarks.families.rigid import defaults
 from benchmarks.families.rigid.controllers import CONSTRAINED, CONTROLLERS, settings_check
-from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms, changed_forms
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, OUTPUT_DEFAULTS, RMPCForms, changed_forms
 from models import PAPER_P_INERTIA, PAPER_P_INITIAL_STATE
 from toolkit_common.errors import ConfigError
 
@@ -162,7 +169,12 @@ def _check(values: dict[str, Any], controller: str, name: Callable[[str], str]) 
 
 
 #: The forms of the RMPC on the 6 states of the satellite (roll, pitch, yaw and their rates).
-FORMS = RMPCForms(6)
+FORMS = RMPCForms(6, output_settings=True)
+#: The inner RMPC's keyword CRMPC's own setting sets (not in settings.rmpc_options).
+_OWN = ("resolve_threshold",)
+_SETTING_CHECKS = MappingProxyType(
+    {**FORMS.setting_checks(), "rmpc_options": rmpc_options_check(FORMS.setting_checks(), _OWN)}
+)
 
 
 def _case_check(
@@ -170,18 +182,21 @@ def _case_check(
 ) -> None:
     """The forms with the case's bounds; none, nor solver options, with the scheduled polytope."""
     changed = changed_forms(settings)
-    if settings.get("solver_options") is not None:
-        changed.append("solver_options")
+    changed += [key for key in ("solver_options", "solver", "output_matrix") if settings.get(key) is not None]
     if controller == "RMPC" and changed and values["kinematics"] == "scheduled":
         expected = (
             f"'single' or 'cover' with {name('settings')}.{changed[0]} (the scheduled RMPC solves "
-            "Kothare's LMIs with the default solver options only)"
+            "Kothare's LMIs with the default solver options and no output bounds only)"
         )
         raise ConfigError(name("kinematics"), expected, "'scheduled'")
     if controller == "GIPC":
         check_gipc_solver_options(settings, name("settings"))
     if controller == "OfflineRMPC":
         check_offline_options(settings, name("settings"))
+    if controller in ("CRMPC", "CRMPC-MIT"):
+        own = {key: settings[key] for key in _OWN}
+        constrained = values["saturation"] == "constraint"
+        check_crmpc_options(settings, own, FORMS.n_states, constrained, name("settings"))
     FORMS.check_case(values, controller, settings, name)
 
 
@@ -282,7 +297,7 @@ RIGID = PlantFamily(
         CONTROLLERS,
         {
             **defaults.CONTROLLER_DEFAULTS,
-            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS, **OUTPUT_DEFAULTS},
             # Kothare's or the nominal cost of the table (left out of a record at its default)
             "OfflineRMPC": {
                 **defaults.CONTROLLER_DEFAULTS["OfflineRMPC"],
@@ -291,6 +306,9 @@ RIGID = PlantFamily(
             },
             # the QP back-end's settings (left out of a record at their default, None)
             "GIPC": {**defaults.CONTROLLER_DEFAULTS["GIPC"], "solver_options": None},
+            # the inner RMPC's further keywords (left out of a record at their default, None)
+            "CRMPC": {**defaults.CONTROLLER_DEFAULTS["CRMPC"], **CRMPC_DEFAULTS},
+            "CRMPC-MIT": {**defaults.CONTROLLER_DEFAULTS["CRMPC-MIT"], **CRMPC_DEFAULTS},
         },
         CONSTRAINED,
     ),
@@ -301,7 +319,9 @@ RIGID = PlantFamily(
     zero_allowed=frozenset({"adaptation_gain", "mit_gain", "hold_radius"}),
     settings_check=settings_check,
     montecarlo=MonteCarlo(dims=3, sets=("true_inertia",), apply=_draw_inertia),
-    setting_checks=FORMS.setting_checks(),
-    quiet_settings=frozenset(FORM_DEFAULTS) | OFFLINE_QUIET,
+    setting_checks=_SETTING_CHECKS,
+    quiet_settings=frozenset(FORM_DEFAULTS) | frozenset(OUTPUT_DEFAULTS) | frozenset(CRMPC_DEFAULTS)
+    | OFFLINE_QUIET,
     case_check=_case_check,
+    not_settings=NOT_SETTINGS,
 )

@@ -82,6 +82,7 @@ def _rmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContro
 
 
 def _crmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltController:
+    from benchmarks.families.crmpc_options import crmpc_rmpc_kwargs
     from rmpc import CRMPC
     from rmpc.mpc.adaptation import LyapunovRule
 
@@ -97,7 +98,7 @@ def _crmpc(model: WheelModel, scenario: Any, s: Mapping[str, Any]) -> BuiltContr
         adaptation=LyapunovRule(gain=s["adaptation_gain"]),
         theta_bound=s["theta_fraction"] * scenario.u_max if constrained else None,
         torque_budget=s["torque_budget"] if constrained else "none",
-        rmpc_options={"backend": s["backend"]},
+        rmpc_options=crmpc_rmpc_kwargs(s, {"backend": s["backend"]}),
     )
     return BuiltController(_mapped(ctrl, "CRMPC"), False)
 

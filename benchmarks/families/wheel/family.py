@@ -66,6 +66,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -82,10 +83,17 @@ from benchmarks.core.family import (
 )
 from benchmarks.core.metrics import compute_metrics
 from benchmarks.families.controller_options import check_gipc_solver_options
-from benchmarks.families.rmpc_forms import FORM_DEFAULTS, RMPCForms
+from benchmarks.families.crmpc_options import (
+    CRMPC_DEFAULTS,
+    NOT_SETTINGS,
+    check_crmpc_options,
+    rmpc_options_check,
+)
+from benchmarks.families.rmpc_forms import FORM_DEFAULTS, OUTPUT_DEFAULTS, RMPCForms
 from benchmarks.families.wheel import defaults
 from benchmarks.families.wheel.controllers import CONSTRAINED, CONTROLLERS, WheelModel, settings_check
 from toolkit_common.errors import ConfigError
+from toolkit_common.validation import is_integer, is_real
 
 __all__ = ["WHEEL", "case_faults", "misaligned_axes", "simulate_case"]
 
@@ -103,21 +111,21 @@ def _optional_positive(value: Any, where: str) -> float | None:
 
 
 def _duration(value: Any, where: str) -> float:
-    if isinstance(value, int | float) and not isinstance(value, bool) and value == math.inf:
+    if is_real(value) and value == math.inf:
         return math.inf
     return _positive(value, where)
 
 
 def _wheel(value: Any, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 4:
+    if not is_integer(value) or not 1 <= value <= 4:
         raise ConfigError(where, "a wheel number 1..4 (wheel 4 is the skew wheel)", repr(value))
-    return value
+    return int(value)
 
 
 def _seed(value: Any, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+    if not is_integer(value) or value < 0:
         raise ConfigError(where, "an integer >= 0", repr(value))
-    return value
+    return int(value)
 
 
 def _spread(value: Any, where: str) -> float | None:
@@ -363,7 +371,12 @@ def simulate_case(scenario: Any, settings: Mapping[str, Any], keep_trace: bool) 
 
 
 #: The robust MPC's forms as settings of the controller "RMPC" (benchmarks.families.rmpc_forms).
-FORMS = RMPCForms(6)
+FORMS = RMPCForms(6, output_settings=True)
+#: The inner RMPC's keyword CRMPC's own setting sets (not in settings.rmpc_options).
+_OWN = ("backend",)
+_SETTING_CHECKS = MappingProxyType(
+    {**FORMS.setting_checks(), "rmpc_options": rmpc_options_check(FORMS.setting_checks(), _OWN)}
+)
 
 
 def _case_check(
@@ -372,6 +385,10 @@ def _case_check(
     """The RMPC's forms with the case's bounds; GIPC's solver options with the case's backend."""
     if controller == "GIPC":
         check_gipc_solver_options(settings, name("settings"))
+    if controller == "CRMPC":
+        own = {key: settings[key] for key in _OWN}
+        constrained = values["saturation"] == "constraint"
+        check_crmpc_options(settings, own, FORMS.n_states, constrained, name("settings"))
     FORMS.check_case(values, controller, settings, name)
 
 
@@ -383,9 +400,11 @@ WHEEL = PlantFamily(
         CONTROLLERS,
         {
             **defaults.CONTROLLER_DEFAULTS,
-            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS},
+            "RMPC": {**defaults.CONTROLLER_DEFAULTS["RMPC"], **FORM_DEFAULTS, **OUTPUT_DEFAULTS},
             # the QP back-end's settings (left out of a record at their default, None)
             "GIPC": {**defaults.CONTROLLER_DEFAULTS["GIPC"], "solver_options": None},
+            # the inner RMPC's further keywords (left out of a record at their default, None)
+            "CRMPC": {**defaults.CONTROLLER_DEFAULTS["CRMPC"], **CRMPC_DEFAULTS},
         },
         CONSTRAINED,
     ),
@@ -396,7 +415,8 @@ WHEEL = PlantFamily(
     zero_allowed=frozenset({"adaptation_gain", "leakage", "gamma_g", "gamma_theta"}),
     settings_check=settings_check,
     controller_defaults=lambda controller: {} if controller in CONSTRAINED else {"saturation": "limiter"},
-    setting_checks=FORMS.setting_checks(),
-    quiet_settings=frozenset(FORM_DEFAULTS),
+    setting_checks=_SETTING_CHECKS,
+    quiet_settings=frozenset(FORM_DEFAULTS) | frozenset(OUTPUT_DEFAULTS) | frozenset(CRMPC_DEFAULTS),
     case_check=_case_check,
+    not_settings=NOT_SETTINGS,
 )
