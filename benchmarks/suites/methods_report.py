@@ -331,6 +331,15 @@ def write_methods_report(
         f"(no `optimal` solve at x0 or at any step: it applied u = 0 or a fallback) shows `{NO_GAIN}` "
         "in place of a cost and has no place in the cost ratios.",
         "",
+        "What the families assume: the LMI forms take the polytope of plants (one vertex for the "
+        "whole prediction with `lyapunov=\"common\"`/`\"vertex\"`, any vertex at every sample with "
+        "`\"vertex_pairs\"`) and bound the worst-case cost (`gamma`); `multistage` (a scenario tree "
+        "over the vertices, robust horizon 1) takes the same polytope, with no cost bound and no "
+        "terminal set; `tube` and `tube_tightening` take one plant with an additive disturbance box W "
+        "and run only where a problem gives one. `violations` counts the samples of the seeded "
+        "switching-vertex runs (pushed by W where a problem has one) whose input or next state broke "
+        "a bound.",
+        "",
         "## Which form is least conservative where",
         "",
         *(
