@@ -56,6 +56,7 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "region vs kothare",
     "cost (nominal plant)",
     "solve p50 / p95 (ms)",
+    "violations / samples",
 )
 
 #: Step statuses that mean the controller applied a certified gain.
@@ -164,6 +165,8 @@ def table_row(rec: dict[str, Any], base: dict[str, Any] | None) -> dict[str, str
         "solve p50 / p95 (ms)": f"{_ms(rec.get('solve_time_p50'))} / {_ms(rec.get('solve_time_p95'))}",
         "cvxpy p50 (ms)": _ms(cv),
         "cvxpy / ipm": _fmt(rec.get("cvxpy_ratio"), ".1f"),
+        "violations / samples": "-" if rec.get("violation_samples") is None
+        else f"{rec.get('violations')} / {rec.get('violation_samples')}",
         "step statuses": ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "-",
     }
 
