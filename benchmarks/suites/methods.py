@@ -1,7 +1,9 @@
 """The benchmark suite "methods": the field's robust MPC forms head to head (``rmpc bench methods``).
 
-Every problem of :mod:`benchmarks.suites.methods_problems` is solved by every form of
-:class:`rmpc.RMPC` in :data:`METHODS`; one record per problem and method holds
+Every problem of :mod:`benchmarks.suites.methods_problems` is solved by every method of
+:data:`METHODS`: the forms of :class:`rmpc.RMPC`, MUP's method keys (:mod:`rmpc.mpc.methods`) and
+the QP families of :mod:`benchmarks.suites.methods_qp` (tube and multi-stage MPC); one record per
+problem and method holds
 
 - ``status``, ``gamma``, ``iterations`` of the solve at the start state ``x0``;
 - ``region``: the largest feasible multiple ``t`` of fixed directions (``t d`` certified
@@ -14,6 +16,7 @@ Every problem of :mod:`benchmarks.suites.methods_problems` is solved by every fo
   around ``ctrl.step``, certification included), and ``cvxpy_time_p50``: wall time of
   ``ctrl.solve`` with ``backend="cvxpy"`` (the same LMIs through cvxpy + Clarabel) on the first
   states of the closed loop, next to the toolkit's ipm on the same states;
+- ``violations``: samples of seeded switching-vertex runs whose input or next state broke a bound;
 - ``status_counts`` of the closed-loop steps and ``skip_reason`` where a method does not apply.
 
 Each finished record is stored in ``DIR/cases/`` at once; running the same command again skips
