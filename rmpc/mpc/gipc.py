@@ -37,7 +37,6 @@ min(du_max, u_max - u(k-1))``). ``H`` and ``C`` are built once; per step only ``
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -392,19 +391,12 @@ class GIPC(Saveable):
     def _design(self) -> dict[str, Any]:
         """The plant, the horizons, weights, bounds, outputs, reference, ``u0`` and the QP back-end
         by name with its settings (a back-end class of :data:`rmpc.qp.BACKENDS` only)."""
-        from rmpc.qp.factory import BACKENDS
+        from rmpc.qp.factory import backend_design
 
-        backend = self.backend
-        if BACKENDS.get(backend.name) is not type(backend):
-            raise InvalidArgumentError(
-                "backend",
-                f"one of the toolkit's QP back-ends ({', '.join(BACKENDS)}) to save the controller",
-                type(backend).__name__,
-            )
+        saved_backend = backend_design(self.backend)
         return {"plant": plant_design(self.plant), **encode({
             "Np": self.Np, "Nc": self.Nc, "Qy": self.Qy, "R_du": self.R_du, "u_max": self.u_max,
-            "du_max": self.du_max, "C": self.C, "backend": backend.name,
-            "solver_options": dataclasses.asdict(backend.settings), "x_ref": self.x_ref, "u0": self.u0,
+            "du_max": self.du_max, "C": self.C, **saved_backend, "x_ref": self.x_ref, "u0": self.u0,
             "max_horizon": self._limits[0], "max_prediction_entries": self._limits[1],
         }, "GIPC design")}
 

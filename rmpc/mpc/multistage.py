@@ -59,7 +59,6 @@ QP: it is refused with a message.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -529,15 +528,9 @@ class MultiStageMPC(Saveable):
     # -- save and load ------------------------------------------------------------------------
     def _design(self) -> dict[str, Any]:
         """The plant, weights, horizons, bounds, terminal cost and the QP back-end by name."""
-        from rmpc.qp.factory import BACKENDS
+        from rmpc.qp.factory import backend_design
 
-        backend = self.backend
-        if BACKENDS.get(backend.name) is not type(backend):
-            raise InvalidArgumentError(
-                "backend",
-                f"one of the toolkit's QP back-ends ({', '.join(BACKENDS)}) to save the controller",
-                type(backend).__name__,
-            )
+        saved_backend = backend_design(self.backend)
         sc = self.state_constraints
         terminal = self.terminal
         return {"plant": plant_design(self.plant), **encode({
@@ -547,7 +540,7 @@ class MultiStageMPC(Saveable):
             "output_matrix": self.output_matrix, "y_max": self.y_max,
             "terminal": terminal if isinstance(terminal, str) else "matrix",
             "terminal_matrix": None if isinstance(terminal, str) else terminal,
-            "backend": backend.name, "solver_options": dataclasses.asdict(backend.settings),
+            **saved_backend,
             "max_variables": self.max_variables,
         }, "MultiStageMPC design")}
 

@@ -468,22 +468,16 @@ class TubeMPC(Saveable):
         """The model, weights, constraint and disturbance sets, options and the computed sets
         (gain, terminal weight, tube cross-section, tightenings, terminal set), so that loading
         designs nothing."""
-        from rmpc.qp.factory import BACKENDS
+        from rmpc.qp.factory import backend_design
 
-        backend = self.backend
-        if BACKENDS.get(backend.name) is not type(backend):
-            raise InvalidArgumentError(
-                "backend",
-                f"one of the toolkit's QP back-ends ({', '.join(BACKENDS)}) to save the controller",
-                type(backend).__name__,
-            )
+        saved_backend = backend_design(self.backend)
         sets = {f.name: getattr(self.sets, f.name) for f in dataclasses.fields(self.sets)}
         return encode({
             "A": self.A, "B": self.B, "Q": self.Q, "R": self.R, "horizon": self.N, "kind": self.kind,
             "state_constraints": [self.X[0], self.X[1], self.X[2]],
             "input_constraints": [self.U[0], self.U[1], self.U[2]],
             "disturbance_set": [self.W.H, self.W.h, self.W.name], "epsilon": self.epsilon,
-            "backend": backend.name, "solver_options": dataclasses.asdict(backend.settings),
+            **saved_backend,
             "max_horizon": self._limit, "sets": sets,
         }, "TubeMPC design")
 

@@ -11,7 +11,7 @@ from rmpc.qp.osqp_backend import OSQPBackend
 from rmpc.qp.proxqp_backend import ProxQPBackend
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
-__all__ = ["BACKENDS", "make_backend"]
+__all__ = ["BACKENDS", "backend_design", "make_backend"]
 
 #: Name -> back-end class. ``"cvxpy"`` is the reference (slow; for tests and benchmarks).
 BACKENDS: dict[str, type[QPBackend]] = {
@@ -52,3 +52,24 @@ def make_backend(name: str, *, argument: str = "name", **settings: Any) -> QPBac
     if key not in BACKENDS:
         raise InvalidArgumentError(argument, f"one of {', '.join(repr(k) for k in BACKENDS)}", repr(name))
     return BACKENDS[key](**settings)
+
+
+def backend_design(backend: QPBackend) -> dict[str, Any]:
+    """A controller's QP back-end as a saved design writes it: ``{"backend": name,
+    "solver_options": settings}``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming ``backend`` for a back-end that is not one of :data:`BACKENDS`' classes (a saved
+        design rebuilds the back-end by name).
+    """
+    import dataclasses
+
+    if BACKENDS.get(backend.name) is not type(backend):
+        raise InvalidArgumentError(
+            "backend",
+            f"one of the toolkit's QP back-ends ({', '.join(BACKENDS)}) to save the controller",
+            type(backend).__name__,
+        )
+    return {"backend": backend.name, "solver_options": dataclasses.asdict(backend.settings)}
