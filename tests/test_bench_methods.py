@@ -247,3 +247,39 @@ def test_switching_runs_push_by_the_disturbance_box():
     assert 0.0 < pushed["final_norm"] <= 7 * np.hypot(0.1, 0.2) + 1e-12
     with pytest.raises(InvalidArgumentError, match="w_max"):
         switching_runs(Zero(), plant, [0.0, 0.0], steps=1, runs=1, seed=0, w_max=[-0.1, 0.1])
+
+
+def test_the_satellites_are_pushed_by_a_gravity_gradient_sized_torque():
+    """Paper M's orbit (650 km: n = 1.071540e-3 rad/s) and paper P's inertias spread by +-30 %:
+    ``3 n^2 (J_max - J_min) / 2``, entering through the nominal input matrix."""
+    from benchmarks.suites.methods_problems import gravity_gradient_bound
+
+    n = 1.071540e-3
+    assert gravity_gradient_bound(np.array([2.0, 3.0])) == pytest.approx(1.5 * n**2, rel=1e-6)
+    p = build_problem("paper_p_2v")
+    j = np.array([1.2928, 4.2953])
+    assert p.w_box == pytest.approx(np.full(3, 1.5 * n**2 * (1.3 * j[1] - 0.7 * j[0])), rel=1e-4)
+    assert p.w_matrix.shape == (6, 3)
+    e, w_max = p.disturbance  # the disturbance form keeps its own design bound
+    assert w_max == pytest.approx(0.05) and e.shape == (6, 3)
+
+
+def test_switching_runs_push_through_the_disturbance_matrix():
+    from models import PolytopicModel
+    from rmpc.mpc.switching_runs import switching_runs
+
+    plant = PolytopicModel([(np.eye(2), np.ones((2, 1)))], dt=1.0)
+
+    class Zero:
+        last = None
+
+        def reset(self):
+            pass
+
+        def step(self, x):
+            return np.zeros(1)
+
+    out = switching_runs(Zero(), plant, [0.0, 0.0], steps=5, runs=1, seed=1, w_max=[0.3], E=[[0.0], [1.0]],
+                         state_constraints=(np.array([[1.0, 0.0], [-1.0, 0.0]]), [0.0, 0.0]))
+    assert out["state_violations"] == 0  # the first state is never pushed
+    assert 0.0 < out["final_norm"] <= 1.5 + 1e-12

@@ -518,7 +518,7 @@ def _violations(ctrl: Any, problem: MethodsProblem, steps: int, settings: Method
             break
         run = switching_runs(ctrl, problem.plant, problem.x0, steps=steps, runs=1, seed=settings.seed + r,
                              u_max=float(problem.u_max), state_constraints=state, Q=problem.Q, R=problem.R,
-                             w_max=problem.w_box)
+                             w_max=problem.w_box, E=problem.w_matrix)
         out["violations"] += run["violations"]
         out["violations_input"] += run["input_violations"]
         out["violations_state"] += run["state_violations"]

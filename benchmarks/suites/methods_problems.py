@@ -17,11 +17,13 @@ import numpy as np
 
 __all__ = [
     "DISTURBANCE_FRACTION",
+    "GRAVITY_GRADIENT_ALTITUDE",
     "PROBLEMS",
     "SHORT_PROBLEMS",
     "SUITE_CHOICES",
     "MethodsProblem",
     "build_problem",
+    "gravity_gradient_bound",
 ]
 
 #: The disturbance of the "disturbance" method: ``E`` = the nominal ``B`` (an input-channel
@@ -56,9 +58,13 @@ class MethodsProblem:
     output_matrix, y_max : ndarray or None
         Output bounds ``|C x| <= y_max``, where the problem has them.
     w_box : ndarray or None
-        An additive disturbance ``x+ = A x + B u + w``, ``|w_i| <= w_box_i`` (the tube's ``W``, the
-        violation runs' pushes and, as the ellipsoid ``||w|| <= ||w_box||``, the "disturbance"
-        method's bound), where the problem has one.
+        An additive disturbance ``x+ = A x + B u + E d``, ``|d_i| <= w_box_i``, where the problem has
+        one: the violation runs push by it; with ``w_matrix`` ``None`` (``E = I``, a box ``W`` in the
+        state space) it is also the tube's ``W`` and, as the ellipsoid ``||w|| <= ||w_box||``, the
+        "disturbance" method's bound.
+    w_matrix : ndarray or None
+        ``E`` (``None``: the identity); the satellites' torque disturbance enters through the
+        nominal input matrix.
     """
 
     name: str
@@ -77,6 +83,7 @@ class MethodsProblem:
     y_max: np.ndarray | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
     w_box: np.ndarray | None = None
+    w_matrix: np.ndarray | None = None
 
     @property
     def n_states(self) -> int:
@@ -87,7 +94,7 @@ class MethodsProblem:
     def disturbance(self) -> tuple[np.ndarray, float]:
         """``(E, w_max)`` of the "disturbance" method: the nominal ``B`` and a fraction of ``u_max``;
         with an additive box ``w_box``, ``E = I`` and the ball around the box."""
-        if self.w_box is not None:
+        if self.w_box is not None and self.w_matrix is None:
             return np.eye(self.n_states), float(np.linalg.norm(self.w_box))
         return np.asarray(self.plant.nominal[1]), DISTURBANCE_FRACTION * float(self.u_max)
 
@@ -186,6 +193,10 @@ def _paper_p(mode: str) -> MethodsProblem:
     plant = sat.polytope(x0, dt=defaults.DT, spread=defaults.SPREAD, mode=mode)
     s = defaults.CONTROLLER_DEFAULTS["RMPC"]
     n_v = plant.n_vertices
+    inertias = np.diag(np.asarray(sat.inertia, dtype=float))
+    torque = gravity_gradient_bound(
+        np.concatenate([inertias * (1 - defaults.SPREAD), inertias * (1 + defaults.SPREAD)])
+    )
     return MethodsProblem(
         name=f"paper_p_{n_v}v",
         title=f"Paper P's rigid satellite, inertia +-{defaults.SPREAD:g} ({mode!r}, {n_v} vertices)",
@@ -199,7 +210,25 @@ def _paper_p(mode: str) -> MethodsProblem:
         true_plant=plant.nominal,
         steps=150,
         region_scale=np.array([1.0, 1.0, 1.0, 0.1, 0.1, 0.1]),
+        w_box=np.full(3, torque),
+        w_matrix=np.asarray(plant.nominal[1], dtype=float),
     )
+
+
+#: The orbit of the gravity-gradient torque bound of the satellites' violation runs: the 650 km
+#: circular orbit of Paper M (:data:`models.mrp.satellite.PAPER_M_ALTITUDE`; paper P states none).
+GRAVITY_GRADIENT_ALTITUDE: float = 650e3
+
+
+def gravity_gradient_bound(inertias: np.ndarray, altitude: float = GRAVITY_GRADIENT_ALTITUDE) -> float:
+    """The largest gravity-gradient torque on a body of principal inertias ``inertias`` (kg m^2,
+    every vertex's): ``|3 n^2 c x (J c)| <= 3 n^2 (J_max - J_min) / 2`` over unit nadir directions
+    ``c`` (``n`` the circular orbit's mean motion at ``altitude``), per axis at most that."""
+    from models.mrp.satellite import EARTH_MU, EARTH_RADIUS
+
+    n = float(np.sqrt(EARTH_MU / (EARTH_RADIUS + altitude) ** 3))
+    j = np.asarray(inertias, dtype=float)
+    return 1.5 * n**2 * float(np.max(j) - np.min(j))
 
 
 def _paper_w() -> MethodsProblem:

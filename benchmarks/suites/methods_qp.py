@@ -119,7 +119,8 @@ def qp_method(
 
     comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
     if method in ("tube", "tube_tightening"):
-        if problem.w_box is None or problem.plant.n_vertices != 1 or problem.output_matrix is None:
+        if (problem.w_box is None or problem.w_matrix is not None or problem.plant.n_vertices != 1
+                or problem.output_matrix is None):
             return None, ("tube MPC takes one plant with an additive disturbance set W and a state "
                           "polytope; this problem is a polytope of plants without W (on paper P's "
                           "6-state satellite the mRPI approximation needs 169 terms: not built)"), True, {}

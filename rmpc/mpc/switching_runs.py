@@ -55,6 +55,7 @@ def switching_runs(
     Q: ArrayLike | None = None,
     R: ArrayLike | None = None,
     w_max: ArrayLike | None = None,
+    E: ArrayLike | None = None,
 ) -> dict[str, Any]:
     """Run ``ctrl`` ``runs`` times for ``steps`` samples on seeded switching vertices of ``plant``.
 
@@ -76,10 +77,13 @@ def switching_runs(
         The state polytope ``H x <= h`` checked at every state after the start.
     Q, R : array_like, optional
         Weights of the closed-loop cost ``sum x'Qx + u'Ru`` (default identities).
-    w_max : (n,) array_like, optional
-        An additive disturbance ``x+ = A_j x + B_j u + w`` with ``w`` a vertex of the box
-        ``|w_i| <= w_max_i`` drawn at every sample (after the vertex sequence of the run, from the
+    w_max : (q,) array_like, optional
+        An additive disturbance ``x+ = A_j x + B_j u + E d`` with ``d`` a vertex of the box
+        ``|d_i| <= w_max_i`` drawn at every sample (after the vertex sequence of the run, from the
         same generator); ``None`` (the default) for none.
+    E : (n, q) array_like, optional
+        How the disturbance enters (default: the identity, ``q = n``; a torque disturbance on a
+        satellite: the input matrix).
 
     Returns
     -------
@@ -104,7 +108,8 @@ def switching_runs(
         h_vec = as_vector(state_constraints[1], "state_constraints h", h_mat.shape[0])
     q = np.eye(n) if Q is None else as_matrix(Q, "Q", (n, n))
     r = np.eye(m) if R is None else as_matrix(R, "R", (m, m))
-    w_box = None if w_max is None else as_vector(w_max, "w_max", n)
+    e_mat = np.eye(n) if E is None else as_matrix(E, "E", (n, None))
+    w_box = None if w_max is None else as_vector(w_max, "w_max", e_mat.shape[1])
     if w_box is not None and not np.all(w_box >= 0.0):
         raise InvalidArgumentError("w_max", "bounds >= 0", repr(w_box.tolist()))
     vertices = [plant.vertex(j) for j in range(plant.n_vertices)]
@@ -117,7 +122,7 @@ def switching_runs(
     for _ in range(runs):
         sequence = rng.integers(0, len(vertices), size=steps)
         pushes = (np.zeros((steps, n)) if w_box is None
-                  else w_box * rng.choice((-1.0, 1.0), size=(steps, n)))
+                  else (w_box * rng.choice((-1.0, 1.0), size=(steps, w_box.size))) @ e_mat.T)
         ctrl.reset()
         x, cost = x_start.copy(), 0.0
         for j, w in zip(sequence, pushes, strict=True):
