@@ -68,3 +68,22 @@ def test_when_kothare_is_at_the_cap_no_region_is_ranked():
     records = [_rec("kothare", t=[64.0, 64.0], capped=True), _rec("vertex", t=[64.0, 64.0], capped=True)]
     (line,) = least_conservative(records)
     assert "largest region (hard bounds): not ranked, the search cap bounds Kothare's region" in line
+
+
+def test_the_families_head_to_head_name_the_winner_by_cost_and_by_time():
+    from benchmarks.suites.methods_report import families_head_to_head
+
+    def rec(problem, method, cost, p50, violations=0):
+        return {"problem": problem, "method": method, "status": "optimal", "closed_loop_cost": cost,
+                "solve_time_p50": p50, "violations": violations, "violation_samples": 10,
+                "comparable": True, "status_counts": {"optimal": 3}}
+
+    lines = families_head_to_head([
+        rec("p", "kothare", 5.0, 2e-3), rec("p", "vertex", 4.0, 3e-3),
+        rec("p", "tube", 4.5, 1e-3, violations=2), rec("p", "multistage", 6.0, 5e-4),
+        rec("q", "kothare", 1.0, 1e-3),  # one family only: no line
+    ])
+    assert len(lines) == 1 and lines[0].startswith("- **p**")
+    assert "LMI: cost 4 (vertex)" in lines[0] and "tube: cost 4.5 (tube)" in lines[0]
+    assert "violations 2 / 10" in lines[0]
+    assert lines[0].endswith("(lowest cost: LMI, fastest: multi-stage).")
