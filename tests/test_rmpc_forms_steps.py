@@ -25,7 +25,6 @@ from models import PolytopicModel
 from rmpc import RMPC, load
 from toolkit_common.errors import ArgumentTypeError, InvalidArgumentError
 
-LMI_RESIDUAL = -1e-8
 AGREE_RTOL = 1e-5
 CLARABEL_ACCURATE = -1e-9
 #: gamma of a form that contains Kothare's answer may exceed Kothare's by the solvers' accuracy only
@@ -72,7 +71,10 @@ def test_optimal_certified_and_the_references_lmis_hold(name, method, options):
     assert sol.status == "optimal" and sol.certificate.ok
     values = steps_values(sol, method, options["horizon"], len(problem["A"]))
     _, _, at = _reference(problem, method, options, at=values)
-    assert at["residual"] >= LMI_RESIDUAL, at["residual"]
+    # the reference's LMIs hold at the answer to the tolerance the toolkit certified it with
+    # (relative margins >= -certificate_tol): -1e-8 promised more than that and measured -2.0e-8 for
+    # shi on example 2 with OPENBLAS_CORETYPE=SandyBridge (-1e-12 on this machine's default BLAS)
+    assert at["residual"] >= -sol.certificate.tol, (at["residual"], sol.certificate.tol)
     status, gamma, var = _reference(problem, method, options)
     if status == "optimal" and var["residual"] >= CLARABEL_ACCURATE:
         assert sol.gamma == pytest.approx(gamma, rel=AGREE_RTOL)
