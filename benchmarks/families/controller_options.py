@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.families.rmpc_forms import raise_at_key_path
 from toolkit_common.errors import ArgumentTypeError, ConfigError, InvalidArgumentError
 
 __all__ = [
@@ -121,17 +122,4 @@ def check_offline_options(settings: Mapping[str, Any], where: str) -> None:
             certificate_tol=settings["certificate_tol"], path=settings["path"],
         )
     except (InvalidArgumentError, ArgumentTypeError) as err:
-        if err.argument in ("backend", "certificate_tol", "path", "solver"):
-            raise ConfigError(f"{where}.{err.argument}", err.expected, err.found) from None
-        if not err.argument.startswith("solver_options"):
-            return  # not the options': the case's own build reports it
-        raise ConfigError(
-            _solver_path(err.argument, f"{where}.solver_options"),
-            f"{err.expected} (backend {settings['backend']!r})", err.found,
-        ) from None
-
-
-def _solver_path(argument: str, where: str) -> str:
-    """``solver_options['max_iter']`` -> ``<where>.max_iter``; ``solver_options`` -> ``<where>``."""
-    inner = re.match(r"^solver_options\[['\"]?(\w+)['\"]?\]$", argument)
-    return f"{where}.{inner.group(1)}" if inner else where
+        raise_at_key_path(err, where, settings["backend"], ("backend", "certificate_tol", "path", "solver"))

@@ -137,7 +137,7 @@ def check_crmpc_options(
     table = settings.get("rmpc_options")
     if table is None and own.get("backend", "ipm") == "ipm":
         return  # nothing the setting checks left unchecked (the wheel's and MRP's backend may be)
-    from benchmarks.families.rmpc_forms import _path
+    from benchmarks.families.rmpc_forms import setting_key_path
     from models import PolytopicModel
     from rmpc.mpc.crmpc import CRMPC
 
@@ -157,6 +157,5 @@ def check_crmpc_options(
         if err.argument in own:  # CRMPC's own setting, passed on to its RMPC (backend = "proxqp")
             expected = f"{err.expected} (the RMPC inside CRMPC)"
             raise ConfigError(f"{where}.{err.argument}", expected, err.found) from None
-        parts = [_path(part, f"{base}.{part.split(' ')[0].split('[')[0]}")
-                 for part in err.argument.split(", ")]
+        parts = [setting_key_path(part, base) for part in err.argument.split(", ")]
         raise ConfigError(", ".join(parts), err.expected, err.found) from None

@@ -78,18 +78,42 @@ def _python_check(where: str, n_states: int, has_output: bool, **options: Any) -
     try:
         return form_options(n_states=n_states, input_constraint="peak", has_output=has_output, **options)
     except (InvalidArgumentError, ArgumentTypeError) as err:
-        raise ConfigError(_path(err.argument, where), err.expected, err.found) from None
+        raise ConfigError(key_path(err.argument, where), err.expected, err.found) from None
 
 
-def _path(argument: str, where: str) -> str:
+def key_path(argument: str, where: str) -> str:
     """The key path of a Python argument: ``soft['u']`` -> ``<where>.u``, ``soft['u'][1]`` ->
-    ``<where>.u[1]``, ``disturbance E`` -> ``<where>.E``.
+    ``<where>.u[1]``, ``disturbance E`` -> ``<where>.E``, ``solver_options['max_iter']`` ->
+    ``<where>.max_iter``; a bare name -> ``<where>``.
     """
     inner = re.match(r"^\w+(?:\[['\"]?(\w+)['\"]?\](\[\d+\])?| (\w+))?$", argument)
     if inner is None:
         return where
     part = inner.group(1) or inner.group(3)
     return f"{where}.{part}{inner.group(2) or ''}" if part else where
+
+
+def setting_key_path(part: str, where: str) -> str:
+    """The key path of one argument named in a constructor's error, under the table ``where``
+    (``soft['u']`` -> ``<where>.soft.u``, ``horizon`` -> ``<where>.horizon``)."""
+    return key_path(part, f"{where}.{part.split(' ')[0].split('[')[0]}")
+
+
+def raise_at_key_path(err: InvalidArgumentError | ArgumentTypeError, where: str, backend: Any,
+                      direct: tuple[str, ...]) -> None:
+    """Re-raise a stand-in constructor's error at the sweep file's key path.
+
+    An argument in ``direct`` is ``<where>.<argument>``; a solver option is
+    ``<where>.solver_options.<name>`` (the message names ``backend``); any other error returns
+    (the case's own build reports it).
+    """
+    if err.argument in direct:
+        raise ConfigError(f"{where}.{err.argument}", err.expected, err.found) from None
+    if not err.argument.startswith("solver_options"):
+        return
+    raise ConfigError(
+        key_path(err.argument, f"{where}.solver_options"), f"{err.expected} (backend {backend!r})", err.found,
+    ) from None
 
 
 def _lyapunov(value: Any, where: str, n: int, out: bool) -> str:
@@ -183,15 +207,8 @@ def check_solver_options(settings: Mapping[str, Any], n_states: int, where: str)
              backend=settings["backend"], solver=solver,
              solver_options=None if options is None else dict(options), **outputs, **form)
     except (InvalidArgumentError, ArgumentTypeError) as err:
-        if err.argument in ("solver", "output_matrix", "y_max", "backend"):
-            # backend: a family's choices are shared with its QP controller's ("proxqp")
-            raise ConfigError(f"{where}.{err.argument}", err.expected, err.found) from None
-        if not err.argument.startswith("solver_options"):
-            return  # not the options': the case's own build reports it
-        raise ConfigError(
-            _path(err.argument, f"{where}.solver_options"),
-            f"{err.expected} (backend {settings['backend']!r})", err.found,
-        ) from None
+        # backend: a family's choices are shared with its QP controller's ("proxqp")
+        raise_at_key_path(err, where, settings["backend"], ("solver", "output_matrix", "y_max", "backend"))
 
 
 def _output_matrix(value: Any, where: str, n: int, out: bool) -> tuple[tuple[float, ...], ...]:
@@ -362,7 +379,7 @@ class RMPCForms:
                 if part == "input_constraint":
                     parts.append(f"{where}.input_constraint" if constrained else name("saturation"))
                 else:
-                    parts.append(_path(part, f"{where}.{part.split(' ')[0].split('[')[0]}"))
+                    parts.append(setting_key_path(part, where))
             expected = err.expected
             if not constrained and ("u_max" in expected or "input_constraint" in err.argument):
                 expected += " (the controller has an input bound with saturation = 'constraint')"
