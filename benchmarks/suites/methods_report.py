@@ -416,6 +416,15 @@ def write_methods_report(
         "bounds), its fastest solve p50 and its bound violations over the seeded runs. The families "
         "assume different uncertainty (see above), so a win is on this problem's terms only.",
         "",
+        *(
+            [
+                "No measurement: a smoke run's short horizons and few runs check the set-up; the lines "
+                "below are what it measured, not a comparison of the families.",
+                "",
+            ]
+            if short
+            else []
+        ),
         *(families_head_to_head(records) or ["(one family ran on every problem)"]),
         "",
     ]
