@@ -1,8 +1,11 @@
-"""Measure tube MPC's targets on the double integrator (python -m dev.tube_targets [--runs N]).
+"""Measure tube MPC's targets (python -m dev.tube_targets [--runs N] [--problem NAME]).
 
 Zero constraint violations over 1,000 seeded 50-step disturbance sequences and a QP solve p50 of
-at most 1 ms, for both kinds and each QP back-end asked for; prints the measured figures, the
-machine's load and the share of the state box the tube's QP is feasible from.
+at most 1 ms on the double integrator, for both kinds and each QP back-end asked for; prints the
+measured figures, the machine's load and the share of the state box the tube's QP is feasible
+from. ``--problem paper_p_hold``: the tightening on paper P's satellite holding attitude under a
+gravity-gradient torque through B (the methods bench's problem; the box is paper P's start
+attitude and 0.05 rad/s, the rigid tube refuses the flat disturbance).
 """
 
 from __future__ import annotations
@@ -24,15 +27,28 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seed", type=int, default=2005)
     parser.add_argument("--kinds", nargs="+", default=["rigid", "tightening"])
     parser.add_argument("--backends", nargs="+", default=["clarabel"])
+    parser.add_argument("--problem", choices=["double_integrator", "paper_p_hold"],
+                        default="double_integrator")
     args = parser.parse_args(argv)
-    problem = double_integrator()
-    for kind in args.kinds:
+    if args.problem == "paper_p_hold":
+        from benchmarks.suites.methods_problems import HOLD_FRACTION, build_problem
+
+        p = build_problem("paper_p_hold")
+        plant = p.true_plant
+        options = {"Q": p.Q, "R": p.R, "horizon": 9, "u_max": p.u_max, "w_max": p.w_box, "E": p.w_matrix}
+        box = np.concatenate([np.abs(p.x0[:3]) / HOLD_FRACTION, [0.05] * 3])    # paper P's start
+        kinds = [k for k in args.kinds if k == "tightening"]
+    else:
+        problem = double_integrator()
+        plant, options, box = (problem["A"], problem["B"]), problem["controller"], np.array([10.0, 10.0])
+        kinds = args.kinds
+    for kind in kinds:
         for backend in args.backends:
             start = time.perf_counter()
-            tube = TubeMPC((problem["A"], problem["B"]), **problem["controller"], kind=kind, backend=backend)
+            tube = TubeMPC(plant, **options, kind=kind, backend=backend)
             design = time.perf_counter() - start
             rng = np.random.default_rng(args.seed)
-            x0s, share = feasible_initial_states(tube, [10.0, 10.0], args.runs, rng)
+            x0s, share = feasible_initial_states(tube, box, args.runs, rng)
             load = os.getloadavg()[0]
             runs = disturbance_runs(tube, x0s, steps=args.steps, rng=rng)
             p50, p95 = np.percentile(runs.solve_times, [50, 95]) * 1e3

@@ -134,7 +134,7 @@ def test_save_and_load_design_nothing(tube: TubeMPC, tmp_path, monkeypatch) -> N
     def no_design(*args, **kwargs):
         raise AssertionError("loading designed a set")
 
-    for name in ("mrpi_outer", "mrpi_parameters", "admissible_set", "reachable_tightening"):
+    for name in ("mrpi_outer", "mrpi_support_bound", "admissible_set", "reachable_tightening"):
         monkeypatch.setattr(tube_module, name, no_design)
     loaded = load(path)
     assert loaded.kind == tube.kind and loaded.name == tube.name
@@ -194,3 +194,74 @@ def test_other_arguments() -> None:
         make(state_constraints=(np.eye(3), np.ones(3)))
     with pytest.raises(InvalidArgumentError, match="epsilon"):
         make(epsilon=0.0)
+
+
+# -- a flat disturbance on a six-state satellite -------------------------------------------------
+@pytest.fixture(scope="module")
+def satellite():
+    """Paper P's satellite holding attitude under a gravity-gradient torque through B (the
+    methods bench's ``paper_p_hold``): ``E W`` is flat (rank 3 in six states)."""
+    from benchmarks.suites.methods_problems import build_problem
+
+    p = build_problem("paper_p_hold")
+    a, b = p.true_plant
+    tube = TubeMPC((a, b), p.Q, p.R, horizon=9, kind="tightening", u_max=p.u_max, w_max=p.w_box,
+                   E=p.w_matrix)
+    return p, tube
+
+
+def _lp_max(c: np.ndarray, H: np.ndarray, h: np.ndarray) -> float:
+    from scipy.optimize import linprog
+
+    res = linprog(-c, A_ub=H, b_ub=h, bounds=[(None, None)] * H.shape[1], method="highs")
+    assert res.status == 0, res.message
+    return float(-res.fun)
+
+
+def test_satellite_terminal_set_is_robustly_invariant_and_admissible(satellite) -> None:
+    """Checked by LPs row by row (no vertex of the 6-D set is enumerated): ``A_K X_f + A_K^N E W
+    in X_f`` (the shifted plan's terminal state stays in it) and ``X_f`` inside the input bound
+    tightened by ``F_N``, both with ``E W``'s support summed over the torque box's corners."""
+    p, tube = satellite
+    K, N, E = tube.sets.K, tube.N, tube.E
+    A_K = tube.A + tube.B @ K
+    H, h = tube.sets.terminal_H, tube.sets.terminal_h
+    corners = np.array(list(__import__("itertools").product(*[[-w, w] for w in p.w_box])))
+    push = corners @ E.T @ np.linalg.matrix_power(A_K, N).T          # A_K^N E w at the corners
+    for i in range(h.size):
+        assert _lp_max(A_K.T @ H[i], H, h) + (push @ H[i]).max() <= h[i] + 1e-9 * max(1.0, abs(h[i]))
+    f_n = np.zeros(2 * K.shape[0])                                   # h_{F_N}(+-K rows)
+    power = np.eye(6)
+    rows = np.vstack([K, -K])
+    for _ in range(N):
+        f_n += (corners @ E.T @ power.T @ rows.T).max(axis=0)
+        power = A_K @ power
+    for r, row in enumerate(rows):
+        assert _lp_max(row, H, h) <= p.u_max - f_n[r] + 1e-9
+
+
+def test_satellite_tightening_has_no_violation_over_seeded_torque_sequences(satellite) -> None:
+    p, tube = satellite
+    rng = np.random.default_rng(41)
+    starts = p.x0 * rng.uniform(0.2, 1.0, size=(6, 1))
+    out = disturbance_runs(tube, starts, steps=60, rng=rng)
+    assert out.failed_steps == 0 and out.violations == 0, out.statuses
+    assert out.max_excess < 0.0
+
+
+def test_the_rigid_tube_refuses_a_flat_disturbance_naming_E(satellite) -> None:
+    p, tube = satellite
+    with pytest.raises(InvalidArgumentError, match=r"^E: expected for kind='rigid'.*rank 3 for 6 states"):
+        TubeMPC((tube.A, tube.B), p.Q, p.R, horizon=9, kind="rigid", u_max=p.u_max, w_max=p.w_box,
+                E=p.w_matrix)
+    with pytest.raises(InvalidArgumentError, match="E"):
+        TubeMPC((tube.A, tube.B), p.Q, p.R, kind="tightening", u_max=p.u_max, w_max=p.w_box,
+                E=np.ones((5, 3)))
+
+
+def test_satellite_tube_saves_and_loads_its_disturbance_matrix(satellite, tmp_path) -> None:
+    p, tube = satellite
+    loaded = load(tube.save(tmp_path / "sat.rmpc"))
+    assert np.array_equal(loaded.E, tube.E)
+    tube.reset()
+    assert np.allclose(loaded.step(p.x0), tube.step(p.x0), atol=1e-8)

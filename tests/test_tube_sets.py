@@ -177,3 +177,67 @@ def test_a_cddlib_failure_is_a_toolkit_error_naming_the_set(monkeypatch) -> None
 def test_a_sum_too_large_is_refused_before_it_is_built() -> None:
     with pytest.raises(ValueError, match="W: expected a Minkowski sum of at most max_vertices = 10"):
         mrpi_outer(A_K, Polytope.box([0.1, 0.1]), epsilon=1e-3, max_vertices=10)
+
+
+# -- the minimal RPI set's support without a set, a flat disturbance ------------------------------
+@pytest.mark.parametrize("E", [None, np.array([[0.0], [1.0]])], ids=["box W", "flat E W"])
+def test_mrpi_support_bound_brackets_the_minimal_rpi_set(E) -> None:
+    """``h_{F_s} <= h_{F_inf} <= bound <= h_{F_s} + epsilon``, with ``h_{F_inf}`` summed directly
+    over 600 terms (``A_K^600`` is below 1e-30); a flat ``E W`` (the disturbance on the second
+    state only) is taken as a full one."""
+    from rmpc.sets import mrpi_support_bound
+
+    rng = np.random.default_rng(7)
+    rows = np.vstack([np.eye(2), -np.eye(2), rng.normal(size=(20, 2))])
+    W = Polytope.box([0.1]) if E is not None else Polytope.box([0.1, 0.1])
+    for eps in (1e-2, 1e-5):
+        bound, s = mrpi_support_bound(A_K, W, rows, eps, E=E)
+        sums = reachable_tightening(A_K, W, rows, 600, E=E)
+        assert (sums[600] <= bound + 1e-12).all()          # an upper bound of F_inf's support
+        assert (bound <= sums[s] + eps + 1e-12).all()      # within epsilon of F_s's
+        assert (bound - sums[600] <= eps + 1e-12).all()
+    if E is None:      # and no looser than Rakovic et al.'s outer approximation at that accuracy
+        approx = mrpi_outer(A_K, W, epsilon=1e-5)
+        bound, _ = mrpi_support_bound(A_K, W, rows, 1e-5)
+        assert (bound <= approx.Z.support(rows) + 1e-5).all()
+
+
+def test_admissible_set_by_lps_is_irredundant_bounded_or_refused() -> None:
+    from rmpc.sets import admissible_set
+    from toolkit_common.errors import InvalidArgumentError
+
+    G = np.vstack([K, -K, np.eye(2), -np.eye(2)])
+    g = np.concatenate([[1.0, 1.0], [10.0] * 4])
+    Xf = admissible_set(A_K, G, lambda j: g)
+    assert np.allclose(np.linalg.norm(Xf.H, axis=1), 1.0)
+    for i in range(Xf.h.size):      # dropping any row enlarges the set
+        others = np.delete(np.arange(Xf.h.size), i)
+        res = linprog(-Xf.H[i], A_ub=Xf.H[others], b_ub=Xf.h[others], bounds=[(None, None)] * 2)
+        assert res.status == 3 or -res.fun > Xf.h[i] + 1e-9
+    # the same set as the vertex-based check: invariant and admissible at its vertices
+    assert (Xf.vertices @ A_K.T @ Xf.H.T <= Xf.h + 1e-9).all()
+    assert (np.abs(Xf.vertices @ K.T) <= 1.0 + 1e-9).all()
+    with pytest.raises(InvalidArgumentError, match="terminal set: expected a bounded set"):
+        admissible_set(0.5 * np.eye(2), np.array([[1.0, 0.0], [-1.0, 0.0]]), lambda j: np.ones(2))
+
+
+def test_lyapunov_ellipsoid_is_invariant_and_fits_its_constraints() -> None:
+    """The ellipsoid that stops the tightening's terminal set: ``||L' A z|| <= rate ||L' z||``
+    with ``rate < 1`` on random states, and the largest radius inside the rows touches one of
+    them (its support, by the ellipsoid's points, equals the bound there)."""
+    from rmpc.sets import LyapunovEllipsoid
+
+    shape = LyapunovEllipsoid.of(A_K)
+    rng = np.random.default_rng(3)
+    z = rng.normal(size=(500, 2))
+    assert shape.rate < 1.0
+    assert (np.linalg.norm(z @ A_K.T @ shape.L, axis=1)
+            <= shape.rate * np.linalg.norm(z @ shape.L, axis=1) + 1e-12).all()
+    G = np.vstack([K, -K, np.eye(2)])
+    g = np.array([1.0, 1.0, 3.0, 0.5])
+    radius = shape.largest_inside(G, g)
+    angles = np.linspace(0.0, 2.0 * np.pi, 20001)
+    circle = np.column_stack([np.cos(angles), np.sin(angles)])
+    points = radius * np.linalg.solve(shape.L.T, circle.T).T          # ||L' z|| = radius
+    reach = (points @ G.T).max(axis=0)
+    assert (reach <= g + 1e-12).all() and np.isclose((reach / g).max(), 1.0, rtol=1e-6)

@@ -1,6 +1,7 @@
 """Tube MPC for linear plants with additive bounded disturbances: rigid tube and tightening.
 
-The plant is ``x+ = A x + B u + w`` with ``w`` in a polytope ``W`` (origin inside), states in
+The plant is ``x+ = A x + B u + E w`` with ``w`` in a polytope ``W`` (origin inside; ``E = I``
+unless given, e.g. the input matrix for a torque disturbance), states in
 ``X = {H_x x <= h_x}`` and inputs in ``U = {H_u u <= h_u}``. The input is ``u = K x + c``
 around a disturbance-rejection gain ``K`` (``A_K = A + B K`` Schur stable; LQR on ``(A, B, Q,
 R)`` by default), and a QP chooses the nominal prediction ``z_(i+1) = A_K z_i + B c_i``:
@@ -18,7 +19,9 @@ R)`` by default), and a QP chooses the nominal prediction ``z_(i+1) = A_K z_i + 
     control with restricted constraints", Automatica 37(7), 2001. ``z_0 = x``; the constraints
     at step ``i`` are tightened by the reachable set ``F_i = W + A_K W + ... + A_K^(i-1) W`` of
     the error (:func:`rmpc.sets.reachable_tightening`) and ``z_N`` lies in the admissible set of
-    the constraints tightened by ``F_(N+j)``, ``j >= 0``; the plant gets ``u = K x + c_0``.
+    the constraints tightened by ``F_(N+j)``, ``j >= 0``; the plant gets ``u = K x + c_0``. Only
+    support functions are evaluated and only LPs solved, so ``E W`` may be flat (a torque through
+    the input matrix of a six-state satellite) and the state space large.
 
 The cost is ``sum_{i<N} z_i' Q z_i + v_i' R v_i + z_N' P z_N`` with ``P`` the Lyapunov matrix
 of ``A_K`` (the Riccati solution when ``K`` is LQR's). The terminal set ``X_f`` is the maximal
@@ -46,7 +49,7 @@ from rmpc.qp import QP, QPBackend, make_backend
 from rmpc.sets.invariant import (
     admissible_set,
     mrpi_outer,
-    mrpi_parameters,
+    mrpi_support_bound,
     reachable_tightening,
 )
 from rmpc.sets.polytope import Polytope
@@ -64,6 +67,9 @@ MAX_HORIZON = 200
 #: least absolute): beyond it the step is a ``"bound_violation"``. The back-ends' default
 #: tolerances are 1e-8 to 1e-10.
 ROW_TOL = 1e-6
+#: The most prediction steps beyond the horizon the tightening's terminal set may need (its
+#: construction stops earlier: measured 9 on the double integrator, see docs/tube_mpc.rst).
+TERMINAL_STEPS = 2000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -148,6 +154,11 @@ class TubeMPC(Saveable):
         Box bounds ``|u_i| <= u_max_i``, ``|x_i| <= x_max_i``.
     w_max : float or array_like, optional
         The box ``W = {|w_i| <= w_max_i}``.
+    E : (n, q) array_like, optional
+        The disturbance's input matrix (``x+ = A x + B u + E w``, ``w`` in ``W`` of ``R^q``; default
+        the identity). A rank below ``n`` makes ``E W`` flat: ``kind="tightening"`` takes it,
+        ``kind="rigid"`` (whose cross-section ``Z`` needs Rakovic et al.'s ``A^s W in alpha W``)
+        refuses it naming ``E``.
     kind : {"rigid", "tightening"}
         The formulation (see the module's description).
     state_constraints, input_constraints, disturbance_set : (H, h) pair, optional
@@ -156,7 +167,9 @@ class TubeMPC(Saveable):
     K : (m, n) array_like, optional
         The disturbance-rejection gain, ``A + B K`` Schur stable (default: LQR on ``(A, B, Q, R)``).
     epsilon : float
-        The accuracy of the rigid tube's mRPI approximation (infinity norm, default 1e-3).
+        The accuracy of the rigid tube's mRPI approximation (infinity norm, default 1e-3); for
+        the tightening, of the bound on the minimal RPI set's support that stops the terminal
+        set's construction (:func:`rmpc.sets.mrpi_support_bound`).
     backend : {"proxqp", "osqp", "clarabel", "cvxpy"} or QPBackend
         The QP back-end (default ``"clarabel"``: on the double integrator's rigid tube, OSQP and
         ProxQP failed on feasible QPs near the edge of the feasible set (iteration limits, a
@@ -178,7 +191,9 @@ class TubeMPC(Saveable):
         The state and input constraints as ``(H, h, names)``: all rows ``H x <= h`` (boxes
         first) and the argument names they came from.
     W : Polytope
-        The disturbance set.
+        The disturbance set (in the space of ``w``).
+    E : (n, q) ndarray
+        The disturbance's input matrix.
     last : StepInfo or None
         The back-end's status (``"bound_violation"`` when an answer breaks its rows), the solve
         time, ``fallback`` and ``extra`` (``z0``, ``c``, ``objective``, ``backend``, ``raw_status``).
@@ -190,8 +205,8 @@ class TubeMPC(Saveable):
         ``disturbance_set``), ``K`` not stabilising, constraints that the tightening empties
         (``state_constraints`` / ``input_constraints``, or ``x_max`` / ``u_max``), wrong shapes.
     PolytopeError
-        When cddlib's floating-point arithmetic gives up on a set (seen on a six-state terminal
-        set); the message names the set.
+        When cddlib's floating-point arithmetic gives up on a set (the rigid tube's Minkowski
+        sums); the message names the set.
 
     Notes
     -----
@@ -230,6 +245,7 @@ class TubeMPC(Saveable):
         input_constraints: tuple[ArrayLike, ArrayLike] | None = None,
         disturbance_set: tuple[ArrayLike, ArrayLike] | None = None,
         K: ArrayLike | None = None,
+        E: ArrayLike | None = None,
         epsilon: float = 1e-3,
         backend: str | QPBackend = "clarabel",
         solver_options: Mapping[str, Any] | None = None,
@@ -248,11 +264,13 @@ class TubeMPC(Saveable):
             raise InvalidArgumentError("disturbance_set", "None when w_max is given (one W)", "both given")
         if w_max is None and disturbance_set is None:
             raise InvalidArgumentError("w_max", "the disturbance bound (or disturbance_set)", "neither given")
+        self.E = np.eye(n) if E is None else as_matrix(E, "E", (n, None))
+        q = self.E.shape[1]
         if w_max is not None:
-            wH, wh = _box_rows(w_max, "w_max", n)
+            wH, wh = _box_rows(w_max, "w_max", q)
             w_name = "w_max"
         else:
-            wH, wh = _as_constraints(disturbance_set, "disturbance_set", n)
+            wH, wh = _as_constraints(disturbance_set, "disturbance_set", q)
             w_name = "disturbance_set"
         W = Polytope(wH, wh, w_name)
         if not W.contains_origin_inside():
@@ -312,7 +330,7 @@ class TubeMPC(Saveable):
         gb = np.concatenate([hx, hu])
         N = self.N
         if self.kind == "rigid":
-            approx = mrpi_outer(A_K, self.W, self.epsilon)
+            approx = mrpi_outer(A_K, self._state_disturbance(), self.epsilon)
             Z = approx.Z
             t_x, t_u = Z.support(Hx), Z.support(Hu @ k)
             self._check_left("X - Z", x_name, hx - t_x, Hx)
@@ -321,20 +339,33 @@ class TubeMPC(Saveable):
             terminal = admissible_set(A_K, G, lambda j: rhs, name="terminal set")
             return TubeSets(k, P, Z.H.copy(), Z.h.copy(), np.tile(t_x, (N, 1)), np.tile(t_u, (N, 1)),
                             terminal.H.copy(), terminal.h.copy(), approx.alpha, approx.s)
-        # Chisci et al.: tightening by F_i, terminal set for F_(N+j); the tail is the admissible
-        # set of the constraints tightened by the mRPI outer approximation (which holds every F_i),
-        # through its support function only (no Minkowski sum is built)
-        alpha, s, _ = mrpi_parameters(A_K, self.W, self.epsilon)
-        t_all = reachable_tightening(A_K, self.W, G, s)[s] / (1.0 - alpha)
+        # Chisci et al.: tightening by F_i, terminal set for F_(N+j); its construction stops once
+        # the set is mapped into an ellipsoid inside the constraints tightened by a bound of the
+        # minimal RPI set's support (support functions and LPs only: no set is built)
+        t_all, s = mrpi_support_bound(A_K, self.W, G, self.epsilon, E=self.E)
         self._check_left("X - F_inf", x_name, hx - t_all[: len(hx)], Hx)
         self._check_left("U - K F_inf", u_name, hu - t_all[len(hx):], Hu)
-        tail = admissible_set(A_K, G, lambda j: gb - t_all, name="terminal set")
-        steps = N + 400
-        tight = reachable_tightening(A_K, self.W, G, steps)
-        terminal = admissible_set(A_K, G, lambda j: gb - tight[min(N + j, steps)], tail=tail,
-                                  name="terminal set", max_steps=400)
+        steps = N + TERMINAL_STEPS
+        tight = reachable_tightening(A_K, self.W, G, steps, E=self.E)
+        terminal = admissible_set(A_K, G, lambda j: gb - tight[N + j], g_limit=gb - t_all,
+                                  name="terminal set", max_steps=TERMINAL_STEPS)
         return TubeSets(k, P, None, None, tight[:N, : len(hx)], tight[:N, len(hx):],
-                        terminal.H.copy(), terminal.h.copy(), alpha, s)
+                        terminal.H.copy(), terminal.h.copy(), float("nan"), s)
+
+    def _state_disturbance(self) -> Polytope:
+        """``E W`` as a polytope of the state space (the rigid tube's Minkowski sums need one
+        with the origin in its interior)."""
+        n = self.A.shape[0]
+        if self.E.shape == (n, n) and np.array_equal(self.E, np.eye(n)):
+            return self.W
+        rank = int(np.linalg.matrix_rank(self.E))
+        if rank < n:
+            raise InvalidArgumentError(
+                "E", "for kind='rigid', a disturbance E w with the origin in the interior of E W "
+                "(E of rank n; kind='tightening' takes a flat E W)",
+                f"E of rank {rank} for {n} states",
+            )
+        return Polytope.from_vertices(self.W.vertices @ self.E.T, "E W")
 
     @staticmethod
     def _check_left(what: str, name: str, left: np.ndarray, rows: np.ndarray) -> None:
@@ -476,7 +507,7 @@ class TubeMPC(Saveable):
             "A": self.A, "B": self.B, "Q": self.Q, "R": self.R, "horizon": self.N, "kind": self.kind,
             "state_constraints": [self.X[0], self.X[1], self.X[2]],
             "input_constraints": [self.U[0], self.U[1], self.U[2]],
-            "disturbance_set": [self.W.H, self.W.h, self.W.name], "epsilon": self.epsilon,
+            "disturbance_set": [self.W.H, self.W.h, self.W.name], "E": self.E, "epsilon": self.epsilon,
             **saved_backend,
             "max_horizon": self._limit, "sets": sets,
         }, "TubeMPC design")
@@ -503,7 +534,9 @@ class TubeMPC(Saveable):
             return H, part.array("h", 1), raw[2]
 
         ctrl.X, ctrl.U = triple("state_constraints", n), triple("input_constraints", m)
-        wH, wh, wname = triple("disturbance_set", n)
+        saved_e = design.optional_array("E", 2)
+        ctrl.E = np.eye(n) if saved_e is None else as_matrix(saved_e, "design.E", (n, None))
+        wH, wh, wname = triple("disturbance_set", ctrl.E.shape[1])
         ctrl.W = Polytope(wH, wh, wname)
         ctrl.backend = cls._backend(design.text("backend"), design.mapping("solver_options"))
         part = design.part("sets")

@@ -112,7 +112,7 @@ def disturbance_runs(
     if not isinstance(rng, np.random.Generator):
         raise ArgumentTypeError("rng", "a numpy.random.Generator (seeded)", type(rng).__name__)
     x0s = np.atleast_2d(np.asarray(initial_states, dtype=float))
-    A, B, W = controller.A, controller.B, controller.W
+    A, B, W = controller.A, controller.B, controller.W      # x+ = A x + B u + E w, w in W
     (Hx, hx, _), (Hu, hu, _) = controller.X, controller.U
     tol_x, tol_u = VIOLATION_TOL * np.maximum(1.0, np.abs(hx)), VIOLATION_TOL * np.maximum(1.0, np.abs(hu))
     out = RunSummary(runs=len(x0s), steps=steps)
@@ -132,7 +132,7 @@ def disturbance_runs(
             out.max_excess = max(out.max_excess, float(ex))
             out.violations += bool(np.any(Hx @ x - hx > tol_x) or np.any(Hu @ u - hu > tol_u))
             cost += float(x @ controller.Q @ x + u @ controller.R @ u)
-            x = A @ x + B @ u + w[k]
+            x = A @ x + B @ u + controller.E @ w[k]
         ex = np.max(Hx @ x - hx, initial=-np.inf)
         out.max_excess = max(out.max_excess, float(ex))
         out.violations += bool(np.any(Hx @ x - hx > tol_x))

@@ -11,22 +11,26 @@ Examples
 """
 
 from rmpc.sets.invariant import (
+    LyapunovEllipsoid,
     MRPIApproximation,
     admissible_set,
     mrpi_outer,
     mrpi_parameters,
+    mrpi_support_bound,
     reachable_tightening,
     schur_radius,
 )
 from rmpc.sets.polytope import Polytope, PolytopeError
 
 __all__ = [
+    "LyapunovEllipsoid",
     "MRPIApproximation",
     "Polytope",
     "PolytopeError",
     "admissible_set",
     "mrpi_outer",
     "mrpi_parameters",
+    "mrpi_support_bound",
     "reachable_tightening",
     "schur_radius",
 ]

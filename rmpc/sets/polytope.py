@@ -112,9 +112,9 @@ class Polytope:
         if vertices.shape[0] < n + 1 or np.linalg.matrix_rank(spread, tol=1e-10) < n:
             raise InvalidArgumentError(name, f"a full-dimensional polytope in R^{n}", "a flat set")
         self.H, self.h = _canonical_rows(h_mat, h_vec)
-        self.vertices = vertices
+        self._vertices: np.ndarray | None = vertices
         self.name = name
-        for arr in (self.H, self.h, self.vertices):
+        for arr in (self.H, self.h, vertices):
             arr.setflags(write=False)
 
     # -- constructors --------------------------------------------------------------------
@@ -159,12 +159,34 @@ class Polytope:
         if verts[0, 0] == verts[-1, 0] and n == 1:
             raise InvalidArgumentError(name, "points spanning R^1", "a single point")
         poly = cls.__new__(cls)
-        poly.H, poly.h, poly.vertices, poly.name = rows, (verts @ rows.T).max(axis=0), verts, name
-        for arr in (poly.H, poly.h, poly.vertices):
+        poly.H, poly.h, poly._vertices, poly.name = rows, (verts @ rows.T).max(axis=0), verts, name
+        for arr in (poly.H, poly.h, verts):
+            arr.setflags(write=False)
+        return poly
+
+    @classmethod
+    def from_irredundant(cls, H: ArrayLike, h: ArrayLike, name: str = "polytope") -> Polytope:
+        """A polytope from rows its caller has already made irredundant and whose set it knows
+        to be bounded and full-dimensional (an admissible set built by LPs): nothing is checked
+        and the vertices are enumerated by cddlib only when asked for. In six or more dimensions
+        with hundreds of rows that enumeration is what is slow (or where cddlib's floating point
+        gives up), and the tube's QP needs only the rows."""
+        poly = cls.__new__(cls)
+        poly.H = np.array(as_matrix(H, f"{name} (H)"), dtype=float)
+        poly.h = np.array(as_vector(h, f"{name} (h)", poly.H.shape[0]), dtype=float)
+        poly._vertices, poly.name = None, name
+        for arr in (poly.H, poly.h):
             arr.setflags(write=False)
         return poly
 
     # -- what a polytope answers -----------------------------------------------------------
+    @property
+    def vertices(self) -> np.ndarray:
+        """The vertices, one per row (enumerated by cddlib on first use where not known)."""
+        if self._vertices is None:
+            self._vertices = Polytope(self.H, self.h, self.name)._vertices
+        return self._vertices
+
     @property
     def dim(self) -> int:
         """The dimension ``n`` of the space."""
