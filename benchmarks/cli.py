@@ -232,13 +232,14 @@ def _cmd_bench_methods(args: argparse.Namespace) -> int:
 
 def _add_methods(bsub: Any) -> None:
     from benchmarks.suites.methods import METHODS
-    from benchmarks.suites.methods_problems import PROBLEMS
+    from benchmarks.suites.methods_problems import PROBLEMS, SHORT_PROBLEMS
 
     methods = bsub.add_parser(
         "methods",
         help="the robust MPC forms head to head on the field's test problems",
         description="Solve every test problem (Kothare's examples 1 and 2, MUP's demo system, paper P's "
-        "satellite at 2 and 8 vertices, paper W's wheel satellite, the 14-state flexible model) with every "
+        "satellite at 2 and 8 vertices and holding attitude under a gravity-gradient torque, paper W's wheel "
+        "satellite, the 14-state flexible model, the double integrator of the tube literature) with every "
         "method (" + ", ".join(METHODS) + "): gamma at the start state, the feasible region along "
         "fixed directions, the closed-loop cost, bound violations over seeded switching runs, solve times "
         "next to cvxpy + Clarabel, statuses. Writes "
@@ -248,7 +249,8 @@ def _add_methods(bsub: Any) -> None:
     )
     methods.add_argument("--out", required=True, type=_out_dir, metavar="DIR", help="output directory")
     methods.add_argument(
-        "--short", action="store_true", help="a smoke run (four small problems, few directions, short loops)"
+        "--short", action="store_true",
+        help=f"a smoke run ({len(SHORT_PROBLEMS)} small problems, few directions, short loops)",
     )
     methods.add_argument(
         "--problems", type=_names, default=None, metavar=",".join(list(PROBLEMS)[:2]) + ",...",

@@ -226,6 +226,18 @@ def test_tube_runs_on_the_double_integrator_and_is_skipped_on_a_polytope(tmp_pat
         assert skipped["status"] == "skipped" and "additive disturbance set W" in skipped["skip_reason"]
 
 
+def test_the_satellite_holding_attitude_runs_the_tightening_and_says_why_not_the_rigid_tube(tmp_path):
+    """paper_p_hold: one plant, a gravity-gradient torque through B (flat in the state space)."""
+    outcome = run_methods(tmp_path, short=True, problems=["paper_p_hold"],
+                          methods=["tube", "tube_tightening"], progress=False)
+    assert not outcome.failures
+    recs = {r["method"]: r for r in outcome.records}
+    tight = recs["tube_tightening"]
+    assert tight["status"] == "optimal" and tight["violations"] == 0 and tight["violation_samples"] > 0
+    assert tight["settings"]["options"]["E"].startswith("the nominal B")
+    assert recs["tube"]["status"] == "skipped" and "3 of 6 state directions" in recs["tube"]["skip_reason"]
+
+
 def test_switching_runs_push_by_the_disturbance_box():
     from models import PolytopicModel
     from rmpc.mpc.switching_runs import switching_runs

@@ -119,18 +119,27 @@ def qp_method(
 
     comparable = problem.input_constraint == "peak" or problem.plant.n_inputs == 1
     if method in ("tube", "tube_tightening"):
-        if (problem.w_box is None or problem.w_matrix is not None or problem.plant.n_vertices != 1
-                or problem.output_matrix is None):
-            return None, ("tube MPC takes one plant with an additive disturbance set W and a state "
-                          "polytope; this problem is a polytope of plants without W (on paper P's "
-                          "6-state satellite the mRPI approximation needs 169 terms: not built)"), True, {}
+        if problem.w_box is None or problem.plant.n_vertices != 1:
+            return None, ("tube MPC takes one plant with an additive disturbance set W; this problem "
+                          "is a polytope of plants" + ("" if problem.w_box is not None else " without W")
+                          ), True, {}
         kind = "rigid" if method == "tube" else "tightening"
+        if kind == "rigid" and problem.w_matrix is not None and (
+                np.linalg.matrix_rank(problem.w_matrix) < problem.n_states):
+            return None, ("the rigid tube's cross-section needs a full-dimensional E W (Rakovic et "
+                          "al.'s A^s W in alpha W); this disturbance enters through "
+                          f"{np.linalg.matrix_rank(problem.w_matrix)} of {problem.n_states} state "
+                          "directions: the tightening (tube_tightening) runs here"), True, {}
         box = state_box(problem)
         ctrl = TubeMPC(problem.true_plant, problem.Q, problem.R, horizon=TUBE_HORIZON, kind=kind,
-                       u_max=float(problem.u_max), state_constraints=box, w_max=problem.w_box)
+                       u_max=float(problem.u_max), state_constraints=box, w_max=problem.w_box,
+                       E=problem.w_matrix)
         options = {"kind": kind, "horizon": TUBE_HORIZON, "u_max": float(problem.u_max),
-                   "w_max": problem.w_box.tolist(), "state_constraints": "|C x| <= y_max",
-                   "backend": "clarabel"}
+                   "w_max": problem.w_box.tolist(), "backend": "clarabel"}
+        if box is not None:
+            options["state_constraints"] = "|C x| <= y_max"
+        if problem.w_matrix is not None:
+            options["E"] = "the nominal B (a torque disturbance)"
         return QPMethod(ctrl), None, comparable, options
     if method == "multistage":
         options = {"horizon": MULTISTAGE_HORIZON, "robust_horizon": 1, "u_max": float(problem.u_max),
