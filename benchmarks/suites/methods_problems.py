@@ -244,7 +244,7 @@ def _paper_p_hold() -> MethodsProblem:
         Q=np.diag(s["Q_diag"]),
         R=np.diag(s["R_diag"]),
         u_max=float(defaults.U_MAX),
-        input_constraint=str(s["input_constraint"]),
+        input_constraint="peak",
         x0=HOLD_FRACTION * np.asarray(x_op, dtype=float),
         true_plant=nominal,
         steps=150,
@@ -252,7 +252,9 @@ def _paper_p_hold() -> MethodsProblem:
         w_box=np.full(3, torque),
         w_matrix=np.asarray(nominal[1], dtype=float),
         notes=("one plant with an additive torque entering through B: the problem of tube MPC; the "
-               "LMI forms' polytope has one vertex",),
+               "LMI forms' polytope has one vertex",
+               "the peak bound |u_l| <= u_max (paper P bounds ||u||_2): the QP families solve the same "
+               "problem, so their costs compare"),
     )
 
 
