@@ -104,9 +104,12 @@ def main(steps: int, names: list[str], verbose: bool = False) -> None:
             if label == "default":
                 hows = {h: r["how"].count(h) for h in sorted(set(r["how"]))}
                 print(f"    searches: {hows}")
-        if "grid" in runs and "default" in runs:
+        if "grid" in runs and "default" in runs and np.any(np.isfinite(runs["grid"]["gamma"])):
             g0, g1 = runs["grid"]["gamma"], runs["default"]["gamma"]
             both = np.isfinite(g0) & np.isfinite(g1)
+            if not both.any():
+                print("  no state certified by both searches")
+                continue
             rel = (g1[both] - g0[both]) / g0[both]
             if verbose:
                 d = runs["default"]
