@@ -144,9 +144,11 @@ def test_the_warm_searchs_solver_holds_the_coefficients_of_the_lam_it_last_solve
     assert not all(np.allclose(solver._coef[j], other[j], rtol=0.0, atol=1e-12) for j in range(len(now)))
 
 
-def fake(prob: FormProblem, objective, infeasible=lambda lam: False) -> list[float]:
+def fake(prob: FormProblem, objective, infeasible=lambda lam: False, slopes: bool = False) -> list[float]:
     """Replace ``prob._solve_at`` by certified answers whose ``gamma`` is ``objective(lam)`` (one real
-    certified answer, its gamma and lam rewritten), ``"infeasible"`` where ``infeasible(lam)``."""
+    certified answer, its gamma and lam rewritten), ``"infeasible"`` where ``infeasible(lam)``; with
+    ``slopes``, each certified answer's ``d gamma / d lam`` too (central differences of ``objective``),
+    as the ipm's dual gives it, else none (the search by values alone)."""
     kw, _, x0 = kothare_ex1()
     real = FormProblem(**{**kw, "disturbance": (kw["disturbance"][0], 0.1, 0.9)}).solve(x0)
     assert real.ok
@@ -154,8 +156,12 @@ def fake(prob: FormProblem, objective, infeasible=lambda lam: False) -> list[flo
 
     def solve_at(x, scale, xs, us, ys, w_max, lam, **kwargs):
         calls.append(lam)
+        prob._last_slope = None
         if infeasible(lam):
             return dataclasses.replace(real, status="infeasible", gamma=math.nan, lam=lam)
+        if slopes:
+            h = 1e-7
+            prob._last_slope = (objective(lam + h) - objective(lam - h)) / (2.0 * h)
         return dataclasses.replace(real, gamma=objective(lam), lam=lam)
 
     prob._solve_at = solve_at  # type: ignore[method-assign]
@@ -166,42 +172,86 @@ def logit(lam: float) -> float:
     return math.log(lam / (1.0 - lam))
 
 
-def test_a_minimum_near_the_previous_lam_is_found_by_the_bracket_and_parabolic_steps():
+@pytest.mark.parametrize("slopes", [False, True])
+def test_a_minimum_near_the_previous_lam_is_found_by_the_bracket_and_refinement(slopes):
     kw, _, x0 = kothare_ex1()
     prob = FormProblem(**kw)
-    calls = fake(prob, lambda lam: 1.0 + (logit(lam) - logit(0.62)) ** 2)
+    calls = fake(prob, lambda lam: 1.0 + (logit(lam) - logit(0.62)) ** 2, slopes=slopes)
     prob._lam_prev = 0.6
     sol = prob.solve(x0)
     assert prob.last_lambda_search.how == "warm" and prob.last_lambda_search.fallback is None
-    assert len(calls) <= 5
+    assert len(calls) <= (3 if slopes else 5)
     assert abs(logit(sol.lam) - logit(0.62)) < 1e-3
     assert prob._lam_prev == sol.lam  # the next state's bracket centre
 
 
-def test_no_interior_minimum_in_the_bracket_falls_back_to_the_full_grid():
+def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
+    """The objective ``1 + 2 (t - c)^2`` (``t`` the log-odds of lam): the first warm search finds
+    ``c`` and keeps the curvature 4; when ``c`` moves by 5e-3, one Newton step from the previous
+    lam lands where the slope is flat: two solves."""
+    kw, _, x0 = kothare_ex1()
+    prob = FormProblem(**kw)
+    centre = [logit(0.62)]
+    calls = fake(prob, lambda lam: 1.0 + 2.0 * (logit(lam) - centre[0]) ** 2, slopes=True)
+    prob._lam_prev = 0.6
+    first = prob.solve(x0)
+    assert prob.last_lambda_search.how == "warm" and len(calls) == 3
+    assert prob._lam_curvature == pytest.approx(4.0, rel=1e-4)
+    assert abs(logit(first.lam) - centre[0]) < 1e-5
+    centre[0] += 5e-3
+    second = prob.solve(x0)
+    assert prob.last_lambda_search.how == "warm" and len(calls) == 3 + 2
+    assert abs(logit(second.lam) - centre[0]) < 1e-5
+
+
+@pytest.mark.parametrize("slopes", [False, True])
+def test_no_interior_minimum_in_the_bracket_falls_back_to_the_full_grid(slopes):
     """The minimum (at lam = 0.97) lies beyond the bracket around lam = 0.2 and its three expansions:
     the full search runs, and finds it."""
     kw, _, x0 = kothare_ex1()
     prob = FormProblem(**kw)
-    calls = fake(prob, lambda lam: 1.0 + (logit(lam) - logit(0.97)) ** 2)
+    calls = fake(prob, lambda lam: 1.0 + (logit(lam) - logit(0.97)) ** 2, slopes=slopes)
     prob._lam_prev = 0.2
     sol = prob.solve(x0)
     rec = prob.last_lambda_search
     assert rec.how == "grid" and "no interior minimum" in rec.fallback
     assert set(LAMBDA_GRID) <= set(calls)
-    assert len(calls) == rec.solves == 6 + FULL  # the bracket (3), its expansions (3), the full search
+    # the previous lam, the first step or both sides, three expansions; then the full search
+    assert len(calls) == rec.solves == (5 if slopes else 6) + FULL
     assert abs(sol.lam - 0.97) < 0.01
 
 
-def test_a_failed_solve_at_the_previous_lam_falls_back_to_the_full_grid():
+@pytest.mark.parametrize("slopes", [False, True])
+def test_a_failed_solve_at_the_previous_lam_falls_back_to_the_full_grid(slopes):
     kw, _, x0 = kothare_ex1()
     prob = FormProblem(**kw)
-    calls = fake(prob, lambda lam: 1.0 + (lam - 0.3) ** 2, infeasible=lambda lam: lam > 0.8)
+    calls = fake(prob, lambda lam: 1.0 + (lam - 0.3) ** 2, infeasible=lambda lam: lam > 0.8, slopes=slopes)
     prob._lam_prev = 0.9
     sol = prob.solve(x0)
     assert prob.last_lambda_search.fallback == "no certified answer at the previous lam 0.9"
     assert calls[0] == pytest.approx(0.9) and set(LAMBDA_GRID) <= set(calls)
     assert sol.ok and abs(sol.lam - 0.3) < 0.01
+
+
+@pytest.mark.parametrize("lam", [0.9, 0.95, 0.985])
+def test_the_slope_from_the_dual_is_the_derivative_of_gamma_in_lam(lam):
+    """The envelope theorem's ``d gamma / d lam`` at an optimum (the ipm's dual blocks against the
+    blocks' derivative in lam) against central differences of gamma, lam given."""
+    kw, _, x0 = kothare_ex1()
+    e_mat, w_max = kw["disturbance"]
+
+    def solve(value: float) -> tuple[float, float | None]:
+        given = {**kw, "disturbance": (e_mat, w_max, value)}
+        prob = FormProblem(**given, solver_options={"tol_gap_rel": 1e-12})
+        sol = prob.solve(x0)
+        assert sol.ok
+        return sol.gamma, prob._last_slope
+
+    h = 1e-4
+    gamma, slope = solve(lam)
+    central = (solve(lam + h)[0] - solve(lam - h)[0]) / (2.0 * h)
+    assert slope is not None and abs(central) > 1e-3 * gamma  # a slope that could be told from zero
+    assert abs(slope - central) <= 1e-3 * abs(central), (slope, central)
 
 
 def test_a_failure_after_a_certified_state_is_a_status_from_the_full_search():
