@@ -98,9 +98,9 @@ _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 class LambdaSearch:
     """What the last search for the disturbance form's contraction factor did.
 
-    ``lams``: the values solved, in order (each one solve); ``how``: ``"warm"`` (the bracket
-    around the previous state's ``lam`` sufficed) or ``"grid"`` (the full search); ``fallback``:
-    why the warm bracket did not suffice, when it was tried.
+    ``lams``: the values solved, in order (each one solve); ``how``: ``"warm"`` (the search from
+    the previous state's ``lam`` sufficed) or ``"grid"`` (the full search); ``fallback``: why the
+    warm search did not suffice, when it was tried.
     """
 
     lams: tuple[float, ...]
@@ -274,8 +274,8 @@ class FormProblem:
         self._check_size(template)
         self._solvers: dict[tuple, Any] = {}
         self._blas = SingleThreadBlas()
-        # the disturbance form's search: the last answer's lam (the next warm bracket's centre),
-        # the blocks lam enters (found on the first retune) and what the last search did
+        # the disturbance form's search: the last answer's lam (the next warm search's start), the
+        # derivative in lam of the blocks it enters (per coordinates) and what the last search did
         self._lam_prev: float | None = None
         self._lam_derivative: tuple[bytes, dict[str, np.ndarray]] | None = None
         # d objective / d lam at the last _solve_at's answer (None unless the ipm's own optimum)
@@ -449,7 +449,7 @@ class FormProblem:
 
     def _search_lambda(self, x: np.ndarray, scale: float, xs: np.ndarray, us: np.ndarray, ys: np.ndarray,
                        w_max: float) -> LMISolution:
-        """The contraction factor with the smallest certified bound: the warm bracket around the
+        """The contraction factor with the smallest certified bound: the warm search from the
         previous state's ``lam`` (:meth:`_warm_bracket`), else the full search (the grid, then
         golden section); :attr:`last_lambda_search` records the ``lam`` solved and why."""
         def solve(lam: float, keep: bool, slot: str | None) -> tuple[LMISolution, float | None]:
