@@ -60,8 +60,11 @@ DIRECT_MIN_VARIABLES = 64
 #: per iteration of each formula (forming ``H``, plus five pairs of products ``P'v``, ``P dx``:
 #: each of the two Newton solves makes one and a half, and one per refinement step, assumed one)
 #: on the forms and Kothare's problems of paper P, paper W, Kothare's example 2 and the 14-state
-#: flexible satellite (26-1184 variables); two runs (14 and 22 cases, load 2.5-3.8 on 2 cores)
-#: gave 201-206, 46-52 and 103-174, with a ``dsyrk`` operation at 0.025 ns and a pair at 4-5 ns.
+#: flexible satellite (26-1184 variables). Three runs (14-22 cases, load 1.4-3.8 on 2 cores) gave
+#: 201-545, 46-103 and 103-842 (a ``dsyrk`` operation at 0.008-0.025 ns, a pair at 4-5 ns): the
+#: terms are correlated and the fit loose, but the choice is not: each run's constants and these
+#: make the same choice on all 22 cases but one where both formulas measure within 10 % (paper
+#: P's vertex form at 2 vertices), and every choice is the faster formula or within 1.3 times it.
 #: The pair loop reads ``G`` at scattered entries and adds into ``H`` one entry at a time, where
 #: ``dsyrk`` streams through cache-blocked panels; forming ``P'`` and its products move ``n m``
 #: doubles through memory. The operation count used before weighed a pair as 4 operations and
