@@ -8,8 +8,8 @@ coefficients kept in the three forms the kernels take: packed (``G``), as their 
 (the ``sp_*`` arrays) and in factored form ``A_ij = D_j N_ij D_j'`` (the ``dict_*`` and ``fe_*``
 arrays, grouped by :func:`factor_groups`). :meth:`BlockData.set_block` replaces a block in
 place; the scaled forms are refreshed before the next iteration (``_refresh``), and
-:data:`DIRECT_MIN_VARIABLES` decides whether the Schur complement is formed from the factored
-coefficients.
+:data:`DIRECT_MIN_VARIABLES` and a cost model (:data:`SCHUR_PAIR_COST`) decide whether the Schur
+complement is formed from the factored coefficients.
 
 Equilibration: ``x = D x~`` with every variable's weighted coefficients of unit Frobenius norm
 over all blocks, and, for badly balanced blocks, block weights ``w_j`` (:func:`block_weights`,
@@ -29,9 +29,10 @@ from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_real_array
 
 __all__ = [
-    "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES", "BlockData", "BlockFactor",
-    "PackedLayout", "block_pairs", "block_weights", "check_block", "check_factor", "concatenate_factors",
-    "concatenate_sparse", "entry_weight", "factor_groups",
+    "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES", "SCHUR_PAIR_COST",
+    "SCHUR_PRODUCT_COST", "SCHUR_STREAM_COST", "BlockData", "BlockFactor", "PackedLayout", "block_pairs",
+    "block_weights", "check_block", "check_factor", "concatenate_factors", "concatenate_sparse",
+    "entry_weight", "factor_groups",
 ]
 
 #: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
@@ -40,14 +41,43 @@ __all__ = [
 BlockFactor = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 #: ``H`` is formed from the factored coefficients (:func:`lmi.ipm.kernels.scaling_and_schur_direct`)
-#: only for more variables than this, and when the operation count says it is cheaper. Below,
-#: the Schur complement is a small part of an iteration: on paper P (61 variables with its
+#: only for more variables than this, and when the cost model (:data:`SCHUR_PAIR_COST`) predicts
+#: it faster. Below, the Schur complement is a small part of an iteration: on paper P (61 variables with its
 #: ellipsoid input bound) both ways measured the same median per solve (3.2-3.3 ms at 2
 #: vertices, 7.3-7.7 ms at 8), and the rows path keeps paper P's records bit-identical (the
 #: direct sum rounds differently; with a peak bound paper P has 67 variables and takes the
 #: direct path). On the 14-state flexible satellite (259 variables, 2 vertices) the direct form
 #: took the warm median from 876 ms to 21 ms (load ~7).
 DIRECT_MIN_VARIABLES = 64
+
+#: The cost model of the choice between the two formulas of the Schur complement
+#: (:meth:`BlockData._direct_is_cheaper`, terms :meth:`BlockData._schur_terms`), in units of one
+#: operation of the rows formula's ``dsyrk``: a pair of factored entries of the direct formula
+#: costs :data:`SCHUR_PAIR_COST`, a multiply-add forming ``P'`` :data:`SCHUR_STREAM_COST`, and an
+#: entry of ``P'`` :data:`SCHUR_PRODUCT_COST` more for the Newton step's products with the formed
+#: ``P`` (the direct path makes them from the sparse coefficients, far cheaper at this scale).
+#: Fitted by relative least squares (``python -m dev.ipm_formula --kernels-only``) to the time
+#: per iteration of each formula (forming ``H``, plus five pairs of products ``P'v``, ``P dx``:
+#: each of the two Newton solves makes one and a half, and one per refinement step, assumed one)
+#: on the forms and Kothare's problems of paper P, paper W, Kothare's example 2 and the 14-state
+#: flexible satellite (26-1184 variables). Three runs (14-22 cases, load 1.4-3.8 on 2 cores) gave
+#: 201-545, 46-103 and 103-842 (a ``dsyrk`` operation at 0.008-0.025 ns, a pair at 4-5 ns): the
+#: terms are correlated and the fit loose, but the choice is not: each run's constants and these
+#: make the same choice on all 22 cases but one where both formulas measure within 10 % (paper
+#: P's vertex form at 2 vertices), and every choice is the faster formula or within 1.3 times it.
+#: The pair loop reads ``G`` at scattered entries and adds into ``H`` one entry at a time, where
+#: ``dsyrk`` streams through cache-blocked panels; forming ``P'`` and its products move ``n m``
+#: doubles through memory. The operation count used before weighed a pair as 4 operations and
+#: took the direct formula where it formed ``H`` up to 6 times slower (the free-move form of the
+#: flexible satellite at ``horizon=2``: 1.0 s against 0.17 s). The choice is unchanged for
+#: Kothare's problems (their vertex blocks, factored and grouped, give few pairs: ``H`` in 1.2 ms
+#: against 19 ms on the flexible satellite) and for every problem of at most
+#: :data:`DIRECT_MIN_VARIABLES` variables.
+SCHUR_PAIR_COST = 200.0
+#: See :data:`SCHUR_PAIR_COST`.
+SCHUR_STREAM_COST = 50.0
+#: See :data:`SCHUR_PAIR_COST`.
+SCHUR_PRODUCT_COST = 150.0
 
 
 #: Block equilibration (:func:`block_weights`): the blocks are weighted only when the balancing
@@ -279,18 +309,39 @@ class BlockData:
             var, p, q, val = var[order], p[order], q[order], val[order]
         return dmat, var, p, q, val * entry_weight(p, q)
 
-    def _direct_is_cheaper(self) -> bool:
-        """Whether forming ``H`` from the factored coefficients costs fewer operations than
-        forming ``P`` and ``P'P``."""
-        n = self.n
-        direct, rows = 0.0, 0.0
+    def _schur_terms(self) -> dict[str, float]:
+        """The terms of the cost model of :meth:`_direct_is_cheaper` (counts, not seconds).
+
+        ``pairs``: the pairs of factored entries the direct formula visits (``e(e + 1)/2`` per
+        group of ``e`` entries, once per member of the group); ``dictionary``: the products
+        ``K D`` and ``(K D)'(K D)`` (``k^2 d + k d^2`` per block); ``stream``: the rows formula's
+        contiguous multiply-adds forming ``P'`` (each coefficient entry and each position pair's
+        packed basis over its block's rows, and the zeroing of ``P'``); ``syrk``: the ``n^2 m``
+        operations of the ``dsyrk`` forming ``P'P`` (``m`` the packed size); ``products``: the ``n m``
+        entries of ``P'`` the Newton step's products read when ``P`` is formed."""
+        n, size = float(self.n), float(self._layout.size)
+        grp_off, grp_blk = self._groups
+        pairs = 0.0
+        for g in range(grp_off.shape[0] - 1):
+            entries = float(self._fact_parts[int(grp_blk[grp_off[g]])][1].shape[0])
+            pairs += float(grp_off[g + 1] - grp_off[g]) * entries * (entries + 1.0) / 2.0
+        dictionary, stream = 0.0, n * size
         for j, k in enumerate(self.block_orders):
-            dmat, var = self._fact_parts[j][0], self._fact_parts[j][1]
-            d = dmat.shape[1]
-            size = k * (k + 1) // 2
-            direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
-            rows += self._sparse_parts[j][1].shape[0] * size + size * n * n
-        return n > DIRECT_MIN_VARIABLES and direct < rows
+            d = float(self._fact_parts[j][0].shape[1])
+            rows = float(k * (k + 1) // 2)
+            dictionary += k * k * d + k * d * d
+            stream += (self._sparse_parts[j][1].shape[0] + self._sparse_parts[j][4].shape[0]) * rows
+        return {"pairs": pairs, "dictionary": dictionary, "stream": stream, "syrk": n * n * size,
+                "products": n * size}
+
+    def _direct_is_cheaper(self) -> bool:
+        """Whether forming ``H`` from the factored coefficients is predicted to take less time than
+        forming ``P'`` and ``P'P`` and using ``P`` in the step (the model of
+        :data:`SCHUR_PAIR_COST`), for more than :data:`DIRECT_MIN_VARIABLES` variables."""
+        t = self._schur_terms()
+        direct = SCHUR_PAIR_COST * t["pairs"] + t["dictionary"]
+        rows = SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"]
+        return self.n > DIRECT_MIN_VARIABLES and direct < rows
 
 
 def block_weights(coefs: Sequence[np.ndarray], copies: Sequence[int] | None = None) -> np.ndarray:

@@ -1,0 +1,98 @@
+"""The choice between the direct and the rows formula of the Schur complement
+(:meth:`lmi.ipm.blocks.BlockData._direct_is_cheaper`, its cost model
+:data:`~lmi.ipm.blocks.SCHUR_PAIR_COST`, :data:`~lmi.ipm.blocks.SCHUR_STREAM_COST`).
+
+* the free-move (steps) form of the 14-state flexible satellite at ``horizon=2`` and paper W's
+  vertex and steps forms take the rows formula, where the operation count used before took the
+  direct one (measured per warm solve, ``python -m dev.ipm_formula``: 3.9 s direct against
+  0.39 s rows on the flexible satellite, 50 ms against 33 ms on paper W's vertex form);
+* Kothare's problems keep the choice they had: the rows formula on paper P at 2 and 8 vertices
+  with its ellipsoid bound (61 variables, below :data:`~lmi.ipm.blocks.DIRECT_MIN_VARIABLES`), the
+  direct one with a peak bound (67 variables), on paper W and on the flexible satellite, whose
+  factored vertex blocks are summed as one group; so do the forms where the direct formula
+  measured faster (paper P's vertex form at 8 vertices, Shi, Su & Chu's form at 2 vertices).
+
+Deterministic: the choice depends on the problem's structure only (no timing).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.suites.methods_problems import build_problem
+from lmi.ipm import BlockLMISolver
+from rmpc import RMPC
+
+
+def operation_count_choice(solver: BlockLMISolver) -> bool:
+    """The choice before the cost model: the operation count ``2 e^2 + k^2 d + k d^2`` per block
+    (``e`` factored entries, dictionary ``k x d``) against ``e_rows m_j + m_j n^2`` (``e_rows``
+    sparse entries, ``m_j`` the block's packed size), direct above 64 variables when smaller."""
+    direct = rows = 0.0
+    for j, k in enumerate(solver.block_orders):
+        dmat, var = solver._fact_parts[j][0], solver._fact_parts[j][1]
+        d = dmat.shape[1]
+        size = k * (k + 1) // 2
+        direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
+        rows += solver._sparse_parts[j][1].shape[0] * size + size * solver.n ** 2
+    return solver.n > 64 and direct < rows
+
+
+def solver_of(name: str, input_constraint: str | None = None, **options) -> BlockLMISolver:
+    """The interior-point solver of the problem ``name`` of the methods bench with ``options``,
+    its data set up (``_refresh``: the variable scaling and the choice) at the start state."""
+    p = build_problem(name)
+    kwargs = {"input_constraint": input_constraint or p.input_constraint, "backend": "ipm", **options}
+    ctrl = RMPC(p.plant, p.Q, p.R, u_max=p.u_max, **kwargs)
+    prob = ctrl.problem
+    if hasattr(prob, "_solvers"):  # a form: its solver is built by the first solve
+        scale = float(np.linalg.norm(p.x0))
+        fd = prob._form_data(p.x0 / scale, prob.data.u_max / scale, prob.data.y_max / scale, 0.0, 1.0)
+        solver = BlockLMISolver(prob._c, prob._symbolic(fd).solver_blocks(), load_kernels=False)
+    else:
+        solver = prob._backend._solver
+    solver._refresh()
+    return solver
+
+
+@pytest.mark.parametrize(("name", "options", "variables"), [
+    ("flexible_8v", {"horizon": 2}, 295),
+    ("paper_w", {"horizon": 2}, 91),
+    ("paper_w", {"lyapunov": "vertex"}, 187),
+])
+def test_forms_whose_direct_formula_measured_slower_take_the_rows_formula(name, options, variables):
+    """The operation count took the direct formula here (the first assertion); the cost model
+    takes the rows one, measured 2.5-10 times faster per formation of ``H``."""
+    solver = solver_of(name, **options)
+    assert solver.n == variables
+    assert operation_count_choice(solver)
+    assert not solver._direct
+
+
+@pytest.mark.parametrize(("name", "input_constraint", "variables", "direct"), [
+    ("paper_p_2v", "ellipsoid", 61, False),
+    ("paper_p_8v", "ellipsoid", 61, False),
+    ("paper_p_2v", "peak", 67, True),
+    ("paper_p_8v", "peak", 67, True),
+    ("paper_w", None, 77, True),
+    ("flexible_8v", None, 259, True),
+])
+def test_kothare_problems_keep_their_formula(name, input_constraint, variables, direct):
+    """Kothare's problem (the defaults): the same choice as the operation count made."""
+    solver = solver_of(name, input_constraint)
+    assert solver.n == variables
+    assert solver._direct is direct
+    assert operation_count_choice(solver) is direct
+
+
+@pytest.mark.parametrize(("name", "options"), [
+    ("paper_p_8v", {"lyapunov": "vertex"}),
+    ("paper_p_2v", {"horizon": 3, "lyapunov": "vertex_pairs", "saturation": "auxiliary",
+                    "input_constraint": "peak"}),
+])
+def test_forms_whose_direct_formula_measured_faster_keep_it(name, options):
+    """Where the direct formula formed ``H`` faster (1.6 against 2.2 ms on paper P's vertex form
+    at 8 vertices, 27 against 67 ms on Shi, Su & Chu's form at 2 vertices) it is still taken."""
+    solver = solver_of(name, **options)
+    assert solver._direct
