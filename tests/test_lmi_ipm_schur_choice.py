@@ -4,8 +4,8 @@
 
 * the free-move (steps) form of the 14-state flexible satellite at ``horizon=2`` and paper W's
   vertex and steps forms take the rows formula, where the operation count used before took the
-  direct one (measured per warm solve, ``python -m dev.ipm_formula``: 3.9 s direct against
-  0.39 s rows on the flexible satellite, 50 ms against 33 ms on paper W's vertex form);
+  direct one (measured per warm solve, ``python -m dev.ipm_formula``: 9.0 s direct against
+  3.2 s rows on the flexible satellite, 50 ms against 33 ms on paper W's vertex form);
 * Kothare's problems keep the choice they had: the rows formula on paper P at 2 and 8 vertices
   with its ellipsoid bound (61 variables, below :data:`~lmi.ipm.blocks.DIRECT_MIN_VARIABLES`), the
   direct one with a peak bound (67 variables), on paper W and on the flexible satellite, whose
@@ -21,22 +21,9 @@ import numpy as np
 import pytest
 
 from benchmarks.suites.methods_problems import build_problem
+from dev.ipm_formula import old_rule as operation_count_choice
 from lmi.ipm import BlockLMISolver
 from rmpc import RMPC
-
-
-def operation_count_choice(solver: BlockLMISolver) -> bool:
-    """The choice before the cost model: the operation count ``2 e^2 + k^2 d + k d^2`` per block
-    (``e`` factored entries, dictionary ``k x d``) against ``e_rows m_j + m_j n^2`` (``e_rows``
-    sparse entries, ``m_j`` the block's packed size), direct above 64 variables when smaller."""
-    direct = rows = 0.0
-    for j, k in enumerate(solver.block_orders):
-        dmat, var = solver._fact_parts[j][0], solver._fact_parts[j][1]
-        d = dmat.shape[1]
-        size = k * (k + 1) // 2
-        direct += 2.0 * var.shape[0] ** 2 + k * k * d + k * d * d
-        rows += solver._sparse_parts[j][1].shape[0] * size + size * solver.n ** 2
-    return solver.n > 64 and direct < rows
 
 
 def solver_of(name: str, input_constraint: str | None = None, **options) -> BlockLMISolver:

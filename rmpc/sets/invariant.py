@@ -82,6 +82,16 @@ class MRPIApproximation:
         return self.alpha / (1.0 - self.alpha) * self.M
 
 
+def _check_stable(A: np.ndarray, epsilon: float) -> None:
+    """Refuse ``epsilon <= 0`` and an ``A = A + B K`` that is not Schur stable (named ``K``)."""
+    if not epsilon > 0 or not np.isfinite(epsilon):
+        raise InvalidArgumentError("epsilon", "a finite number > 0", repr(epsilon))
+    rho = schur_radius(A)
+    if rho >= 1.0:
+        raise InvalidArgumentError("K", "a gain with A + B K Schur stable (spectral radius < 1)",
+                                   f"spectral radius {rho:.6g}")
+
+
 def mrpi_parameters(A: np.ndarray, W: Polytope, epsilon: float = 1e-3, s_max: int = 200
                     ) -> tuple[float, int, float]:
     """The ``(alpha, s, M(s))`` of Rakovic et al.'s Algorithm 1: the smallest ``s`` with ``A^s W in
@@ -96,12 +106,7 @@ def mrpi_parameters(A: np.ndarray, W: Polytope, epsilon: float = 1e-3, s_max: in
         or not reached within ``s_max`` terms.
     """
     n = A.shape[0]
-    if not epsilon > 0 or not np.isfinite(epsilon):
-        raise InvalidArgumentError("epsilon", "a finite number > 0", repr(epsilon))
-    rho = schur_radius(A)
-    if rho >= 1.0:
-        raise InvalidArgumentError("K", "a gain with A + B K Schur stable (spectral radius < 1)",
-                                   f"spectral radius {rho:.6g}")
+    _check_stable(A, epsilon)
     if not W.contains_origin_inside():
         raise InvalidArgumentError("W", "a disturbance set with the origin in its interior",
                                    f"min h_i = {float(W.h.min()):.6g}")
@@ -247,12 +252,7 @@ def mrpi_support_bound(A: np.ndarray, W: Polytope, rows: np.ndarray, epsilon: fl
     InvalidArgumentError
         ``A`` not Schur stable (named ``K``), ``epsilon <= 0`` or not reached within ``s_max``.
     """
-    if not epsilon > 0 or not np.isfinite(epsilon):
-        raise InvalidArgumentError("epsilon", "a finite number > 0", repr(epsilon))
-    rho = schur_radius(A)
-    if rho >= 1.0:
-        raise InvalidArgumentError("K", "a gain with A + B K Schur stable (spectral radius < 1)",
-                                   f"spectral radius {rho:.6g}")
+    _check_stable(A, epsilon)
     shape = LyapunovEllipsoid.of(A)
     w_vertices = W.vertices if E is None else W.vertices @ E.T
     radius = float(np.max(np.linalg.norm(w_vertices @ shape.L, axis=1))) / (1.0 - shape.rate)
