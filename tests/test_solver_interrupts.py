@@ -81,6 +81,8 @@ _SCS_DRIVER = textwrap.dedent("""
 
     if sys.argv[1] == "ignore":
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # as in a benchmark worker process
+    else:  # Python's own handler, whatever the parent left (a shell's background job ignores SIGINT)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     x0 = np.array([0.3, -0.2, 0.25, 0.0, 0.0, 0.0])
     poly = RigidSatellite.paper_p().polytope(x0, 0.05, 0.3, "box")
     ctrl = RMPC(poly, np.eye(6), np.eye(3), u_max=1.0, backend="cvxpy", solver="SCS",
@@ -146,6 +148,7 @@ _OFFLINE_SCS_DRIVER = textwrap.dedent("""
     from models import RigidSatellite
     from rmpc import OfflineRMPC
 
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # whatever the parent left
     x0 = np.array([0.3, -0.2, 0.25, 0.0, 0.0, 0.0])
     poly = RigidSatellite.paper_p().polytope(x0, 0.05, 0.3, "box")
     threading.Timer(4.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
