@@ -600,7 +600,11 @@ def test_residuals_match_numpy_formulas(seed):
     z_blocks = [_sym(rng.normal(size=(k, k))) for k in orders]
     x, cvec = rng.normal(size=n), rng.normal(size=n)
     g_mat, h_vec = rng.normal(size=(m, n)), rng.normal(size=m)
-    got = kernels.residuals(_padded(s_blocks), _padded(z_blocks), x, g_mat, h_vec, cvec, *lay.arrays)
+    # G dense: the sparse coefficients (used only when G has no rows) empty
+    no_sparse = (np.zeros(len(orders) + 1, dtype=np.int64), *(np.zeros(0, dtype=np.int64),) * 2, np.zeros(0),
+                 np.zeros(len(orders) + 1, dtype=np.int64), *(np.zeros(0, dtype=np.int64),) * 2)
+    got = kernels.residuals(_padded(s_blocks), _padded(z_blocks), x, g_mat, h_vec, cvec, *lay.arrays,
+                            *no_sparse)
     rd, rp, gap, pcost, dcost, n_rp, n_gx, n_sp, n_rd, n_gtz = got
 
     sp = np.concatenate([_packed_block(s) for s in s_blocks])

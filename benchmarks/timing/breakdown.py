@@ -128,8 +128,9 @@ def replay_iteration(args: tuple) -> dict[str, float]:
                                                                    REPEATS)
         householder = (qr_h, qr_tau)
     parts["Newton step (2 solves, step lengths, update)"] = _median_time(lambda: newton_step(
-        pt, r_fac, *householder, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, *layout,
-        *sparse, s_out, z_out, chol_out, err_limit if not use_qr else np.inf), REPEATS)
+        pt, r_fac, np.zeros(0, dtype=np.int64), *householder, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec,
+        mu, ref_scale, *layout, *sparse, s_out, z_out, chol_out, err_limit if not use_qr else np.inf),
+        REPEATS)
     return parts
 
 

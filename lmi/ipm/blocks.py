@@ -29,8 +29,9 @@ from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import as_real_array
 
 __all__ = [
-    "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES", "SCHUR_PAIR_COST",
-    "SCHUR_PRODUCT_COST", "SCHUR_STREAM_COST", "BlockData", "BlockFactor", "PackedLayout", "block_pairs",
+    "BLOCKWISE_SHARE", "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES",
+    "SCHUR_PAIR_COST", "SCHUR_PRODUCT_COST", "SCHUR_SCATTER_COST", "SCHUR_STREAM_COST", "BlockData",
+    "BlockFactor", "PackedLayout", "arrow_order", "block_pairs", "block_variables",
     "block_weights", "check_block", "check_factor", "concatenate_factors", "concatenate_sparse",
     "entry_weight", "factor_groups",
 ]
@@ -78,6 +79,16 @@ SCHUR_PAIR_COST = 200.0
 SCHUR_STREAM_COST = 50.0
 #: See :data:`SCHUR_PAIR_COST`.
 SCHUR_PRODUCT_COST = 150.0
+#: The blockwise formula's cost of adding one entry of a block's ``P_j'P_j`` into ``H`` (scattered
+#: reads and writes), in the units of :data:`SCHUR_PAIR_COST`.
+SCHUR_SCATTER_COST = 20.0
+#: The blockwise formula (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`) is a candidate only
+#: when its ``dsyrk`` work ``sum_j n_j^2 m_j`` (``n_j`` the variables block ``j`` holds, ``m_j`` its
+#: packed size) is at most this share of the rows formula's ``n^2 m``: the vertex forms, whose
+#: blocks hold one vertex's (or pair's) Lyapunov matrices and the shared variables (0.09 on the
+#: flexible satellite's vertex form over 8 vertices). Kothare's form, whose blocks nearly all hold
+#: every variable, keeps its formula and its records.
+BLOCKWISE_SHARE = 0.5
 
 
 #: Block equilibration (:func:`block_weights`): the blocks are weighted only when the balancing
@@ -186,7 +197,12 @@ class BlockData:
         self._fact: tuple[np.ndarray, ...] = ()
         self._groups: tuple[np.ndarray, np.ndarray] = (np.zeros(1, dtype=np.int64),
                                                        np.zeros(0, dtype=np.int64))
-        self._direct = False
+        # the Schur formula (_choose_formula) and each block's own variables (block_variables)
+        self._formula = "rows"
+        self._arrow: tuple[np.ndarray, np.ndarray] = (np.arange(n, dtype=np.int64),
+                                                      np.zeros(1, dtype=np.int64))
+        self._blockvars: tuple[np.ndarray, np.ndarray, np.ndarray] = block_variables(
+            (np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)))
         self._const: list[np.ndarray] = [const for const, _ in checked]
         for j, (const, coef) in enumerate(checked):
             self._set_checked(j, const, coef)
@@ -275,7 +291,14 @@ class BlockData:
             self._sparse = concatenate_sparse(self._sparse_parts)
             self._fact = concatenate_factors(self._fact_parts, self._kmax)
             self._groups = factor_groups(self._fact_parts, self._factor_raw)
-            self._direct = self._direct_is_cheaper()
+            self._blockvars = block_variables(self._sparse)
+            self._formula = self._choose_formula()
+            self._arrow = arrow_order(self._blockvars, self.n)
+
+    @property
+    def _direct(self) -> bool:
+        """Whether ``H`` is formed from the factored coefficients (the direct formula)."""
+        return self._formula == "direct"
 
     def _copies(self) -> list[int]:
         """Per block, the first block with an equal given factor (itself if none): copies of one
@@ -318,7 +341,10 @@ class BlockData:
         contiguous multiply-adds forming ``P'`` (each coefficient entry and each position pair's
         packed basis over its block's rows, and the zeroing of ``P'``); ``syrk``: the ``n^2 m``
         operations of the ``dsyrk`` forming ``P'P`` (``m`` the packed size); ``products``: the ``n m``
-        entries of ``P'`` the Newton step's products read when ``P`` is formed."""
+        entries of ``P'`` the Newton step's products read when ``P`` is formed; ``block_stream``,
+        ``block_syrk`` and ``scatter``: the blockwise formula's (:meth:`_blockwise_cost`) ``stream``
+        (its ``P_j'`` zeroed over the block's own ``n_j`` variables only), ``sum_j n_j^2 m_j`` and
+        the ``sum_j n_j^2`` additions into ``H``."""
         n, size = float(self.n), float(self._layout.size)
         grp_off, grp_blk = self._groups
         pairs = 0.0
@@ -331,17 +357,106 @@ class BlockData:
             rows = float(k * (k + 1) // 2)
             dictionary += k * k * d + k * d * d
             stream += (self._sparse_parts[j][1].shape[0] + self._sparse_parts[j][4].shape[0]) * rows
+        bv_off = self._blockvars[0]
+        block_stream, block_syrk, scatter = stream - n * size, 0.0, 0.0
+        for j, k in enumerate(self.block_orders):
+            nj, rows = float(bv_off[j + 1] - bv_off[j]), float(k * (k + 1) // 2)
+            block_stream += nj * rows
+            block_syrk += nj * nj * rows
+            scatter += nj * nj
         return {"pairs": pairs, "dictionary": dictionary, "stream": stream, "syrk": n * n * size,
-                "products": n * size}
+                "products": n * size, "block_stream": block_stream, "block_syrk": block_syrk,
+                "scatter": scatter}
+
+    def _formula_costs(self) -> dict[str, float]:
+        """The cost model's prediction per Schur formula (see :data:`SCHUR_PAIR_COST`), in units of
+        one ``dsyrk`` operation: ``rows`` (``P'`` formed, one ``dsyrk``, the step's products with
+        the formed ``P``), ``direct`` (the pair sums) and ``blockwise`` (``P_j'P_j`` on each block's
+        own variables, :func:`lmi.ipm.kernels.scaling_and_schur_blockwise`; its step's products
+        come from the sparse coefficients, as the direct formula's, and are not counted)."""
+        t = self._schur_terms()
+        return {
+            "rows": SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"],
+            "direct": SCHUR_PAIR_COST * t["pairs"] + t["dictionary"],
+            "blockwise": (SCHUR_STREAM_COST * t["block_stream"] + t["block_syrk"]
+                          + SCHUR_SCATTER_COST * t["scatter"]),
+        }
+
+    def _choose_formula(self) -> str:
+        """The Schur formula of the iterations: ``"rows"`` for at most :data:`DIRECT_MIN_VARIABLES`
+        variables; above, the one the cost model (:meth:`_formula_costs`) predicts fastest, the
+        blockwise formula only where its ``dsyrk`` work is at most :data:`BLOCKWISE_SHARE` of the
+        rows formula's (the blocks hold disjoint parts of the variables)."""
+        if self.n <= DIRECT_MIN_VARIABLES:
+            return "rows"
+        costs = self._formula_costs()
+        t = self._schur_terms()
+        if t["block_syrk"] > BLOCKWISE_SHARE * t["syrk"]:
+            costs.pop("blockwise")
+        return min(costs, key=costs.__getitem__)
 
     def _direct_is_cheaper(self) -> bool:
         """Whether forming ``H`` from the factored coefficients is predicted to take less time than
         forming ``P'`` and ``P'P`` and using ``P`` in the step (the model of
         :data:`SCHUR_PAIR_COST`), for more than :data:`DIRECT_MIN_VARIABLES` variables."""
-        t = self._schur_terms()
-        direct = SCHUR_PAIR_COST * t["pairs"] + t["dictionary"]
-        rows = SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"]
-        return self.n > DIRECT_MIN_VARIABLES and direct < rows
+        costs = self._formula_costs()
+        return self.n > DIRECT_MIN_VARIABLES and costs["direct"] < costs["rows"]
+
+
+def block_variables(sparse: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernels' ``bv_off, bv_var, sp_loc`` (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`)
+    from the sparse coefficients' ``sp_off, sp_var``: block ``j``'s variables, ascending, are
+    ``bv_var[bv_off[j]:bv_off[j + 1]]`` and entry ``e``'s variable is ``bv_var[bv_off[j] +
+    sp_loc[e]]``."""
+    sp_off, sp_var = sparse[0], sparse[1]
+    own, loc = [], []
+    for j in range(sp_off.shape[0] - 1):
+        entries = sp_var[sp_off[j]: sp_off[j + 1]]
+        variables = np.unique(entries)
+        own.append(variables)
+        loc.append(np.searchsorted(variables, entries))
+    bv_off = np.cumsum([0, *(v.shape[0] for v in own)]).astype(np.int64)
+    return (bv_off, np.concatenate([np.zeros(0, dtype=np.int64), *own]).astype(np.int64),
+            np.concatenate([np.zeros(0, dtype=np.int64), *loc]).astype(np.int64))
+
+
+def arrow_order(blockvars: tuple[np.ndarray, ...], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A variable order in which ``H`` is a block arrow, for
+    :func:`lmi.ipm.kernels.lapack.arrow_cholesky`: ``(perm, grp_off)``, the groups
+    ``perm[grp_off[g]:grp_off[g + 1]]`` coupled to no other group, the border ``perm[grp_off[-1]:]``.
+
+    ``H_ik`` can be non-zero only if some block holds both variables. The variables held by the
+    same blocks form a class; two classes are coupled when one block holds both. Classes are taken
+    as groups greedily, those coupled to the fewest variables first (the larger first among
+    equals), each one coupled to no group taken before; the rest is the border. In a vertex form
+    each vertex's Lyapunov matrix is a class that only the vertex's own blocks hold: those become
+    the groups, the shared variables (``G``, ``Y``, the bounds) the border.
+    """
+    bv_off, bv_var = blockvars[0], blockvars[1]
+    holders: list[list[int]] = [[] for _ in range(n)]
+    for j in range(bv_off.shape[0] - 1):
+        for i in bv_var[bv_off[j]: bv_off[j + 1]]:
+            holders[int(i)].append(j)
+    classes: dict[tuple[int, ...], list[int]] = {}
+    for i, blocks in enumerate(holders):
+        classes.setdefault(tuple(blocks), []).append(i)
+    block_size = np.diff(bv_off)
+
+    def reach(blocks: tuple[int, ...]) -> int:  # variables coupled to the class (an upper bound)
+        return int(sum(block_size[j] for j in blocks))
+
+    taken_blocks: set[int] = set()
+    groups: list[list[int]] = []
+    border: list[int] = []
+    for blocks in sorted(classes, key=lambda b: (reach(b), -len(classes[b]), b)):
+        if blocks and not taken_blocks.intersection(blocks):
+            groups.append(classes[blocks])
+            taken_blocks.update(blocks)
+        else:
+            border.extend(classes[blocks])
+    grp_off = np.cumsum([0, *(len(g) for g in groups)]).astype(np.int64)
+    perm = np.array([i for g in groups for i in g] + sorted(border), dtype=np.int64)
+    return perm, grp_off
 
 
 def block_weights(coefs: Sequence[np.ndarray], copies: Sequence[int] | None = None) -> np.ndarray:

@@ -328,7 +328,7 @@ class BlockLMISolver(BlockData):
         ``P`` for the rest of a solve: :data:`QR_SWITCH_LATE` on the direct path when the QR
         costs at least :data:`QR_LATE_FLOPS`, :data:`QR_SWITCH` otherwise."""
         qr_flops = 2.0 * self._layout.size * float(self.n) ** 2
-        return QR_SWITCH_LATE if self._direct and qr_flops >= QR_LATE_FLOPS else QR_SWITCH
+        return QR_SWITCH_LATE if self._formula != "rows" and qr_flops >= QR_LATE_FLOPS else QR_SWITCH
 
     def reset_warm_start(self) -> None:
         """Forget the stored warm-start point (the next warm solve starts cold)."""
@@ -583,8 +583,11 @@ class BlockLMISolver(BlockData):
         # (measured: 1e-10 -> 3e-6 relative over the last iterations of some paper-P solves)
         r0 = _kernels.pack(s, *packing) + g_mat @ x - h_vec
         theta = 1.0
-        kk, lam, pt_mat, no_pt, h_mat, h_work, r_fac, qr_h, qr_tau = self._workspace()
+        kk, lam, pt_mat, no_pt, h_mat, h_work, r_fac, qr_h, qr_tau, pt_block, h_block = self._workspace()
         sp = self._sparse
+        # the blockwise formula's products with G come from the sparse coefficients (G "not
+        # formed": no rows), the others' from G itself
+        g_kern = np.zeros((0, self.n)) if self._formula == "blockwise" else g_mat
         s_chol = np.zeros_like(s)
         status = "max_iterations"
         pres = dres = gap = np.inf
@@ -604,7 +607,7 @@ class BlockLMISolver(BlockData):
         debug = _LOG.isEnabledFor(logging.DEBUG)
         for it in range(max_iter + 1):
             rd, rp, gap, pcost, dcost, n_rp, n_gx, n_sp, n_rd, n_gtz = _kernels.residuals(
-                s, z, x, g_mat, h_vec, cvec, *packing)
+                s, z, x, g_kern, h_vec, cvec, *packing, *sp)
             pres = n_rp / max(h_norm, n_gx, n_sp)
             dres = n_rd / max(c_norm, n_gtz)
             rel_gap = gap / max(abs(pcost), abs(dcost), 1e-300)
@@ -616,12 +619,12 @@ class BlockLMISolver(BlockData):
                            dres, gap)
             if agree and pres <= self.tol_feas and dres <= self.tol_feas and (
                 gap <= self.tol_gap_abs or rel_gap <= self.tol_gap_rel
-            ) and _kernels.blocks_within(s, x, rp, g_mat, h_vec, self.tol_feas, *packing):
+            ) and _kernels.blocks_within(s, x, rp, g_kern, h_vec, self.tol_feas, *packing, *sp):
                 status = "optimal"
                 break
             if (stall_point is None and agree and max(pres, dres) <= REDUCED_TOL
                     and min(gap, rel_gap) <= REDUCED_TOL
-                    and _kernels.blocks_within(s, x, rp, g_mat, h_vec, REDUCED_TOL, *packing)):
+                    and _kernels.blocks_within(s, x, rp, g_kern, h_vec, REDUCED_TOL, *packing, *sp)):
                 best = (x, s, z, pres, dres, gap)
             if monitor is not None and (word := monitor(x, s, z)) is not None:
                 status, best = word, None
@@ -669,7 +672,12 @@ class BlockLMISolver(BlockData):
             mu, ref_scale = gap / self.degree, max(c_norm, n_gtz)
             err_limit = STEP_ACCURACY * max(n_rd, self.tol_feas * ref_scale)
             # one compiled call: the scaling, H or P, its factor and the step (kernels.iteration)
-            if self._direct:  # H from the factored coefficients, P formed in the QR phase only
+            if self._formula == "blockwise":  # H block by block, P formed in the QR phase only
+                out = _kernels.blockwise_iteration(
+                    s_chol, z, *packing, *sp, *self._blockvars, *self._arrow, pt_block, h_block, kk, lam,
+                    pt_mat, no_pt, h_mat, h_work, r_fac, qr_h, qr_tau, *no_qr, use_qr, x, theta, r0, rd, rp,
+                    g_kern, h_vec, mu, ref_scale, qr_switch, s_new, z_new, chol_new, err_limit)
+            elif self._direct:  # H from the factored coefficients, P formed in the QR phase only
                 out = _kernels.grouped_iteration(
                     s_chol, z, *packing, *sp, *self._fact, *self._groups, kk, lam, pt_mat, no_pt, h_mat,
                     h_work, r_fac, qr_h, qr_tau, *no_qr, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu,
@@ -720,14 +728,21 @@ class BlockLMISolver(BlockData):
         """The iterations' work arrays, made once per problem size and reused by every solve
         (every entry a kernel reads is written first at each iteration): the NT scalings ``K``
         and ``lambda``, ``P'`` (``n x size``), ``P`` not formed (``n x 0``), ``H``, the
-        factorisation's work array, its factor ``R`` and the Householder factors of ``P``. Fresh
+        factorisation's work array, its factor ``R``, the Householder factors of ``P`` and the
+        blockwise formula's ``P_j'`` and ``P_j'P_j`` (flat, the largest block's sizes). Fresh
         arrays of ``n x size`` cost page faults at their first writes in every solve (measured on
         paper P: about 0.1 ms of a 4 ms warm solve)."""
         n, size, nb, kmax = self.n, self._layout.size, len(self.block_orders), self._kmax
+        bv_off, orders = self._blockvars[0], self._layout.orders
+        own = np.diff(bv_off)
+        block_size = int(np.max(own * (orders * (orders + 1) // 2), initial=0))
+        block_h = int(np.max(own * own, initial=0))
         work = getattr(self, "_work", None)
-        if work is None or work[2].shape != (n, size) or work[0].shape != (nb, kmax, kmax):
+        if (work is None or work[2].shape != (n, size) or work[0].shape != (nb, kmax, kmax)
+                or work[9].shape[0] < block_size or work[10].shape[0] < block_h):
             work = (np.zeros((nb, kmax, kmax)), np.zeros((nb, kmax)), np.zeros((n, size)), np.zeros((n, 0)),
-                    np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, size)), np.zeros(n))
+                    np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, size)), np.zeros(n),
+                    np.zeros(block_size), np.zeros(block_h))
             self._work = work
         return work
 

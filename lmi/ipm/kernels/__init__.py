@@ -46,12 +46,14 @@ if TYPE_CHECKING:
         STEP_LOST_DEFINITENESS,
         STEP_OK,
         STEP_SINGULAR,
+        blockwise_iteration,
         grouped_iteration,
         rows_iteration,
     )
     from lmi.ipm.kernels.notice import compile_notice
     from lmi.ipm.kernels.packed import blocks_within, cholesky_blocks, pack, residuals, unpack
     from lmi.ipm.kernels.schur import (
+        scaling_and_schur_blockwise,
         scaling_and_schur_direct,
         scaling_and_schur_grouped,
         scaling_and_schur_rows,
@@ -62,20 +64,23 @@ if TYPE_CHECKING:
 # the module defining each public name, imported when the name is first looked up
 _EXPORTS = {
     "lmi.ipm.kernels.iteration": (
-        "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "grouped_iteration", "rows_iteration",
+        "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blockwise_iteration", "grouped_iteration",
+        "rows_iteration",
     ),
     "lmi.ipm.kernels.packed": ("blocks_within", "cholesky_blocks", "pack", "residuals", "unpack"),
     "lmi.ipm.kernels.schur": (
-        "scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows",
+        "scaling_and_schur_blockwise", "scaling_and_schur_direct", "scaling_and_schur_grouped",
+        "scaling_and_schur_rows",
     ),
     "lmi.ipm.kernels.notice": ("compile_notice",),
     "lmi.ipm.kernels.step": ("REFINE_STEPS", "newton_step", "smallest_eigenvalue"),
 }
 
 __all__ = [
-    "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blocks_within", "cholesky_blocks",
-    "compile_notice", "grouped_iteration", "newton_step", "pack", "residuals", "rows_iteration",
-    "scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows", "smallest_eigenvalue",
-    "unpack",
+    "REFINE_STEPS", "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blocks_within",
+    "blockwise_iteration", "cholesky_blocks", "compile_notice", "grouped_iteration", "newton_step", "pack",
+    "residuals", "rows_iteration",
+    "scaling_and_schur_blockwise", "scaling_and_schur_direct", "scaling_and_schur_grouped",
+    "scaling_and_schur_rows", "smallest_eigenvalue", "unpack",
 ]
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

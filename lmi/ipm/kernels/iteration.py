@@ -9,6 +9,10 @@ the separate calls the solver made before, in the same order (paper P's closed-l
 are bitwise the same); what goes is the Python between them: scipy's and numpy's wrappers, the
 pivot test in numpy, the copies of the QR factors and the argument checks of several calls.
 
+Three forms of the Schur complement, one kernel each: :func:`rows_iteration` (``P`` formed,
+one ``dsyrk``), :func:`blockwise_iteration` (``P_j'P_j`` per block on its own variables) and
+:func:`grouped_iteration` (from the factored coefficients).
+
 Each returns ``(code, x, theta, alpha_aff, sigma, alpha, use_qr)``: ``code`` is
 :data:`STEP_OK`, a code of :func:`~lmi.ipm.kernels.step.newton_step` (1: step length not
 finite or <= 1e-12, 2: no shortened step kept ``S`` positive definite),
@@ -21,12 +25,19 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from lmi.ipm.kernels.lapack import cholesky_upper, householder_qr, schur_complement
+from lmi.ipm.kernels.lapack import arrow_cholesky, cholesky_upper, householder_qr, schur_complement
 from lmi.ipm.kernels.packed import JIT
-from lmi.ipm.kernels.schur import scaling_and_schur_grouped, scaling_and_schur_rows
+from lmi.ipm.kernels.schur import (
+    scaling_and_schur_blockwise,
+    scaling_and_schur_grouped,
+    scaling_and_schur_rows,
+)
 from lmi.ipm.kernels.step import STEP_INACCURATE, newton_step
 
-__all__ = ["STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "grouped_iteration", "rows_iteration"]
+__all__ = [
+    "STEP_LOST_DEFINITENESS", "STEP_OK", "STEP_SINGULAR", "blockwise_iteration", "grouped_iteration",
+    "rows_iteration",
+]
 
 #: The step was taken.
 STEP_OK = 0
@@ -62,6 +73,7 @@ def _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var
                                                  sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row,
                                                  pair_col, kk, lam, pt):
         return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0
+    no_perm = np.zeros(0, dtype=np.int64)
     if householder_qr(pt, qr_h, qr_tau, r_fac) != 0:
         return STEP_SINGULAR, x, theta, 0.0, 0.0, 0.0
     n = r_fac.shape[0]
@@ -71,7 +83,7 @@ def _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var
         for j in range(i, n):
             if not np.isfinite(r_fac[i, j]):
                 return STEP_SINGULAR, x, theta, 0.0, 0.0, 0.0
-    return newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
+    return newton_step(pt, r_fac, no_perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
                        ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
                        sp_val, pair_off, pair_row, pair_col, s_out, z_out, chol_out, np.inf)
 
@@ -87,14 +99,15 @@ def rows_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, 
     sigma, alpha, use_qr)``, see the module notes. ``h``, ``work``, ``r_fac`` (``(n, n)``),
     ``qr_h`` (``(n, size)``) and ``qr_tau`` (``n``) are workspaces; ``no_qr_h``, ``no_qr_tau``
     empty."""
+    no_perm = np.zeros(0, dtype=np.int64)
     if not scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
                                   sp_pair, sp_val, pair_off, pair_row, pair_col, kk, lam, pt):
         return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
     if not use_qr:
         schur_complement(pt, h)
         if cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
-            out = newton_step(pt, r_fac, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat,
-                              h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
+            out = newton_step(pt, r_fac, no_perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
+                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
                               sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
                               chol_out, err_limit)
             if out[0] != STEP_INACCURATE:
@@ -114,13 +127,45 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
     """One iteration with ``H`` formed from the factored coefficients
     (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_grouped`), ``P`` not formed (``no_pt``
     ``(n, 0)``), until the QR phase, which forms ``P`` in ``pt``; see :func:`rows_iteration`."""
+    no_perm = np.zeros(0, dtype=np.int64)
     if not use_qr:
         if not scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p,
                                          fe_q, fe_val, grp_off, grp_blk, kk, lam, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
         if cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
-            out = newton_step(no_pt, r_fac, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat,
-                              h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
+            out = newton_step(no_pt, r_fac, no_perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
+                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
+                              sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
+                              chol_out, err_limit)
+            if out[0] != STEP_INACCURATE:
+                return out[0], out[1], out[2], out[3], out[4], out[5], False
+    out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+                   pair_off, pair_row, pair_col, kk, lam, pt, False, qr_h, qr_tau, r_fac, x, theta, r0, rd,
+                   rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
+    return out[0], out[1], out[2], out[3], out[4], out[5], True
+
+
+@njit(**JIT)
+def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
+                        sp_val, pair_off, pair_row, pair_col, bv_off, bv_var, sp_loc, perm, arrow_off,
+                        pt_work, hj_work, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
+                        no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch,
+                        s_out, z_out, chol_out, err_limit):
+    """One iteration with ``H`` formed block by block on each block's own variables
+    (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_blockwise`; ``pt_work`` and ``hj_work`` its
+    workspaces), ``P`` not formed (``no_pt`` ``(n, 0)``: the Newton step's products come from the
+    sparse coefficients) until the QR phase, which forms ``P`` in ``pt``; see
+    :func:`rows_iteration`. ``H`` is factored in the variable order ``perm`` as a block arrow
+    (the groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); ``work`` is left
+    holding ``H`` in that order, whose diagonal the pivot test reads."""
+    if not use_qr:
+        if not scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off,
+                                           pair_row, pair_col, bv_off, bv_var, sp_loc, kk, lam, pt_work,
+                                           hj_work, h):
+            return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
+        if arrow_cholesky(h, perm, arrow_off, work, r_fac) == 0 and _factor_ok(work, r_fac, qr_switch):
+            out = newton_step(no_pt, r_fac, perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
+                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
                               sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
                               chol_out, err_limit)
             if out[0] != STEP_INACCURATE:

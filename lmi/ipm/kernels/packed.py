@@ -82,16 +82,20 @@ def cholesky_blocks(mats, orders, out):
 
 
 @njit(**JIT)
-def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, ent_w):
+def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
+              sp_val, pair_off, pair_row, pair_col):
     """Residuals and norms at ``(x, S, Z)``.
 
     Returns ``rd = G'z + c``, ``rp = G x + s - h``, ``gap = s'z``, the primal and dual costs,
-    and the norms of ``rp, G x, s, rd, G'z``.
+    and the norms of ``rp, G x, s, rd, G'z``. ``G`` dense (``g_mat``), or from the sparse
+    coefficients when ``g_mat`` has no rows (:func:`g_times`).
     """
     sp = pack(s, orders, offsets, ent_row, ent_col, ent_w)
     zp = pack(z, orders, offsets, ent_row, ent_col, ent_w)
-    gx = g_mat @ x
-    gtz = g_mat.T @ zp
+    gx = g_times(g_mat, x, orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row,
+                 pair_col)
+    gtz = gt_times(g_mat, zp, x.shape[0], orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+                   pair_row, pair_col)
     rd = gtz + cvec
     rp = gx + sp - h_vec
     gap = float(sp @ zp)
@@ -102,26 +106,72 @@ def residuals(s, z, x, g_mat, h_vec, cvec, orders, offsets, ent_row, ent_col, en
 
 
 @njit(**JIT)
+def _pair_position(offsets, orders, j, a, b):
+    """Packed position of entry ``(a, b)``, ``a <= b``, of block ``j``."""
+    return diagonal_entry(offsets, j, orders[j], a) + b - a
+
+
+@njit(**JIT)
+def g_times(g_mat, x, orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col):
+    """``G x`` (packed ``sum_i x_i A_ij``, scaled): ``g_mat @ x``, or, when ``g_mat`` has no rows
+    (not formed), from the sparse coefficients (one multiply-add per entry, then the packing
+    weights), which is far less work on problems whose blocks hold few of the variables."""
+    if g_mat.shape[0] > 0:
+        return g_mat @ x
+    out = np.zeros(offsets[-1])
+    for j in range(orders.shape[0]):
+        for e in range(sp_off[j], sp_off[j + 1]):
+            q = sp_pair[e]
+            out[_pair_position(offsets, orders, j, pair_row[q], pair_col[q])] += sp_val[e] * x[sp_var[e]]
+    return out * ent_w
+
+
+@njit(**JIT)
+def gt_times(g_mat, v, n, orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row,
+             pair_col):
+    """``G' v`` for a packed ``v``: ``g_mat.T @ v``, or from the sparse coefficients when ``g_mat``
+    has no rows (see :func:`g_times`)."""
+    if g_mat.shape[0] > 0:
+        return g_mat.T @ v
+    out = np.zeros(n)
+    for j in range(orders.shape[0]):
+        for e in range(sp_off[j], sp_off[j + 1]):
+            q = sp_pair[e]
+            t = _pair_position(offsets, orders, j, pair_row[q], pair_col[q])
+            out[sp_var[e]] += sp_val[e] * ent_w[t] * v[t]
+    return out
+
+
+@njit(**JIT)
 def diagonal_entry(offsets, j, k, a):
     """Packed position of entry ``(a, a)`` of block ``j`` (upper triangle, row by row)."""
     return offsets[j] + a * k - (a * (a - 1)) // 2
 
 
 @njit(**JIT)
-def blocks_within(s, x, rp, g_mat, h_vec, tol, orders, offsets, ent_row, ent_col, ent_w):
+def blocks_within(s, x, rp, g_mat, h_vec, tol, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
+                  sp_pair, sp_val, pair_off, pair_row, pair_col):
     """Whether every block's primal residual is within ``tol`` of that block's size:
     ``max |rp_j| <= tol max(max |h_j|, max (|G_j| |x|), max |s_j|)`` (max-norms, so no squares
     underflow for tiny blocks; ``|G_j| |x|``, the magnitudes of the terms of ``G_j x``, so a block
-    whose terms cancel keeps its size). See :meth:`lmi.ipm.BlockLMISolver.solve`."""
+    whose terms cancel keeps its size). ``G`` from the sparse coefficients when ``g_mat`` has no
+    rows (:func:`g_times`). See :meth:`lmi.ipm.BlockLMISolver.solve`."""
     sp = pack(s, orders, offsets, ent_row, ent_col, ent_w)
     n = x.shape[0]
+    sparse_terms = np.zeros(0)
+    if g_mat.shape[0] == 0:
+        sparse_terms = g_times(g_mat, np.abs(x), orders, offsets, ent_w, sp_off, sp_var, sp_pair,
+                               np.abs(sp_val), pair_off, pair_row, pair_col)
     for j in range(orders.shape[0]):
         size = 0.0
         worst = 0.0
         for t in range(offsets[j], offsets[j + 1]):
-            terms = 0.0
-            for i in range(n):
-                terms += abs(g_mat[t, i]) * abs(x[i])
+            if g_mat.shape[0] == 0:
+                terms = sparse_terms[t]
+            else:
+                terms = 0.0
+                for i in range(n):
+                    terms += abs(g_mat[t, i]) * abs(x[i])
             size = max(size, abs(h_vec[t]), terms, abs(sp[t]))
             worst = max(worst, abs(rp[t]))
         if not worst <= tol * size:

@@ -1,8 +1,10 @@
 """Kernels of the NT scaling and the Schur complement ``H = P'P`` (:mod:`lmi.ipm.kernels`).
 
 :func:`scaling_and_schur_rows` forms ``P`` from the sparse coefficients and leaves ``H`` to
-LAPACK; :func:`scaling_and_schur_direct` and :func:`scaling_and_schur_grouped` form ``H`` from
-the factored coefficients, the vertex blocks of a group summed together.
+LAPACK; :func:`scaling_and_schur_blockwise` does the same block by block on each block's own
+variables (``H`` block-arrow shaped: the vertex forms); :func:`scaling_and_schur_direct` and
+:func:`scaling_and_schur_grouped` form ``H`` from the factored coefficients, the vertex blocks of
+a group summed together.
 """
 
 from __future__ import annotations
@@ -10,9 +12,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from lmi.ipm.kernels.lapack import schur_complement
 from lmi.ipm.kernels.packed import JIT
 
-__all__ = ["scaling_and_schur_direct", "scaling_and_schur_grouped", "scaling_and_schur_rows"]
+__all__ = [
+    "scaling_and_schur_blockwise", "scaling_and_schur_direct", "scaling_and_schur_grouped",
+    "scaling_and_schur_rows",
+]
 
 
 @njit(**JIT)
@@ -87,23 +93,72 @@ def scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, 
         k = orders[j]
         if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
             return False
-        kk = np.ascontiguousarray(kk_out[j, :k, :k])  # contiguous, as computed: same rounding
-        kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
         lo, hi = offsets[j], offsets[j + 1]
-        size = hi - lo
-        first = pair_off[j]
-        basis = np.empty((pair_off[j + 1] - first, size))
-        for q in range(first, pair_off[j + 1]):
-            _pair_basis(kt[pair_row[q]], kt[pair_col[q]], pair_row[q] == pair_col[q], k, basis[q - first])
         for i in range(n):
             for t in range(lo, hi):
                 pt_out[i, t] = 0.0
-        for e in range(sp_off[j], sp_off[j + 1]):
-            v = sp_val[e]
-            row = pt_out[sp_var[e]]
-            src = basis[sp_pair[e] - first]
-            for t in range(size):
-                row[lo + t] += v * src[t]
+        _block_rows(kk_out, j, k, hi - lo, pair_off, pair_row, pair_col, sp_off, sp_var, sp_pair, sp_val,
+                    pt_out, lo)
+    return True
+
+
+@njit(**JIT)
+def _block_rows(kk_out, j, k, size, pair_off, pair_row, pair_col, sp_off, sp_row, sp_pair, sp_val, out, col0):
+    """Add block ``j``'s scaled coefficients ``K A_ij K'`` (packed, ``size`` entries) into the rows
+    ``sp_row[e]`` of ``out`` from column ``col0`` on (zeroed by the caller): the packed pair
+    bases of :func:`scaling_and_schur_rows`, then one contiguous multiply-add per coefficient
+    entry, in entry order."""
+    kk = np.ascontiguousarray(kk_out[j, :k, :k])  # contiguous, as computed: same rounding
+    kt = np.ascontiguousarray(kk.T)  # kt[a, p] = K[p, a]
+    first = pair_off[j]
+    basis = np.empty((pair_off[j + 1] - first, size))
+    for q in range(first, pair_off[j + 1]):
+        _pair_basis(kt[pair_row[q]], kt[pair_col[q]], pair_row[q] == pair_col[q], k, basis[q - first])
+    for e in range(sp_off[j], sp_off[j + 1]):
+        v = sp_val[e]
+        row = out[sp_row[e]]
+        src = basis[sp_pair[e] - first]
+        for t in range(size):
+            row[col0 + t] += v * src[t]
+
+
+@njit(**JIT)
+def scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off, pair_row,
+                                pair_col, bv_off, bv_var, sp_loc, kk_out, lam_out, pt_work, h_work, h_out):
+    """NT scaling of every block and ``H = P'P`` formed block by block on each block's own variables.
+
+    Block ``j`` holds only the variables ``bv_var[bv_off[j]:bv_off[j + 1]]`` (``n_j`` of them,
+    ascending; ``sp_loc[e]`` is entry ``e``'s position among them): its rows of ``P'``,
+    ``P_j'`` (``n_j x size_j``), are formed as :func:`scaling_and_schur_rows` forms them, in
+    ``pt_work``, and ``P_j'P_j`` (one ``dsyrk`` into ``h_work``) is added into ``H`` at those
+    variables. The work is ``sum_j n_j^2 size_j`` instead of ``n^2 size``: a vertex form's
+    blocks each hold one vertex's Lyapunov matrix and the shared variables, so that ``H`` is
+    block-arrow shaped (measured on the 14-state flexible satellite over 8 vertices, 1184
+    variables: 1.0e9 instead of 1.06e10 operations). Returns ``False`` if a block lost
+    positive definiteness.
+    """
+    n = h_out.shape[0]
+    for a in range(n):
+        for b in range(n):
+            h_out[a, b] = 0.0
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        if not _nt_block(s_chol, z, j, k, kk_out, lam_out):
+            return False
+        size = offsets[j + 1] - offsets[j]
+        lo = bv_off[j]
+        nj = bv_off[j + 1] - lo
+        if nj == 0:
+            continue
+        ptj = pt_work[: nj * size].reshape((nj, size))
+        ptj[:, :] = 0.0
+        _block_rows(kk_out, j, k, size, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_pair, sp_val, ptj, 0)
+        hj = h_work[: nj * nj].reshape((nj, nj))
+        schur_complement(ptj, hj)
+        for a in range(nj):
+            hrow = h_out[bv_var[lo + a]]
+            for b in range(nj):
+                hrow[bv_var[lo + b]] += hj[a, b]
     return True
 
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, pack_block, unpack_block
+from lmi.ipm.kernels.lapack import triangular_solve_blas
+from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, g_times, pack_block, unpack_block
 
 __all__ = ["REFINE_STEPS", "STEP_INACCURATE", "newton_step", "smallest_eigenvalue"]
 
@@ -98,10 +99,24 @@ def _triangular_solve(r_fac, b):
 
 
 @njit(**JIT)
-def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col, ent_w, sp):
+def _factor_solve(r_fac, perm, b):
+    """``x`` with ``H x = b``: ``R'R x = b`` (``perm`` empty), or, with the factor of ``H`` in the
+    variable order ``perm`` (``R'R = H[perm][:, perm]``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`),
+    ``x[perm] = (R'R)^-1 b[perm]`` by BLAS (``dtrsv``)."""
+    if perm.shape[0] == 0:
+        return _triangular_solve(r_fac, b)
+    y = triangular_solve_blas(r_fac, b[perm])
+    x = np.empty_like(y)
+    x[perm] = y
+    return x
+
+
+@njit(**JIT)
+def _newton(pt, r_fac, perm, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_col, ent_w, sp):
     """Scaled Newton step ``(dx, ds~, dz~, e)`` for the complementarity right-hand side ``u``.
 
-    Solves ``P'P dx = -r_d - P'(u + r~_p)``, ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
+    Solves ``P'P dx = -r_d - P'(u + r~_p)`` (``R'R = P'P``, or with ``perm`` see
+    :func:`_factor_solve`), ``dz~ = P dx + u + r~_p``, ``ds~ = u - dz~``, then
     refines on the exact equation ``P' dz~ = -r_d`` while its residual shrinks; ``e`` is the norm
     of that residual, ``||P' dz~ + r_d||``, at the end. ``sp`` holds the
     sparse coefficients ``(sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col)`` used for the
@@ -110,14 +125,14 @@ def _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row, ent_
     n = rd.shape[0]
     lay = (orders, offsets, ent_row, ent_col, ent_w)
     v = u + rpt
-    dx = _triangular_solve(r_fac, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
+    dx = _factor_solve(r_fac, perm, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
     dzt = _p_times(pt, dx, kk, *lay, *sp) + v
     err = _pt_times(pt, dzt, kk, *lay, *sp, n) + rd
     err_norm = np.linalg.norm(err)
     for _ in range(REFINE_STEPS):
         if err_norm <= 1e-14 * ref_scale:
             break
-        ddx = _triangular_solve(r_fac, -err)
+        ddx = _factor_solve(r_fac, perm, -err)
         dzt_new = dzt + _p_times(pt, ddx, kk, *lay, *sp)
         err_new = _pt_times(pt, dzt_new, kk, *lay, *sp, n) + rd
         new_norm = np.linalg.norm(err_new)
@@ -309,7 +324,7 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
 
 
 @njit(**JIT)
-def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
+def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat, h_vec, mu,
                 ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
                 pair_off, pair_row, pair_col, s_out, z_out, chol_out, err_limit):
     """One predictor-corrector step from ``(x, S, Z)`` (Mehrotra, as in CVXOPT's ``coneqp``).
@@ -326,11 +341,14 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     instead of decaying). If rounding leaves ``Z + alpha dZ`` not positive definite (checked by
     Cholesky), that block is formed through the scaling, positive definite by the step length.
     In the QR phase (``qr_h``, ``qr_tau``: the Householder factors of ``P``, else empty) the
-    Newton equations are solved by :func:`_newton_qr`, otherwise by :func:`_newton`.
+    Newton equations are solved by :func:`_newton_qr`, otherwise by :func:`_newton` with the
+    Cholesky factor ``r_fac`` of ``H`` (of ``H`` in the variable order ``perm`` unless ``perm`` is
+    empty, see :func:`_factor_solve`).
 
     ``pt`` is ``P'`` (``n x size``) when it was formed (QR phase), or ``n x 0`` when only ``H``
     was (:func:`scaling_and_schur_direct`); then the products with ``P`` come from the sparse
-    coefficients ``sp_*``, ``pair_*`` (layout of :func:`scaling_and_schur_rows`).
+    coefficients ``sp_*``, ``pair_*`` (layout of :func:`scaling_and_schur_rows`). So do the
+    products with ``G`` when ``g_mat`` has no rows (:func:`~lmi.ipm.kernels.packed.g_times`).
 
     Outside the QR phase, a corrector whose dual equation is met only to more than
     ``err_limit`` (``||P' dz~ + r_d||``, :func:`_newton`) is not taken: the Cholesky factor of
@@ -359,7 +377,7 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     if qr_h.shape[0] > 0:
         _dx, dsa, dza = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale)
     else:
-        _dx, dsa, dza, _err = _newton(pt, r_fac, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row,
+        _dx, dsa, dza, _err = _newton(pt, r_fac, perm, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row,
                                       ent_col, ent_w, sp)
     alpha_aff = min(1.0, _max_step(lam, dsa, dza, orders, offsets, ent_row, ent_col, ent_w))
     sigma = (1.0 - alpha_aff) ** 3
@@ -380,7 +398,7 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     if qr_h.shape[0] > 0:
         dx, dst, dzt = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u_cor, ref_scale)
     else:
-        dx, dst, dzt, err = _newton(pt, r_fac, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
+        dx, dst, dzt, err = _newton(pt, r_fac, perm, rd, rpt, u_cor, ref_scale, kk, orders, offsets, ent_row,
                                     ent_col, ent_w, sp)
         if not err <= err_limit:
             return STEP_INACCURATE, x, theta, alpha_aff, sigma, 0.0
@@ -391,7 +409,7 @@ def newton_step(pt, r_fac, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat
     for _ in range(6):
         x_new = x + alpha * dx
         theta_new = theta * (1.0 - alpha)
-        s_vec = h_vec - g_mat @ x_new + theta_new * r0
+        s_vec = h_vec - g_times(g_mat, x_new, orders, offsets, ent_w, *sp) + theta_new * r0
         ok = True
         for j in range(nb):
             k = orders[j]
