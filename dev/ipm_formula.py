@@ -8,9 +8,10 @@ Run as ``python -m dev.ipm_formula [CASE ...] [--states N] [--kernels-only]``; a
 :class:`lmi.ipm.BlockLMISolver` forms the Schur complement ``H`` either from the factored
 coefficients (the "direct" formula, :func:`lmi.ipm.kernels.scaling_and_schur_grouped`) or from
 ``P'`` and one ``dsyrk`` (the "rows" formula, :func:`lmi.ipm.kernels.scaling_and_schur_rows`);
-:meth:`lmi.ipm.blocks.BlockData._direct_is_cheaper` chooses. Per case, three controllers are built
+:meth:`lmi.ipm.blocks.BlockData._choose_formula` chooses. Per case, four controllers are built
 (``backend="ipm"``): the choice as the package makes it (``auto``), and each formula forced
-(``BlockData._direct_is_cheaper`` replaced for the run). They solve the same ``N`` states
+(``BlockData._choose_formula`` replaced for the run; the blockwise formula,
+:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`, too). They solve the same ``N`` states
 alternately, state by state, so that they see the same machine load: the closed loop of the
 ``auto`` controller's first move (clipped to the bound) on the true plant from ``x0``, restarted
 from ``0.9^k x0`` when ``||x|| < 0.05 ||x0||``. Printed per case and mode: the median and the
@@ -66,7 +67,7 @@ CASES = (
     "paper_w:kothare", "paper_w:vertex", "paper_w:horizon=2",
     "flexible_8v:kothare", "flexible_8v:horizon=2", "flexible_8v:vertex",
 )
-MODES = ("auto", "direct", "rows")
+MODES = ("auto", "direct", "rows", "blockwise")
 #: Pairs of products ``P'v``, ``P dx`` per iteration in the fit (each of the two Newton solves
 #: makes one and a half, and one more per refinement step: one assumed).
 PRODUCT_PAIRS = 5
@@ -76,14 +77,14 @@ MIN_FIT_CASES = 8
 
 @contextmanager
 def forced(mode: str) -> Iterator[None]:
-    """``BlockData._direct_is_cheaper`` answering ``mode`` (``auto``: unchanged) inside."""
-    original = BlockData._direct_is_cheaper
+    """``BlockData._choose_formula`` answering ``mode`` (``auto``: unchanged) inside."""
+    original = BlockData._choose_formula
     if mode != "auto":
-        BlockData._direct_is_cheaper = lambda self: mode == "direct"  # type: ignore[method-assign]
+        BlockData._choose_formula = lambda self: mode  # type: ignore[method-assign]
     try:
         yield
     finally:
-        BlockData._direct_is_cheaper = original  # type: ignore[method-assign]
+        BlockData._choose_formula = original  # type: ignore[method-assign]
 
 
 def solvers_of(ctrl: Any) -> list[BlockLMISolver]:
@@ -219,7 +220,7 @@ def time_case(case: str, states: int, kernels_only: bool, fits: list[Fit]) -> No
         fits.append((case, terms, grouped, t_dir + PRODUCT_PAIRS * t_sparse,
                      t_rows + PRODUCT_PAIRS * t_formed))
         old = "direct" if old_rule(solver) else "rows"
-        new = "direct" if solver._direct else "rows"
+        new = solver._formula
         print(f"{case:34s} n={solver.n:4d} blocks={len(solver.block_orders):3d} "
               f"size={solver._layout.size:6d} old={old:6s} new={new:6s} H: direct {1e3 * t_dir:8.3f} ms "
               f"rows {1e3 * t_rows:8.3f} ms  products: sparse {1e3 * t_sparse:8.3f} ms "
@@ -229,7 +230,7 @@ def time_case(case: str, states: int, kernels_only: bool, fits: list[Fit]) -> No
         return
     for mode in MODES:
         v = np.array(times[mode])
-        took = ",".join("direct" if s._direct else "rows" for s in solvers_of(ctrls[mode])) or "-"
+        took = ",".join(s._formula for s in solvers_of(ctrls[mode])) or "-"
         if uses_core(ctrls[mode]):
             took += "+ccore"
         print(f"{case:34s} {mode:6s} warm p50 {1e3 * np.median(v):9.2f} ms "
