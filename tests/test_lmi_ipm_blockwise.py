@@ -166,6 +166,24 @@ def test_arrow_order_never_groups_two_classes_a_block_couples():
             assert len(in_groups) <= 1
 
 
+def test_arrow_order_keeps_no_group_when_elimination_saves_little():
+    """One small group beside a large border (a vertex-pair form's structure: every pair block
+    couples two vertices' matrices) gives the given order and no group (one dense factor); the
+    vertex-like structure keeps its groups."""
+    n = 40
+    held = [np.r_[8 * g: 8 * g + 8, 32:40] for g in range(4)]  # 4 groups of 8, a border of 8
+    sp_off = np.cumsum([0, *(h.size for h in held)]).astype(np.int64)
+    blockvars = block_variables((sp_off, np.concatenate(held).astype(np.int64)))
+    perm, grp_off = arrow_order(blockvars, n)
+    assert list(np.diff(grp_off)) == [8, 8, 8, 8]
+    held = [np.arange(0, 2), np.arange(0, n)]  # the 2 private ones beside a border of 38
+    sp_off = np.cumsum([0, *(h.size for h in held)]).astype(np.int64)
+    blockvars = block_variables((sp_off, np.concatenate(held).astype(np.int64)))
+    perm, grp_off = arrow_order(blockvars, n)
+    np.testing.assert_array_equal(perm, np.arange(n))
+    np.testing.assert_array_equal(grp_off, [0])
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_arrow_cholesky_is_the_cholesky_factor_of_the_permuted_matrix(seed):
     """``R`` equals LAPACK's upper Cholesky factor of ``H[perm][:, perm]`` (unique for a definite
