@@ -226,6 +226,7 @@ def _cmd_bench_methods(args: argparse.Namespace) -> int:
         methods=args.methods,
         progress=None if not args.no_progress else False,
         fresh=args.fresh,
+        baseline=args.baseline,
     )
     return _report_suite("methods", outcome, args.out, resumable=True)
 
@@ -260,6 +261,12 @@ def _add_methods(bsub: Any) -> None:
         "--methods", type=_names, default=None, metavar="kothare,vertex,...", help="run only these methods"
     )
     methods.add_argument("--fresh", action="store_true", help="ignore the cases stored by an earlier run")
+    methods.add_argument(
+        "--baseline", default=None, metavar="OLD_DIR",
+        help="an earlier methods run's output directory: the report puts its solve times, iterations "
+        "and time ratios next to this run's, with new/old per problem and method, and flags a "
+        "baseline measured on another machine",
+    )
     methods.add_argument("--no-progress", action="store_true", help="no progress output at all")
     methods.set_defaults(func=_cmd_bench_methods)
 

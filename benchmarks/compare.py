@@ -34,15 +34,24 @@ from benchmarks.core.publish import STAGING_PREFIX
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import check_positive
 
-__all__ = ["compare_records", "compare_runs", "duplicate_identities", "is_run_dependent", "main"]
+__all__ = [
+    "compare_records",
+    "compare_runs",
+    "duplicate_identities",
+    "is_run_dependent",
+    "load_run",
+    "main",
+    "paired_records",
+    "record_identity",
+]
 
 #: Parts of a field name that mark a measurement of time or of the machine.
 _RUN_DEPENDENT = ("time", "machine", "versions", "load", "wall", "elapsed")
 #: Field names that contain one of those parts but are settings of the case.
 _SETTINGS = frozenset({"duration", "disturbance_start", "t_on", "t_off", "time_scale"})
 #: Field names without one of those parts that are still measurements of the run (a ratio of
-#: two solve times).
-_RUN_FIELDS = frozenset({"cvxpy_ratio"})
+#: two solve times; the figures of an earlier run written next to this one's, ``--baseline``).
+_RUN_FIELDS = frozenset({"cvxpy_ratio", "baseline"})
 #: How deep a record may nest (the suites' records nest a handful of levels).
 MAX_DEPTH = 64
 
@@ -59,10 +68,13 @@ def is_run_dependent(name: str) -> bool:
     return any(part in key for part in _RUN_DEPENDENT)
 
 
-def _record_key(record: dict[str, Any], index: int, timing: bool) -> str:
+def record_identity(record: dict[str, Any], timing: bool) -> str:
+    """What names a record across runs: ``experiment | label`` (or ``case_id``), the methods
+    suite's ``problem | method``, a timing record's ``problem | formulation | backend | vertices |
+    n_states`` (the fields it has); empty when the record has none of them."""
     if timing:
         parts = [record.get(k) for k in ("problem", "formulation", "backend", "vertices", "n_states")]
-        return " | ".join(str(p) for p in parts if p is not None) + f" | #{index}"
+        return " | ".join(str(p) for p in parts if p is not None)
     label = record.get("label") or record.get("case_id")
     parts = (record.get("experiment"), label)
     if all(p is None for p in parts):  # the methods suite: one record per problem and method
@@ -70,9 +82,25 @@ def _record_key(record: dict[str, Any], index: int, timing: bool) -> str:
     return " | ".join(str(p) for p in parts if p is not None)
 
 
-def _paired(records: Sequence[dict[str, Any]], timing: bool) -> dict[str, dict[str, Any]]:
-    """The records by key; keys that repeat get their position (``#2``...) so none is dropped."""
-    keys = [_record_key(r, i, timing) for i, r in enumerate(records)]
+def _record_key(record: dict[str, Any], index: int, timing: bool) -> str:
+    """:func:`record_identity`; a timing record's also ends with its position (``| #index``)."""
+    identity = record_identity(record, timing)
+    return f"{identity} | #{index}" if timing else identity
+
+
+def paired_records(
+    records: Sequence[dict[str, Any]], timing: bool, positional: bool = True
+) -> dict[str, dict[str, Any]]:
+    """The records by key; keys that repeat get their count (``#2``...) so none is dropped.
+
+    ``positional``: a timing record's key holds its position in the run (how
+    :func:`compare_records` pairs two runs of the same command); ``False`` pairs by
+    :func:`record_identity` alone (two runs that timed different sets of cases).
+    """
+    keys = [
+        _record_key(r, i, timing) if positional else record_identity(r, timing)
+        for i, r in enumerate(records)
+    ]
     seen: dict[str, int] = {}
     out = {}
     for key, record in zip(keys, records, strict=True):
@@ -138,8 +166,8 @@ def compare_records(
     rtol = check_positive(rtol, "rtol", allow_zero=True)
     for name, records in (("before", before), ("after", after)):
         _check_records(records, name, timing)
-    pairs_a = _paired(before, timing)
-    pairs_b = _paired(after, timing)
+    pairs_a = paired_records(before, timing)
+    pairs_b = paired_records(after, timing)
     out: list[str] = []
     for key in sorted(set(pairs_a) | set(pairs_b)):
         if key not in pairs_a:
@@ -203,15 +231,28 @@ def duplicate_identities(records: Sequence[dict[str, Any]], timing: bool = False
     return {k: n for k, n in counts.items() if n > 1}
 
 
-def _load(folder: Path) -> tuple[list[dict[str, Any]], bool]:
+def load_run(folder: Path, argument: str | None = None) -> tuple[list[dict[str, Any]], bool]:
+    """The records of the run in ``folder`` and whether they are ``rmpc timing``'s.
+
+    Reads ``results.json`` (a suite) or else ``timing.json``; anything else raises
+    :class:`~toolkit_common.errors.InvalidArgumentError` naming ``argument`` (default: the path
+    read) with what was expected and what was found.
+    """
+    folder = Path(folder)
+
+    def refuse(path: Path, expected: str, found: str) -> InvalidArgumentError:
+        if argument is None:
+            return InvalidArgumentError(str(path), expected, found)
+        return InvalidArgumentError(argument, expected, f"{found} ({path})")
+
     if not folder.is_dir():
-        raise InvalidArgumentError(
-            str(folder), "a run's output folder (with results.json or timing.json)",
+        raise refuse(
+            folder, "a run's output folder (with results.json or timing.json)",
             "a file" if folder.exists() else "nothing there",
         )
     if folder.resolve().name.startswith(STAGING_PREFIX):
-        raise InvalidArgumentError(
-            str(folder), "a run's output folder (with results.json or timing.json)",
+        raise refuse(
+            folder, "a run's output folder (with results.json or timing.json)",
             "the unfinished reports of a run killed while writing them (the next run into that "
             "output folder removes them)",
         )
@@ -222,26 +263,28 @@ def _load(folder: Path) -> tuple[list[dict[str, Any]], bool]:
                 data = json.loads(path.read_text(encoding="utf-8"))
             except (OSError, ValueError, RecursionError) as err:
                 why = "nested too deeply to read" if isinstance(err, RecursionError) else str(err)[:200]
-                raise InvalidArgumentError(
-                    str(path), "a readable JSON file of a run's records", why
-                ) from None
+                raise refuse(path, "a readable JSON file of a run's records", why) from None
             if isinstance(data, dict) and not isinstance(data.get("records"), list):
-                raise InvalidArgumentError(
-                    str(path), "a list of records or an object with a list 'records'",
-                    "an object without it",
+                raise refuse(
+                    path, "a list of records or an object with a list 'records'", "an object without it"
                 )
             records = data["records"] if isinstance(data, dict) else data
-            _check_records(records, str(path), timing)
+            try:
+                _check_records(records, str(path), timing)
+            except InvalidArgumentError as err:
+                if argument is None:
+                    raise
+                raise refuse(path, err.expected, err.found) from None
             if not records:
-                raise InvalidArgumentError(str(path), "the records of a run (one or more)", "no records")
+                raise refuse(path, "the records of a run (one or more)", "no records")
             return records, timing
-    raise InvalidArgumentError(str(folder), "a folder with results.json or timing.json", "neither")
+    raise refuse(folder, "a folder with results.json or timing.json", "neither")
 
 
 def compare_runs(before: str | Path, after: str | Path, rtol: float = 0.0) -> list[str]:
     """:func:`compare_records` on the records of two output folders (both suites or both timing)."""
-    records_a, timing_a = _load(Path(before))
-    records_b, timing_b = _load(Path(after))
+    records_a, timing_a = load_run(Path(before))
+    records_b, timing_b = load_run(Path(after))
     if timing_a != timing_b:
         raise InvalidArgumentError("after", "the same kind of output as before", "a suite and a timing run")
     return compare_records(records_a, records_b, rtol, timing=timing_a)
@@ -266,8 +309,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--rtol", type=float, default=0.0, help="relative tolerance on numbers (default 0)")
     args = parser.parse_args(argv)
     try:
-        records_a, timing_a = _load(Path(args.before))
-        records_b, timing_b = _load(Path(args.after))
+        records_a, timing_a = load_run(Path(args.before))
+        records_b, timing_b = load_run(Path(args.after))
         if timing_a != timing_b:
             raise InvalidArgumentError(
                 "after", "the same kind of output as before", "a suite and a timing run"

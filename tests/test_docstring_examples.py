@@ -17,6 +17,7 @@ PACKAGES = ("models", "lmi", "rmpc", "benchmarks", "toolkit_common", "dev")
 
 #: The modules whose docstrings hold examples (``>>>``), by their import name.
 MODULES_WITH_EXAMPLES = (
+    "benchmarks.baseline",
     "benchmarks.compare",
     "benchmarks.core.executors",
     "benchmarks.core.family",
@@ -58,6 +59,7 @@ MODULES_WITH_EXAMPLES = (
     "benchmarks.timing.common",
     "benchmarks.timing.config",
     "benchmarks.timing.cpg_attempt",
+    "benchmarks.timing.versus",
     "lmi.backends.ipm",
     "lmi.data",
     "lmi.forms.problem",

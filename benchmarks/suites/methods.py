@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.baseline import Baseline, load_baseline
 from benchmarks.core.execute import ExecOutcome
 from benchmarks.core.interrupts import Interrupts
 from benchmarks.core.jsonable import json_safe
@@ -571,6 +572,7 @@ def run_methods(
     methods: Sequence[str] | None = None,
     progress: bool | None = None,
     fresh: bool = False,
+    baseline: str | Path | Baseline | None = None,
 ) -> SuiteOutcome:
     """Run every chosen problem x method and write the report into ``out`` (created if needed).
 
@@ -587,6 +589,11 @@ def run_methods(
         Force the progress bar on or off (default: on a terminal).
     fresh : bool
         Ignore the stored cases and measure everything again.
+    baseline : str, Path or Baseline, optional
+        An earlier run's output folder (or :func:`benchmarks.baseline.load_baseline` of it): the
+        report puts its timing figures next to this run's (read before anything is measured; a
+        folder without methods records raises
+        :class:`~toolkit_common.errors.InvalidArgumentError` naming ``--baseline``).
 
     Returns
     -------
@@ -596,6 +603,8 @@ def run_methods(
         solvers too (:class:`benchmarks.core.interrupts.Interrupts`); that case is neither
         stored nor counted as failed.
     """
+    if baseline is not None and not isinstance(baseline, Baseline):
+        baseline = load_baseline(baseline, "methods")
     settings = MethodsSettings.short() if short else MethodsSettings()
     default_problems = list(SHORT_PROBLEMS) if short else list(PROBLEMS)
     chosen_p = _chosen(list(PROBLEMS), default_problems if problems is None else problems, "--problems")
@@ -659,6 +668,8 @@ def run_methods(
     )
     extras = {k: results[k].get("extra", {}) for k in keys if k in results}
     with staged_reports(out) as stage:  # every report file, or none of them, is new
-        files = write_methods_report(stage, outcome, extras, settings, len(keys), resumed, short)
+        files = write_methods_report(
+            stage, outcome, extras, settings, len(keys), resumed, short, baseline=baseline
+        )
     outcome.files = published_paths(files, stage, out)
     return outcome

@@ -14,16 +14,26 @@ them). Two kinds of record are kept apart from the comparisons:
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from benchmarks.baseline import (
+    Baseline,
+    TimeField,
+    baseline_summary_lines,
+    baseline_table,
+    compare_times,
+    rows_of,
+)
 from benchmarks.core.suite import SuiteOutcome, write_records, write_rows_csv, write_run_info
 
 __all__ = [
     "FAMILIES",
     "GAMMA_COMPARABLE",
+    "METHODS_TIME_FIELDS",
     "NO_GAIN",
     "SUMMARY_COLUMNS",
     "TIE_TOLERANCE",
@@ -31,6 +41,7 @@ __all__ = [
     "families_head_to_head",
     "family_of",
     "least_conservative",
+    "methods_comparison",
     "region_ratio",
     "summary_ratios",
     "table_row",
@@ -303,6 +314,47 @@ def families_head_to_head(records: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
+#: The timing figures ``--baseline`` puts next to the earlier run's (``p50_vs_kothare``: the
+#: solve p50 over Kothare's form's on the same problem, in the same run).
+METHODS_TIME_FIELDS: tuple[TimeField, ...] = (
+    TimeField("solve_time_p50", "solve p50", "ms"),
+    TimeField("solve_time_p95", "solve p95", "ms"),
+    TimeField("iterations", "iter", "count"),
+    TimeField("p50_vs_kothare", "p50 / kothare's", "x"),
+    TimeField("cvxpy_time_p50", "cvxpy p50", "ms"),
+    TimeField("cvxpy_ratio", "cvxpy / ipm", "x"),
+)
+
+
+def _time_figures(records: list[dict[str, Any]]) -> Any:
+    """The figures of :data:`METHODS_TIME_FIELDS` of a record of ``records``."""
+
+    def figures(rec: dict[str, Any]) -> dict[str, Any]:
+        out = {f.key: rec.get(f.key) for f in METHODS_TIME_FIELDS}
+        base = _kothare(records, rec["problem"])
+        p50, k50 = rec.get("solve_time_p50"), None if base is None else base.get("solve_time_p50")
+        out["p50_vs_kothare"] = p50 / k50 if p50 is not None and k50 else None
+        return out
+
+    return figures
+
+
+def methods_comparison(
+    records: list[dict[str, Any]], baseline: Baseline, machine: dict[str, Any] | None,
+    versions: dict[str, Any] | None,
+) -> dict[str, Any]:
+    """This run's timing figures next to the baseline's, per problem and method
+    (:func:`benchmarks.baseline.compare_times`; ``machine``, ``versions``: this run's)."""
+
+    def side(recs: list[dict[str, Any]]) -> list[tuple[str, str, str, dict[str, Any]]]:
+        return rows_of(recs, False, lambda r: r["problem"], lambda r: r["method"], _time_figures(recs))
+
+    return compare_times(
+        side(records), side(baseline.records), METHODS_TIME_FIELDS, baseline.folder,
+        {"new": machine, "old": baseline.machine}, {"new": versions, "old": baseline.versions},
+    )
+
+
 def write_methods_report(
     out: Path,
     outcome: SuiteOutcome,
@@ -311,11 +363,16 @@ def write_methods_report(
     n_cases: int,
     resumed: int,
     short: bool,
+    baseline: Baseline | None = None,
 ) -> list[Path]:
     """Write ``results.json``, ``results.csv``, ``run.json``, ``results.md`` and the figures.
 
     ``settings`` is the run's :class:`benchmarks.suites.methods.MethodsSettings` (not named in
-    the signature: the runner imports this module).
+    the signature: the runner imports this module). With ``baseline`` (an earlier run,
+    :func:`benchmarks.baseline.load_baseline`) each problem's section gains a table of the
+    timing figures next to the baseline's, ``results.md`` a section on what it is compared
+    with, ``run.json`` the comparison under ``baseline`` and each record of ``results.json``
+    its row under ``baseline`` (:mod:`benchmarks.baseline`).
     """
     from benchmarks.reports.methods_figures import plot_regions, plot_summary
     from benchmarks.reports.sections import failed_cases, run_lines, settings_section
@@ -323,12 +380,19 @@ def write_methods_report(
     from benchmarks.suites.methods_problems import SUITE_CHOICES
 
     records = outcome.records
-    files: list[Path] = [write_records(out, records)]
+    info = write_run_info(out, "rmpc bench methods", outcome, n_cases, None, None, ("short", float(short)))
+    comparison = None
+    if baseline is not None:
+        comparison = methods_comparison(records, baseline, info.get("machine"), info.get("versions"))
+        info["baseline"] = comparison
+        (out / "run.json").write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
+        by_key = {(r["group"], r["label"]): r for r in comparison["rows"]}
+        written = [{**r, "baseline": by_key.get((r["problem"], r["method"]))} for r in records]
+    files: list[Path] = [write_records(out, records if comparison is None else written)]
     rows = [{"problem": r["problem"], **table_row(r, _kothare(records, r["problem"]))} for r in records]
     csv_path = write_rows_csv(out / "results.csv", rows)
     if csv_path is not None:
         files.append(csv_path)
-    info = write_run_info(out, "rmpc bench methods", outcome, n_cases, None, None, ("short", float(short)))
     (out / "figures").mkdir(exist_ok=True)
     figures: dict[str, Path] = {}
     for p in dict.fromkeys(r["problem"] for r in records):
@@ -428,6 +492,16 @@ def write_methods_report(
         *(families_head_to_head(records) or ["(one family ran on every problem)"]),
         "",
     ]
+    if comparison is not None:
+        lines += [
+            "## Times against the baseline",
+            "",
+            "Each problem's section ends with its timing figures next to those of the baseline run "
+            "(paired by problem and method) and the ratio new/old; `p50 / kothare's` is the solve p50 "
+            "over Kothare's form's on the same problem, in the same run.",
+            "",
+            *baseline_summary_lines(comparison, [r["problem"] for r in records]),
+        ]
     for p in dict.fromkeys(r["problem"] for r in records):
         recs = [r for r in records if r["problem"] == p]
         s = recs[0]["settings"]
@@ -459,6 +533,8 @@ def write_methods_report(
             if not certified(r)
         ]
         lines += notes + ([""] if notes else [])
+        if comparison is not None:
+            lines += ["Times against the baseline:", "", *baseline_table(comparison, p), ""]
         if p in figures:
             lines += [f"![{p}]({figures[p].relative_to(out).as_posix()})", ""]
     if summary is not None:

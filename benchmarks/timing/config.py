@@ -65,6 +65,8 @@ class TimingConfig:
     scale_sizes: tuple[int, ...] = (6, 10, 14, 20)
     scale_scs_steps: int = 1
     scale_cvxpy_steps: int = 2
+    #: An earlier report's folder (``--baseline``): its times go next to this run's.
+    baseline: Path | None = None
 
     @property
     def cheap_steps(self) -> int:
@@ -179,4 +181,5 @@ def config_from_args(args: argparse.Namespace) -> TimingConfig:
         scale_sizes=sizes,
         scale_scs_steps=0 if quick else 1,
         scale_cvxpy_steps=min(scale_cvxpy, scale_steps),
+        baseline=None if getattr(args, "baseline", None) is None else Path(args.baseline),
     )

@@ -146,6 +146,10 @@ def format_markdown(report: dict[str, Any], plot_name: str | None = "timing.png"
         from benchmarks.timing.c_exports import c_markdown
 
         lines += c_markdown(report)
+    if report.get("baseline") is not None:
+        from benchmarks.timing.versus import baseline_markdown
+
+        lines += baseline_markdown(report["baseline"])
     if plot_name:
         lines += ["## Distributions", "", f"![per-step time distributions]({plot_name})", ""]
     return "\n".join(lines)

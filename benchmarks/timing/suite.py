@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.baseline import Baseline, load_baseline
 from benchmarks.core.folders import not_writable
 from benchmarks.core.jsonable import json_safe
 from benchmarks.core.machine import machine_info, package_versions
@@ -183,12 +184,21 @@ def _c_summary(records: list[dict[str, Any]], runs: list[dict[str, Any]]) -> dic
 
 
 # -- the files ------------------------------------------------------------------------------------
-def write_report(result: dict[str, Any], out: Path) -> list[Path]:
-    """Write ``timing.json``, ``timing.md``, ``timing.png`` and ``timing_samples.npz`` into ``out``."""
+def write_report(result: dict[str, Any], out: Path, baseline: Baseline | None = None) -> list[Path]:
+    """Write ``timing.json``, ``timing.md``, ``timing.png`` and ``timing_samples.npz`` into ``out``.
+
+    With ``baseline`` (an earlier report, :func:`benchmarks.baseline.load_baseline`) the report
+    gains ``baseline`` (:func:`benchmarks.timing.versus.timing_comparison`) and ``timing.md``
+    its section.
+    """
     from benchmarks.timing.plots import plot_distributions
 
     out.mkdir(parents=True, exist_ok=True)
     report = result["report"]
+    if baseline is not None:
+        from benchmarks.timing.versus import timing_comparison
+
+        report["baseline"] = timing_comparison(report, baseline)
     paths = [out / "timing.json", out / "timing.md", out / "timing.png", out / "timing_samples.npz"]
     paths[0].write_text(json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     plot_distributions(report, result["samples"], paths[2])
@@ -215,14 +225,21 @@ def run_timing_command(args: argparse.Namespace) -> int:
     problem = not_writable(cfg.out)  # fail before minutes of measuring, not after
     if problem is not None:
         raise InvalidArgumentError("--out", "a folder that can be written", f"{str(cfg.out)!r} ({problem})")
+    baseline = None if cfg.baseline is None else load_baseline(cfg.baseline, "timing")
     cfg.out.mkdir(parents=True, exist_ok=True)
     result = run_timing(cfg)
-    write_report(result, cfg.out)
+    write_report(result, cfg.out, baseline)
     report = result["report"]
     print(f"rmpc timing: {len(report['records'])} records in {report['wall_time_s']:.1f} s; "
           f"report in {cfg.out}/timing.md")
     if report["c"] is not None and report["c"]["note"]:
         print(f"  C section: {report['c']['note']}")
+    if report.get("baseline") is not None:
+        cmp = report["baseline"]
+        mean = cmp["p50_ratio_geomean"]
+        print(f"  against {cmp['baseline']}: {cmp['counts']['both']} cases in both"
+              + ("" if mean is None else f", p50 new/old geometric mean {mean:.3f}")
+              + ("" if cmp["same_machine"] else " (measured on another machine, or unknown)"))
     for q in report["rebuild_over_fast"]:
         ratio = q["rebuild_over_fast"]
         print(f"  {q['vertices']} vertices: rebuild-per-step / fast path (p50) = {ratio:.1f}x")
@@ -275,4 +292,8 @@ def add_timing_parser(subparsers: Any) -> None:
     parser.add_argument("--scs-steps", default=None, metavar="K",
                         help="states for cvxpy + SCS (default 5; --quick: 1; 0 leaves SCS out)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
+    parser.add_argument("--baseline", default=None, metavar="OLD_DIR",
+                        help="an earlier report's output directory: timing.md and timing.json put its "
+                        "per-case times (p50, p95, solver p50, iterations) next to this run's, with "
+                        "new/old, and flag a baseline measured on another machine")
     parser.set_defaults(func=run_timing_command)
