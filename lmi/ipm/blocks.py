@@ -8,8 +8,10 @@ coefficients kept in the three forms the kernels take: packed (``G``), as their 
 (the ``sp_*`` arrays) and in factored form ``A_ij = D_j N_ij D_j'`` (the ``dict_*`` and ``fe_*``
 arrays, grouped by :func:`factor_groups`). :meth:`BlockData.set_block` replaces a block in
 place; the scaled forms are refreshed before the next iteration (``_refresh``), and
-:data:`DIRECT_MIN_VARIABLES` and a cost model (:data:`SCHUR_PAIR_COST`) decide whether the Schur
-complement is formed from the factored coefficients.
+:data:`DIRECT_MIN_VARIABLES` and a cost model (:data:`SCHUR_PAIR_COST`) choose the formula of the
+Schur complement: from ``P`` formed (rows), from the factored coefficients (direct), or block by
+block on each block's own variables (blockwise, :func:`block_variables`; ``H`` then factored in
+the block-arrow order of :func:`arrow_order`).
 
 Equilibration: ``x = D x~`` with every variable's weighted coefficients of unit Frobenius norm
 over all blocks, and, for badly balanced blocks, block weights ``w_j`` (:func:`block_weights`,

@@ -43,7 +43,11 @@ coefficients are given in factored form ``A_ij = D_j N_ij D_j'`` (a dictionary `
 all variables, sparse ``N_ij``; :mod:`lmi.kothare_factors`), ``H`` is formed directly as a sum
 over pairs of entries (:func:`lmi.ipm.kernels.scaling_and_schur_direct`) and ``P`` is never
 formed; the Newton products with ``P`` use the sparse coefficients. The QR phase still forms
-``P``. See :data:`DIRECT_MIN_VARIABLES` for when this is used.
+``P``. See :data:`DIRECT_MIN_VARIABLES` for when this is used. When each block holds only part
+of the variables (the vertex forms: a vertex's Lyapunov matrix and the shared variables), ``H``
+is formed block by block on those variables (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`)
+and factored as a block arrow (:func:`lmi.ipm.kernels.lapack.arrow_cholesky`), the products with
+``P`` and ``G`` from the sparse coefficients (:meth:`lmi.ipm.blocks.BlockData._choose_formula`).
 
 The solver is split along its seams: the data as the kernels read it (:mod:`lmi.ipm.blocks`,
 the base class :class:`~lmi.ipm.blocks.BlockData`), phase one and its certificate
