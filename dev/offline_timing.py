@@ -8,8 +8,9 @@ back-end: the median, minimum and maximum wall time, the number of ellipsoids an
 design is complete (every ellipsoid ``"optimal"``: converged, certified and nested), the stop
 reason, and per ellipsoid the status, ``gamma``, the solver's own words, the iterations where the
 back-end counts them and the nesting margin; and where the time went (medians): the problem's
-construction, the solver's own time summed over the ellipsoids, and the rest (certificates,
-nesting and interpolation checks, Python). When both back-ends ran, the relative difference of
+construction, the solver's own time summed over the stored ellipsoids, and the rest
+(certificates, nesting and interpolation checks, Python, and the solve that stopped an incomplete
+design). When both back-ends ran, the relative difference of
 their gammas per ellipsoid, and the speed-up (cvxpy's median over the ipm's) only when both
 designs were complete in every repeat: a design that stopped early is timed to its failure,
 which is no time to compare with (the flexible case in the ``"delta_shared"`` form, on which
@@ -127,7 +128,7 @@ def _design(args: dict[str, Any], x1: np.ndarray, count: int, shrink: float, bac
         "construct_s": built - start,
         "solver_s": solver_s,
         "rest_s": wall - (built - start) - solver_s,
-        "iterations_total": None if None in iterations else int(sum(iterations)),
+        "iterations_total": None if not ells or None in iterations else int(sum(iterations)),
         "n_ellipsoids": table.n_ellipsoids,
         "complete": table.stop_reason == "complete" and table.n_ellipsoids == count
         and all(e.ok for e in ells),

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from dev.offline_timing import _markdown, speedup
 
 
@@ -48,3 +50,29 @@ def test_report_marks_a_failed_design_and_its_missing_speedup() -> None:
     assert "- F4: 50.0x (cvxpy / ipm, both complete)" in text
     assert "- flex8: no speed-up: cvxpy incomplete" in text
     assert "| 0.50 / 1.00 / 0.50 | 128 |" in text
+
+
+def _scalar_unstable() -> dict[str, Any]:
+    """``x+ = 1.5 x + u``, ``|u| <= 1``: no invariant ellipsoid holds a state beyond ``|x| = 2``."""
+    return {"A": [[[1.5]]], "B": [[[1.0]]], "Q": [[1.0]], "R": [[1.0]], "dt": 1.0,
+            "input_constraint": "peak", "u_max": 1.0, "formulation": "standard"}
+
+
+def test_design_record_splits_the_time_and_counts_iterations() -> None:
+    from dev.offline_timing import _design
+
+    rec = _design(_scalar_unstable(), np.array([0.5]), 3, 0.5, "clarabel")
+    assert rec["complete"] and rec["n_ellipsoids"] == 3
+    assert rec["iterations_total"] == sum(rec["iterations"]) > 0
+    parts = rec["construct_s"] + rec["solver_s"] + rec["rest_s"]
+    assert abs(parts - rec["wall_s"]) < 1e-9 and rec["solver_s"] == sum(rec["solve_s"])
+    assert min(rec["construct_s"], rec["solver_s"], rec["rest_s"]) >= 0.0
+
+
+def test_design_record_of_a_design_that_failed_has_no_iteration_total() -> None:
+    from dev.offline_timing import _design
+
+    rec = _design(_scalar_unstable(), np.array([100.0]), 3, 0.5, "clarabel")
+    assert not rec["complete"] and rec["n_ellipsoids"] == 0
+    assert rec["status"] == ["infeasible"]
+    assert rec["iterations_total"] is None and rec["solver_s"] == 0.0
