@@ -7,9 +7,15 @@ fresh problem each time (its construction counted: that is what a user pays once
 back-end: the median, minimum and maximum wall time, the number of ellipsoids and whether the
 design is complete (every ellipsoid ``"optimal"``: converged, certified and nested), the stop
 reason, and per ellipsoid the status, ``gamma``, the solver's own words, the iterations where the
-back-end counts them and the nesting margin. When both back-ends ran, the relative difference of
-their gammas per ellipsoid. The machine and its load average go with the answer (the machines
-are shared and noisy).
+back-end counts them and the nesting margin; and where the time went (medians): the problem's
+construction, the solver's own time summed over the stored ellipsoids, and the rest
+(certificates, nesting and interpolation checks, Python, and the solve that stopped an incomplete
+design). When both back-ends ran, the relative difference of
+their gammas per ellipsoid, and the speed-up (cvxpy's median over the ipm's) only when both
+designs were complete in every repeat: a design that stopped early is timed to its failure,
+which is no time to compare with (the flexible case in the ``"delta_shared"`` form, on which
+cvxpy + Clarabel ends ``"solver_error"`` at the first design state after a few seconds). The
+machine and its load average go with the answer (the machines are shared and noisy).
 
 Cases:
 
@@ -43,7 +49,7 @@ import numpy as np
 
 from benchmarks.core.machine import machine_info, package_versions
 
-__all__ = ["CASES", "case_problem", "main", "run"]
+__all__ = ["CASES", "case_problem", "main", "run", "speedup"]
 
 #: Case name -> a short description (the module docstring has the details).
 CASES: dict[str, str] = {
@@ -111,11 +117,18 @@ def _design(args: dict[str, Any], x1: np.ndarray, count: int, shrink: float, bac
     extra = {"backend": backend} if _has_backend_option() else {}
     start = time.perf_counter()
     prob = NestedKothareProblem(**args, **extra)
+    built = time.perf_counter()
     table = prob.design_ray(x1, count, shrink)
     wall = time.perf_counter() - start
     ells = list(table.ellipsoids)
+    solver_s = float(sum(e.solve_time for e in ells))
+    iterations = [getattr(e, "iterations", None) for e in ells]
     return {
         "wall_s": wall,
+        "construct_s": built - start,
+        "solver_s": solver_s,
+        "rest_s": wall - (built - start) - solver_s,
+        "iterations_total": None if not ells or None in iterations else int(sum(iterations)),
         "n_ellipsoids": table.n_ellipsoids,
         "complete": table.stop_reason == "complete" and table.n_ellipsoids == count
         and all(e.ok for e in ells),
@@ -123,7 +136,7 @@ def _design(args: dict[str, Any], x1: np.ndarray, count: int, shrink: float, bac
         "status": [e.status for e in ells] + ([table.failed_status] if table.failed_status else []),
         "gamma": [float(e.gamma) for e in ells],
         "solver_status": [e.solver_status for e in ells],
-        "iterations": [getattr(e, "iterations", None) for e in ells],
+        "iterations": iterations,
         "nesting_margin": [float(e.nesting_margin) for e in ells],
         "solve_s": [float(e.solve_time) for e in ells],
     }
@@ -143,7 +156,9 @@ def run(cases: Sequence[str], backends: Sequence[str], repeats: int) -> dict[str
             walls = [r["wall_s"] for r in runs]
             entry[backend] = {"median_s": float(np.median(walls)), "min_s": min(walls), "max_s": max(walls),
                               "walls_s": walls, "last": runs[-1],
-                              "complete_all": all(r["complete"] for r in runs)}
+                              "complete_all": all(r["complete"] for r in runs),
+                              **{f"{part}_median_s": float(np.median([r[f"{part}_s"] for r in runs]))
+                                 for part in ("construct", "solver", "rest")}}
             print(f"{name:8s} {backend:6s} median {entry[backend]['median_s']:8.2f} s  "
                   f"{runs[-1]['n_ellipsoids']} ellipsoids  {runs[-1]['stop_reason']}", flush=True)
         if "ipm" in entry and "cvxpy" in entry:
@@ -151,9 +166,25 @@ def run(cases: Sequence[str], backends: Sequence[str], repeats: int) -> dict[str
             k = min(len(g_i), len(g_c))
             entry["gamma_rel_diff"] = [abs(a - b) / max(abs(b), 1e-300) for a, b in zip(g_i[:k], g_c[:k],
                                                                                          strict=True)]
+            entry["speedup"], entry["speedup_note"] = speedup(entry)
         out["cases"][name] = entry
     out["load_after"] = os.getloadavg()
     return out
+
+
+def speedup(entry: dict[str, Any]) -> tuple[float | None, str]:
+    """cvxpy's median design time over the ipm's for one case of :func:`run`, and a note.
+
+    ``None`` (the note says why) unless both back-ends designed the complete table in every
+    repeat: an incomplete design is timed only up to the solve that stopped it.
+    """
+    if "ipm" not in entry or "cvxpy" not in entry:
+        return None, "no speed-up: one back-end did not run"
+    failed = [b for b in ("ipm", "cvxpy") if not entry[b]["complete_all"]]
+    if failed:
+        why = "; ".join(f"{b} incomplete ({entry[b]['last']['stop_reason']})" for b in failed)
+        return None, f"no speed-up: {why}, timed to its failure"
+    return entry["cvxpy"]["median_s"] / entry["ipm"]["median_s"], "cvxpy / ipm, both complete"
 
 
 def _markdown(res: dict[str, Any]) -> str:
@@ -161,16 +192,26 @@ def _markdown(res: dict[str, Any]) -> str:
              f"machine: {res['machine']}",
              f"load average before / after: {res['load_before']} / {res['load_after']}",
              f"repeats: {res['repeats']} (fresh problem each, construction counted)", "",
-             "| case | back-end | median (s) | min / max (s) | ellipsoids | complete | stop reason |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+             "| case | back-end | median (s) | min / max (s) | construction / solver / rest (s) "
+             "| iterations | ellipsoids | complete | stop reason |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for name, entry in res["cases"].items():
         for backend in ("ipm", "cvxpy"):
             if backend not in entry:
                 continue
             e = entry[backend]
-            lines.append(f"| {name} | {backend} | {e['median_s']:.2f} | {e['min_s']:.2f} / "
-                         f"{e['max_s']:.2f} | {e['last']['n_ellipsoids']} | {e['complete_all']} | "
-                         f"{e['last']['stop_reason']} |")
+            median = f"{e['median_s']:.2f}" + ("" if e["complete_all"] else " (to failure)")
+            parts = " / ".join(f"{e.get(f'{p}_median_s', float('nan')):.2f}"
+                               for p in ("construct", "solver", "rest"))
+            lines.append(f"| {name} | {backend} | {median} | {e['min_s']:.2f} / {e['max_s']:.2f} | "
+                         f"{parts} | {e['last'].get('iterations_total')} | {e['last']['n_ellipsoids']} | "
+                         f"{e['complete_all']} | {e['last']['stop_reason']} |")
+    speedups = [(name, entry) for name, entry in res["cases"].items() if "speedup_note" in entry]
+    if speedups:
+        lines += ["", "Speed-up of the ipm design (median over median):", ""]
+        lines += [f"- {name}: " + (f"{entry['speedup']:.1f}x ({entry['speedup_note']})"
+                                   if entry["speedup"] is not None else entry["speedup_note"])
+                  for name, entry in speedups]
     lines += ["", "Gamma per ellipsoid (last repeat) and |gamma_ipm - gamma_cvxpy| / gamma_cvxpy:", ""]
     for name, entry in res["cases"].items():
         lines.append(f"- {name}: " + "; ".join(
