@@ -20,6 +20,7 @@ the bounds below are about 100 times the worst differences measured.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -103,8 +104,10 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
     """``H`` block by block equals ``P'P`` from the formed ``P`` (and the NT scalings are the same
     arithmetic): worst measured ``|H_blockwise - H_rows|`` 2e-16 of ``|P|'|P|``."""
     c, blocks = arrow_problem(seed)
-    solver = refreshed(c, blocks)
     rng = np.random.default_rng(100 + seed)
+    shuffle = rng.permutation(c.size)  # the shared variables among the private ones
+    c, blocks = c[shuffle], [(const, coef[shuffle]) for const, coef in blocks]
+    solver = refreshed(c, blocks)
     orders = solver.block_orders
     s_chol = _padded([np.linalg.cholesky(_rand_pd(rng, k)) for k in orders])
     z = _padded([_rand_pd(rng, k) for k in orders])
@@ -123,7 +126,16 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
     scale = np.abs(pt) @ np.abs(pt).T
     assert np.all(np.abs(h - h_rows) <= 64 * EPS * scale)
     # the block structure is real: entries between two groups' private variables are exactly 0
-    assert h[0, n - 6] == 0.0 and h_rows[0, n - 6] == 0.0
+    first, last = np.argsort(shuffle)[0], np.argsort(shuffle)[n - 6]  # variables 0 and n - 6 before
+    assert h[first, last] == 0.0 and h_rows[first, last] == 0.0
+    # given the variables' positions in the arrow order, the same sums land there: H[perm][:, perm]
+    perm = solver._arrow[0]
+    assert not np.array_equal(perm, np.arange(n))
+    h_perm = np.full((n, n), np.nan)
+    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, lay.offsets, sp[0], *sp[2:],
+                                               solver._blockvars[0], solver._arrow_positions,
+                                               solver._blockvars[2], kk, lam, work[9], work[10], h_perm)
+    np.testing.assert_array_equal(h_perm, h[perm][:, perm])
 
 
 def test_block_variables_and_the_arrow_order_of_a_vertex_like_problem():
@@ -186,29 +198,31 @@ def test_arrow_order_keeps_no_group_when_elimination_saves_little():
 
 @pytest.mark.parametrize("seed", range(3))
 def test_arrow_cholesky_is_the_cholesky_factor_of_the_permuted_matrix(seed):
-    """``R`` equals LAPACK's upper Cholesky factor of ``H[perm][:, perm]`` (unique for a definite
-    matrix) to 1e-12 relative (measured 2e-15), with exact zeros between groups; an indefinite
-    ``H`` is reported (non-zero return)."""
+    """``R`` equals LAPACK's upper Cholesky factor of ``H_p = H[perm][:, perm]`` (unique for a
+    definite matrix) to 1e-12 relative (measured 2e-15), with exact zeros between groups; an
+    indefinite ``H_p`` is reported (non-zero return). The blockwise kernel forms ``H_p`` itself when
+    given the variables' positions in that order."""
     c, blocks = arrow_problem(seed)
     solver = refreshed(c, blocks)
     perm, grp_off = solver._arrow
     g = solver._g_mat
     h = g.T @ g + 1e-3 * np.eye(solver.n)
-    work, r = np.zeros_like(h), np.zeros_like(h)
-    assert arrow_cholesky(h, perm, grp_off, work, r) == 0
     hp = h[perm][:, perm]
+    r = np.full_like(h, np.nan)
+    kept = hp.copy()
+    assert arrow_cholesky(hp, grp_off, r) == 0
     want = cholesky(hp, lower=False)
     assert np.max(np.abs(r - want)) <= 1e-12 * np.max(np.abs(want))
-    np.testing.assert_array_equal(work, hp)  # the pivot test reads its diagonal
+    np.testing.assert_array_equal(hp, kept)  # left as it is (the pivot test reads its diagonal)
     for a in range(len(grp_off) - 1):
         for b in range(a + 1, len(grp_off) - 1):
             assert np.all(r[grp_off[a]:grp_off[a + 1], grp_off[b]:grp_off[b + 1]] == 0.0)
-    bad = h.copy()
-    bad[perm[-1], perm[-1]] = -1.0  # a border pivot
-    assert arrow_cholesky(bad, perm, grp_off, work, r) != 0
-    bad = h.copy()
-    bad[perm[0], perm[0]] = -1.0  # a group's pivot
-    assert arrow_cholesky(bad, perm, grp_off, work, r) != 0
+    bad = hp.copy()
+    bad[-1, -1] = -1.0  # a border pivot
+    assert arrow_cholesky(bad, grp_off, r) != 0
+    bad = hp.copy()
+    bad[0, 0] = -1.0  # a group's pivot
+    assert arrow_cholesky(bad, grp_off, r) != 0
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -234,16 +248,25 @@ def test_products_with_g_from_the_sparse_coefficients_equal_the_dense_ones(seed)
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_solves_with_the_blockwise_formula_agree_with_the_rows_formula(seed):
+def test_solves_with_the_blockwise_formula_agree_with_the_rows_formula(seed, caplog):
     """The same problem solved with each formula forced: both ``"optimal"``, objectives equal to
-    1e-7 relative, points to 1e-5 of their norm (measured 1e-10 and 1e-8)."""
+    1e-7 relative, points to 1e-5 of their norm (measured 1e-10 and 1e-8), the iterations within
+    one, every blockwise step from the Cholesky factor (none in the QR phase). The variables are
+    shuffled, so the arrow order differs from the given one."""
     c, blocks = arrow_problem(seed)
+    shuffle = np.random.default_rng(200 + seed).permutation(c.size)
+    c, blocks = c[shuffle], [(const, coef[shuffle]) for const, coef in blocks]
     with formula("rows"):
         rows = BlockLMISolver(c, blocks).solve()
-    with formula("blockwise"):
+    with formula("blockwise"), caplog.at_level(logging.DEBUG, logger="lmi.ipm.solver"):
         solver = BlockLMISolver(c, blocks)
         blockwise = solver.solve()
+    # every step from the block-arrow factor (a wrong factor sends the steps to the QR phase)
+    steps = [r.getMessage() for r in caplog.records if "alpha_aff" in r.getMessage()]
+    assert steps and not any("qr True" in m for m in steps)
+    assert abs(blockwise.iterations - rows.iterations) <= 1
     assert solver._formula == "blockwise"
+    assert not np.array_equal(solver._arrow[0], np.arange(c.size))
     assert rows.status == blockwise.status == "optimal"
     scale = max(1.0, abs(rows.primal_objective))
     assert abs(rows.primal_objective - blockwise.primal_objective) <= 1e-7 * scale

@@ -208,6 +208,7 @@ class BlockData:
         self._formula = "rows"
         self._arrow: tuple[np.ndarray, np.ndarray] = (np.arange(n, dtype=np.int64),
                                                       np.zeros(1, dtype=np.int64))
+        self._arrow_positions = np.zeros(0, dtype=np.int64)
         self._blockvars: tuple[np.ndarray, np.ndarray, np.ndarray] = block_variables(
             (np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)))
         self._const: list[np.ndarray] = [const for const, _ in checked]
@@ -301,6 +302,10 @@ class BlockData:
             self._blockvars = block_variables(self._sparse)
             self._formula = self._choose_formula()
             self._arrow = arrow_order(self._blockvars, self.n)
+            # where each block's variables sit in that order (H is formed there directly)
+            position = np.empty(self.n, dtype=np.int64)
+            position[self._arrow[0]] = np.arange(self.n, dtype=np.int64)
+            self._arrow_positions = position[self._blockvars[1]]
 
     @property
     def _direct(self) -> bool:

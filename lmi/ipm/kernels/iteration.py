@@ -147,7 +147,7 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
 
 @njit(**JIT)
 def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
-                        sp_val, pair_off, pair_row, pair_col, bv_off, bv_var, sp_loc, perm, arrow_off,
+                        sp_val, pair_off, pair_row, pair_col, bv_off, bv_pos, sp_loc, perm, arrow_off,
                         pt_work, hj_work, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
                         no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch,
                         s_out, z_out, chol_out, err_limit):
@@ -155,15 +155,16 @@ def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_
     (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_blockwise`; ``pt_work`` and ``hj_work`` its
     workspaces), ``P`` not formed (``no_pt`` ``(n, 0)``: the Newton step's products come from the
     sparse coefficients) until the QR phase, which forms ``P`` in ``pt``; see
-    :func:`rows_iteration`. ``H`` is factored in the variable order ``perm`` as a block arrow
-    (the groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); ``work`` is left
-    holding ``H`` in that order, whose diagonal the pivot test reads."""
+    :func:`rows_iteration`. ``H`` is formed in the variable order ``perm`` (block ``j``'s variables
+    at ``bv_pos[bv_off[j]:bv_off[j + 1]]`` of that order) and factored there as a block arrow (the
+    groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); the Newton solves map
+    their vectors through ``perm``."""
     if not use_qr:
         if not scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off,
-                                           pair_row, pair_col, bv_off, bv_var, sp_loc, kk, lam, pt_work,
+                                           pair_row, pair_col, bv_off, bv_pos, sp_loc, kk, lam, pt_work,
                                            hj_work, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
-        if arrow_cholesky(h, perm, arrow_off, work, r_fac) == 0 and _factor_ok(work, r_fac, qr_switch):
+        if arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
             out = newton_step(no_pt, r_fac, perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
                               g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
                               sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,

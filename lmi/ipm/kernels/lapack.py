@@ -143,26 +143,23 @@ def triangular_solve_blas(r_fac, b):
 
 
 @njit(**JIT)
-def arrow_cholesky(h, perm, grp_off, work, r_out):
-    """Upper Cholesky factor ``R`` (``R'R = H_p``) of ``H`` with its variables in the order ``perm``
-    (``H_p = H[perm][:, perm]``, into ``work``), for a block-arrow ``H_p``: the groups
-    ``grp_off[g]:grp_off[g + 1]`` are coupled to no other group, only to the border (the
-    variables from ``grp_off[-1]`` on). Each group's block ``D_g = R_g'R_g`` is factored on its
-    own, its border rows ``X_g = R_g'^-1 E_g`` (``E_g`` the group's rows of the border columns,
-    one ``dtrsm``) and the border block updated, ``F - X_g'X_g`` (one ``dsyrk``); then that is
-    factored. ``R`` has the factor of a Cholesky of ``H_p`` in that order (zero between groups);
+def arrow_cholesky(hp, grp_off, r_out):
+    """Upper Cholesky factor ``R`` (``R'R = H_p``) of a block-arrow ``H_p`` (``hp``, left as it is):
+    the groups ``grp_off[g]:grp_off[g + 1]`` are coupled to no other group, only to the border
+    (the variables from ``grp_off[-1]`` on). Each group's block ``D_g = R_g'R_g`` is factored on
+    its own, its border rows ``X_g = R_g'^-1 E_g`` (``E_g`` the group's rows of the border
+    columns, one ``dtrsm``) and the border block updated, ``F - X_g'X_g`` (one ``dsyrk``); then
+    that is factored. ``R`` is the factor of a Cholesky of ``H_p`` (zero between groups);
     ``sum_g n_g^3/3 + n_g^2 n_b + n_g n_b^2`` operations instead of ``n^3 / 3``. Returns 0, or
     LAPACK's ``info`` of the first factorisation that failed (offset by the group's first row).
     """
-    n = h.shape[0]
+    n = hp.shape[0]
     for a in range(n):
-        pa = perm[a]
         for b in range(n):
-            work[a, b] = h[pa, perm[b]]
             r_out[a, b] = 0.0
     nbor = grp_off[grp_off.shape[0] - 1]
     nb = n - nbor
-    fmat = np.ascontiguousarray(work[nbor:, nbor:])
+    fmat = np.ascontiguousarray(hp[nbor:, nbor:])
     chars = np.array([_RIGHT, _LOWER, _TRANS, _NO, _UPPER], dtype=np.uint8)
     scalars = np.array([1.0, -1.0])
     for g in range(grp_off.shape[0] - 1):
@@ -170,7 +167,7 @@ def arrow_cholesky(h, perm, grp_off, work, r_out):
         ng = hi - lo
         if ng == 0:
             continue
-        dmat = np.ascontiguousarray(work[lo:hi, lo:hi])
+        dmat = np.ascontiguousarray(hp[lo:hi, lo:hi])
         rg = np.empty((ng, ng))
         info = cholesky_upper(dmat, np.empty((ng, ng)), rg)
         if info != 0:
@@ -180,7 +177,7 @@ def arrow_cholesky(h, perm, grp_off, work, r_out):
             continue
         # X_g (ng x nb, C-ordered) = R_g'^-1 E_g: its Fortran view X_g' = E_g' R_g^-1, with
         # R_g's Fortran view R_g' lower: side R, uplo L, transa T
-        xg = np.ascontiguousarray(work[lo:hi, nbor:])
+        xg = np.ascontiguousarray(hp[lo:hi, nbor:])
         ints = np.array([nb, ng], dtype=np.int32)
         _dtrsm(chars[0:].ctypes, chars[1:].ctypes, chars[2:].ctypes, chars[3:].ctypes, ints[0:].ctypes,
                ints[1:].ctypes, scalars[0:].ctypes, rg.ctypes, ints[1:].ctypes, xg.ctypes, ints[0:].ctypes)

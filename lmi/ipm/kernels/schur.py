@@ -131,11 +131,12 @@ def scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_
     ascending; ``sp_loc[e]`` is entry ``e``'s position among them): its rows of ``P'``,
     ``P_j'`` (``n_j x size_j``), are formed as :func:`scaling_and_schur_rows` forms them, in
     ``pt_work``, and ``P_j'P_j`` (one ``dsyrk`` into ``h_work``) is added into ``H`` at those
-    variables. The work is ``sum_j n_j^2 size_j`` instead of ``n^2 size``: a vertex form's
-    blocks each hold one vertex's Lyapunov matrix and the shared variables, so that ``H`` is
-    block-arrow shaped (measured on the 14-state flexible satellite over 8 vertices, 1184
-    variables: 1.0e9 instead of 1.06e10 operations). Returns ``False`` if a block lost
-    positive definiteness.
+    variables (``bv_var`` their indices; the solver passes their positions in the order of its
+    block-arrow factor, forming ``H`` in that order). The work is ``sum_j n_j^2 size_j`` instead
+    of ``n^2 size``: a vertex form's blocks each hold one vertex's Lyapunov matrix and the shared
+    variables, so that ``H`` is block-arrow shaped (measured on the 14-state flexible satellite
+    over 8 vertices, 1184 variables: 1.0e9 instead of 1.06e10 operations). Returns ``False`` if a
+    block lost positive definiteness.
     """
     n = h_out.shape[0]
     for a in range(n):
