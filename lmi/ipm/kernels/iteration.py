@@ -89,6 +89,29 @@ def _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var
 
 
 @njit(**JIT)
+def _cholesky_or_qr_step(ok, step_pt, r_fac, perm, pt, formed, s_chol, z, orders, offsets, ent_row, ent_col,
+                         ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, kk, lam, qr_h,
+                         qr_tau, no_qr_h, no_qr_tau, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, s_out,
+                         z_out, chol_out, err_limit):
+    """The step every iteration kernel ends with: from the Cholesky factor ``r_fac`` of ``H`` (in
+    the variable order ``perm``, empty for the given one) when ``ok`` (it was formed and its
+    pivots passed), the products with ``P`` from ``step_pt`` (``P'``, or ``(n, 0)``: from the
+    sparse coefficients); else, or when that step missed ``err_limit``, the QR phase's step
+    (:func:`_qr_step`; ``P`` in ``pt``, formed there unless ``formed``). Returns ``(code, x, theta,
+    alpha_aff, sigma, alpha, use_qr)``."""
+    if ok:
+        out = newton_step(step_pt, r_fac, perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp, g_mat,
+                          h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
+                          sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out, chol_out, err_limit)
+        if out[0] != STEP_INACCURATE:
+            return out[0], out[1], out[2], out[3], out[4], out[5], False
+    out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+                   pair_off, pair_row, pair_col, kk, lam, pt, formed, qr_h, qr_tau, r_fac, x, theta, r0, rd,
+                   rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
+    return out[0], out[1], out[2], out[3], out[4], out[5], True
+
+
+@njit(**JIT)
 def rows_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
                    pair_off, pair_row, pair_col, kk, lam, pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
                    no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_out,
@@ -99,23 +122,17 @@ def rows_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, 
     sigma, alpha, use_qr)``, see the module notes. ``h``, ``work``, ``r_fac`` (``(n, n)``),
     ``qr_h`` (``(n, size)``) and ``qr_tau`` (``n``) are workspaces; ``no_qr_h``, ``no_qr_tau``
     empty."""
-    no_perm = np.zeros(0, dtype=np.int64)
     if not scaling_and_schur_rows(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var,
                                   sp_pair, sp_val, pair_off, pair_row, pair_col, kk, lam, pt):
         return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
+    ok = False
     if not use_qr:
         schur_complement(pt, h)
-        if cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
-            out = newton_step(pt, r_fac, no_perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
-                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
-                              sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
-                              chol_out, err_limit)
-            if out[0] != STEP_INACCURATE:
-                return out[0], out[1], out[2], out[3], out[4], out[5], False
-    out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-                   pair_off, pair_row, pair_col, kk, lam, pt, True, qr_h, qr_tau, r_fac, x, theta, r0, rd,
-                   rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
-    return out[0], out[1], out[2], out[3], out[4], out[5], True
+        ok = cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
+    return _cholesky_or_qr_step(ok, pt, r_fac, np.zeros(0, dtype=np.int64), pt, True, s_chol, z, orders,
+                                offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+                                pair_row, pair_col, kk, lam, qr_h, qr_tau, no_qr_h, no_qr_tau, x, theta, r0,
+                                rd, rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out, err_limit)
 
 
 @njit(**JIT)
@@ -127,22 +144,16 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
     """One iteration with ``H`` formed from the factored coefficients
     (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_grouped`), ``P`` not formed (``no_pt``
     ``(n, 0)``), until the QR phase, which forms ``P`` in ``pt``; see :func:`rows_iteration`."""
-    no_perm = np.zeros(0, dtype=np.int64)
+    ok = False
     if not use_qr:
         if not scaling_and_schur_grouped(s_chol, z, orders, dict_mat, dict_dims, fe_off, fe_var, fe_p,
                                          fe_q, fe_val, grp_off, grp_blk, kk, lam, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
-        if cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
-            out = newton_step(no_pt, r_fac, no_perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
-                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
-                              sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
-                              chol_out, err_limit)
-            if out[0] != STEP_INACCURATE:
-                return out[0], out[1], out[2], out[3], out[4], out[5], False
-    out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-                   pair_off, pair_row, pair_col, kk, lam, pt, False, qr_h, qr_tau, r_fac, x, theta, r0, rd,
-                   rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
-    return out[0], out[1], out[2], out[3], out[4], out[5], True
+        ok = cholesky_upper(h, work, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
+    return _cholesky_or_qr_step(ok, no_pt, r_fac, np.zeros(0, dtype=np.int64), pt, False, s_chol, z, orders,
+                                offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off,
+                                pair_row, pair_col, kk, lam, qr_h, qr_tau, no_qr_h, no_qr_tau, x, theta, r0,
+                                rd, rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out, err_limit)
 
 
 @njit(**JIT)
@@ -158,20 +169,15 @@ def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_
     :func:`rows_iteration`. ``H`` is formed in the variable order ``perm`` (block ``j``'s variables
     at ``bv_pos[bv_off[j]:bv_off[j + 1]]`` of that order) and factored there as a block arrow (the
     groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); the Newton solves map
-    their vectors through ``perm``."""
+    their vectors through ``perm``. ``work`` is not used."""
+    ok = False
     if not use_qr:
         if not scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off,
                                            pair_row, pair_col, bv_off, bv_pos, sp_loc, kk, lam, pt_work,
                                            hj_work, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
-        if arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch):
-            out = newton_step(no_pt, r_fac, perm, no_qr_h, no_qr_tau, kk, lam, x, z, theta, r0, rd, rp,
-                              g_mat, h_vec, mu, ref_scale, orders, offsets, ent_row, ent_col, ent_w, sp_off,
-                              sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, s_out, z_out,
-                              chol_out, err_limit)
-            if out[0] != STEP_INACCURATE:
-                return out[0], out[1], out[2], out[3], out[4], out[5], False
-    out = _qr_step(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
-                   pair_off, pair_row, pair_col, kk, lam, pt, False, qr_h, qr_tau, r_fac, x, theta, r0, rd,
-                   rp, g_mat, h_vec, mu, ref_scale, s_out, z_out, chol_out)
-    return out[0], out[1], out[2], out[3], out[4], out[5], True
+        ok = arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
+    return _cholesky_or_qr_step(ok, no_pt, r_fac, perm, pt, False, s_chol, z, orders, offsets, ent_row,
+                                ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col,
+                                kk, lam, qr_h, qr_tau, no_qr_h, no_qr_tau, x, theta, r0, rd, rp, g_mat, h_vec,
+                                mu, ref_scale, s_out, z_out, chol_out, err_limit)
