@@ -740,7 +740,8 @@ class BlockLMISolver(BlockData):
         n, size, nb, kmax = self.n, self._layout.size, len(self.block_orders), self._kmax
         bv_off, orders = self._blockvars[0], self._layout.orders
         own = np.diff(bv_off)
-        block_size = int(np.max(own * (orders * (orders + 1) // 2), initial=0))
+        sizes = orders * (orders + 1) // 2
+        block_size = int(np.max(2 * own * sizes + sizes * sizes, initial=0))  # M, U', U of _block_gram
         block_h = int(np.max(own * own, initial=0))
         work = getattr(self, "_work", None)
         if (work is None or work[2].shape != (n, size) or work[0].shape != (nb, kmax, kmax)
