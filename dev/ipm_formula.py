@@ -46,13 +46,7 @@ from benchmarks.suites.methods import _controller, method_options
 from benchmarks.suites.methods_problems import build_problem
 from lmi.ipm import BlockLMISolver
 from lmi.ipm import kernels as ker
-from lmi.ipm.blocks import (
-    DIRECT_MIN_VARIABLES,
-    SCHUR_PAIR_COST,
-    SCHUR_PRODUCT_COST,
-    SCHUR_STREAM_COST,
-    BlockData,
-)
+from lmi.ipm.blocks import DIRECT_MIN_VARIABLES, BlockData, formula_costs
 from lmi.ipm.kernels.lapack import schur_complement
 from lmi.ipm.kernels.step import _p_times, _pt_times
 from toolkit_common.errors import InvalidArgumentError
@@ -268,8 +262,8 @@ def fit(fits: list[Fit]) -> None:
     for name, t, _, td, tr in fits:
         if t["variables"] <= DIRECT_MIN_VARIABLES:  # rows whatever the model says
             continue
-        direct = SCHUR_PAIR_COST * t["pairs"] + t["dictionary"]
-        rows = SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"]
+        costs = formula_costs(t)
+        direct, rows = costs["direct"], costs["rows"]
         if (direct < rows) != (td < tr) and max(td, tr) > 1.3 * min(td, tr):
             wrong.append(name)
     print(f"the package's constants pick the slower formula by more than 1.3x in {len(wrong)} of "

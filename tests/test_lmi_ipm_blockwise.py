@@ -119,7 +119,7 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
     schur_complement(pt, h_rows)
     kk, lam, h = np.zeros_like(kk_rows), np.zeros_like(lam_rows), np.full((n, n), np.nan)
     work = solver._workspace()
-    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, lay.offsets, sp[0], *sp[2:],
+    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, sp[0], *sp[2:],
                                                *solver._blockvars, kk, lam, work[9], work[10], h)
     np.testing.assert_array_equal(kk, kk_rows)
     np.testing.assert_array_equal(lam, lam_rows)
@@ -132,7 +132,7 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
     perm = solver._arrow[0]
     assert not np.array_equal(perm, np.arange(n))
     h_perm = np.full((n, n), np.nan)
-    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, lay.offsets, sp[0], *sp[2:],
+    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, sp[0], *sp[2:],
                                                solver._blockvars[0], solver._arrow_positions,
                                                solver._blockvars[2], kk, lam, work[9], work[10], h_perm)
     np.testing.assert_array_equal(h_perm, h[perm][:, perm])

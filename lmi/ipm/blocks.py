@@ -54,7 +54,7 @@ BlockFactor = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 DIRECT_MIN_VARIABLES = 64
 
 #: The cost model of the choice between the two formulas of the Schur complement
-#: (:meth:`BlockData._direct_is_cheaper`, terms :meth:`BlockData._schur_terms`), in units of one
+#: (:meth:`BlockData._choose_formula`, terms :meth:`BlockData._schur_terms`), in units of one
 #: operation of the rows formula's ``dsyrk``: a pair of factored entries of the direct formula
 #: costs :data:`SCHUR_PAIR_COST`, a multiply-add forming ``P'`` :data:`SCHUR_STREAM_COST`, and an
 #: entry of ``P'`` :data:`SCHUR_PRODUCT_COST` more for the Newton step's products with the formed
@@ -345,7 +345,7 @@ class BlockData:
         return dmat, var, p, q, val * entry_weight(p, q)
 
     def _schur_terms(self) -> dict[str, float]:
-        """The terms of the cost model of :meth:`_direct_is_cheaper` (counts, not seconds).
+        """The terms of the cost model of :meth:`_choose_formula` (counts, not seconds).
 
         ``pairs``: the pairs of factored entries the direct formula visits (``e(e + 1)/2`` per
         group of ``e`` entries, once per member of the group); ``dictionary``: the products
@@ -381,18 +381,8 @@ class BlockData:
                 "scatter": scatter}
 
     def _formula_costs(self) -> dict[str, float]:
-        """The cost model's prediction per Schur formula (see :data:`SCHUR_PAIR_COST`), in units of
-        one ``dsyrk`` operation: ``rows`` (``P'`` formed, one ``dsyrk``, the step's products with
-        the formed ``P``), ``direct`` (the pair sums) and ``blockwise`` (``P_j'P_j`` on each block's
-        own variables, :func:`lmi.ipm.kernels.scaling_and_schur_blockwise`; its step's products
-        come from the sparse coefficients, as the direct formula's, and are not counted)."""
-        t = self._schur_terms()
-        return {
-            "rows": SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"],
-            "direct": SCHUR_PAIR_COST * t["pairs"] + t["dictionary"],
-            "blockwise": (SCHUR_STREAM_COST * t["block_stream"] + t["block_syrk"]
-                          + SCHUR_SCATTER_COST * t["scatter"]),
-        }
+        """:func:`formula_costs` of this problem's terms (:meth:`_schur_terms`)."""
+        return formula_costs(self._schur_terms())
 
     def _choose_formula(self) -> str:
         """The Schur formula of the iterations: ``"rows"`` for at most :data:`DIRECT_MIN_VARIABLES`
@@ -401,18 +391,27 @@ class BlockData:
         rows formula's (the blocks hold disjoint parts of the variables)."""
         if self.n <= DIRECT_MIN_VARIABLES:
             return "rows"
-        costs = self._formula_costs()
         t = self._schur_terms()
+        costs = formula_costs(t)
         if t["block_syrk"] > BLOCKWISE_SHARE * t["syrk"]:
             costs.pop("blockwise")
         return min(costs, key=costs.__getitem__)
 
-    def _direct_is_cheaper(self) -> bool:
-        """Whether forming ``H`` from the factored coefficients is predicted to take less time than
-        forming ``P'`` and ``P'P`` and using ``P`` in the step (the model of
-        :data:`SCHUR_PAIR_COST`), for more than :data:`DIRECT_MIN_VARIABLES` variables."""
-        costs = self._formula_costs()
-        return self.n > DIRECT_MIN_VARIABLES and costs["direct"] < costs["rows"]
+
+def formula_costs(terms: dict[str, float]) -> dict[str, float]:
+    """The cost model's prediction per Schur formula (see :data:`SCHUR_PAIR_COST`) from the terms
+    of :meth:`BlockData._schur_terms`, in units of one ``dsyrk`` operation: ``rows`` (``P'``
+    formed, one ``dsyrk``, the step's products with the formed ``P``), ``direct`` (the pair sums)
+    and ``blockwise`` (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`, estimated by forming
+    ``P_j'`` and a ``dsyrk`` per block, an upper bound of its Gram form's work; its step's
+    products come from the sparse coefficients, as the direct formula's, and are not counted)."""
+    t = terms
+    return {
+        "rows": SCHUR_STREAM_COST * t["stream"] + t["syrk"] + SCHUR_PRODUCT_COST * t["products"],
+        "direct": SCHUR_PAIR_COST * t["pairs"] + t["dictionary"],
+        "blockwise": (SCHUR_STREAM_COST * t["block_stream"] + t["block_syrk"]
+                      + SCHUR_SCATTER_COST * t["scatter"]),
+    }
 
 
 def block_variables(sparse: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -159,11 +159,11 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
 @njit(**JIT)
 def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
                         sp_val, pair_off, pair_row, pair_col, bv_off, bv_pos, sp_loc, perm, arrow_off,
-                        pt_work, hj_work, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
+                        gram_work, hj_work, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
                         no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch,
                         s_out, z_out, chol_out, err_limit):
     """One iteration with ``H`` formed block by block on each block's own variables
-    (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_blockwise`; ``pt_work`` and ``hj_work`` its
+    (:func:`~lmi.ipm.kernels.schur.scaling_and_schur_blockwise`; ``gram_work`` and ``hj_work`` its
     workspaces), ``P`` not formed (``no_pt`` ``(n, 0)``: the Newton step's products come from the
     sparse coefficients) until the QR phase, which forms ``P`` in ``pt``; see
     :func:`rows_iteration`. ``H`` is formed in the variable order ``perm`` (block ``j``'s variables
@@ -172,9 +172,8 @@ def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_
     their vectors through ``perm``. ``work`` is not used."""
     ok = False
     if not use_qr:
-        if not scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off,
-                                           pair_row, pair_col, bv_off, bv_pos, sp_loc, kk, lam, pt_work,
-                                           hj_work, h):
+        if not scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair_off, pair_row,
+                                           pair_col, bv_off, bv_pos, sp_loc, kk, lam, gram_work, hj_work, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
         ok = arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
     return _cholesky_or_qr_step(ok, no_pt, r_fac, perm, pt, False, s_chol, z, orders, offsets, ent_row,

@@ -172,14 +172,14 @@ def _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_p
 
 
 @njit(**JIT)
-def scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_val, pair_off, pair_row,
-                                pair_col, bv_off, bv_var, sp_loc, kk_out, lam_out, pt_work, h_work, h_out):
+def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair_off, pair_row, pair_col,
+                                bv_off, bv_var, sp_loc, kk_out, lam_out, gram_work, h_work, h_out):
     """NT scaling of every block and ``H = P'P`` formed block by block on each block's own variables.
 
     Block ``j`` holds only the variables ``bv_var[bv_off[j]:bv_off[j + 1]]`` (``n_j`` of them,
     ascending; ``sp_loc[e]`` is entry ``e``'s position among them): its ``P_j'P_j`` (``n_j x n_j``,
     in ``h_work``; :func:`_block_gram`, from the Gram matrix of the block's position pairs, ``P_j``
-    never formed; ``pt_work`` its workspace) is added into ``H`` at those variables (``bv_var``
+    never formed; ``gram_work`` its workspace) is added into ``H`` at those variables (``bv_var``
     their indices; the solver passes their positions in the order of its block-arrow factor,
     forming ``H`` in that order). A vertex form's blocks each hold one vertex's Lyapunov matrix
     and the shared variables, so that ``H`` is block-arrow shaped. Measured on the 14-state
@@ -202,8 +202,8 @@ def scaling_and_schur_blockwise(s_chol, z, orders, offsets, sp_off, sp_pair, sp_
         if nj == 0:
             continue
         hj = h_work[: nj * nj].reshape((nj, nj))
-        _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_pair, sp_val, nj, pt_work,
-                    hj)
+        _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_pair, sp_val, nj,
+                    gram_work, hj)
         for a in range(nj):
             hrow = h_out[bv_var[lo + a]]
             for b in range(nj):
