@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from lmi.forms import FormProblem
-from lmi.forms.problem import LAMBDA_GRID, LAMBDA_REFINE
+from lmi.forms.problem import LAMBDA_FLAT, LAMBDA_GRID, LAMBDA_REFINE
 from toolkit_common.errors import InvalidArgumentError
 
 FULL = len(LAMBDA_GRID) + LAMBDA_REFINE  # the full search's solves when the grid certifies one
@@ -202,6 +202,31 @@ def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
     second = prob.solve(x0)
     assert prob.last_lambda_search.how == "warm" and len(calls) == 3 + 2
     assert abs(logit(second.lam) - centre[0]) < 1e-5
+
+
+def test_no_step_when_the_kept_curvature_predicts_a_gain_below_the_flat_tolerance():
+    """The objective ``1 + 2 (t - c)^2``: after the first warm search keeps the curvature 4, ``c``
+    moves by 4e-4; a Newton step would gain ``(4 * 4e-4)^2 / (2 * 4) = 3.2e-7`` relative, less than
+    :data:`LAMBDA_FLAT`: the search ends after the solve at the previous lam, within that of the
+    minimum. At 5e-3 (a gain of 5e-5) it steps (the test above)."""
+    kw, _, x0 = kothare_ex1()
+    prob = FormProblem(**kw)
+    centre = [logit(0.62)]
+    calls = fake(prob, lambda lam: 1.0 + 2.0 * (logit(lam) - centre[0]) ** 2, slopes=True)
+    prob._lam_prev = 0.6
+    first = prob.solve(x0)
+    assert len(calls) == 3 and prob._lam_curvature == pytest.approx(4.0, rel=1e-4)
+    centre[0] += 4e-4
+    second = prob.solve(x0)
+    assert prob.last_lambda_search.how == "warm" and len(calls) == 3 + 1
+    assert second.lam == first.lam
+    assert 1.0 < second.gamma <= 1.0 + LAMBDA_FLAT
+    # the next state starts at the Newton step's end, the moved minimum
+    assert abs(logit(prob._lam_prev) - centre[0]) < 1e-9
+    centre[0] += 4e-4  # the minimum drifts on by as much: again one solve
+    third = prob.solve(x0)
+    assert len(calls) == 3 + 2 and abs(logit(third.lam) - (centre[0] - 4e-4)) < 1e-9
+    assert 1.0 < third.gamma <= 1.0 + LAMBDA_FLAT
 
 
 @pytest.mark.parametrize("slopes", [False, True])
