@@ -1,8 +1,9 @@
 """The blockwise Schur formula of the interior-point solver and its block-arrow factorisation.
 
-* :func:`lmi.ipm.kernels.scaling_and_schur_blockwise` forms the same ``H = P'P`` as the rows
-  formula (``P'`` formed, one ``dsyrk``) and the same NT scaling, on problems whose blocks hold
-  disjoint parts of the variables plus shared ones (as the vertex forms' blocks do);
+* :func:`lmi.ipm.kernels.scaling_and_schur_blockwise` forms the lower triangle of the same
+  ``H = P'P`` as the rows formula (``P'`` formed, one ``dsyrk``) and the same NT scaling, on
+  problems whose blocks hold disjoint parts of the variables plus shared ones (as the vertex
+  forms' blocks do);
 * :func:`lmi.ipm.blocks.arrow_order` gives groups that no block couples, and
   :func:`lmi.ipm.kernels.lapack.arrow_cholesky` the Cholesky factor of ``H`` in that order
   (checked against LAPACK's dense factor of the permuted matrix, which is unique);
@@ -123,19 +124,24 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
                                                *solver._blockvars, kk, lam, work[9], work[10], h)
     np.testing.assert_array_equal(kk, kk_rows)
     np.testing.assert_array_equal(lam, lam_rows)
+    lower = np.tril(np.ones((n, n), dtype=bool))
+    assert np.all(np.isnan(h[~lower]))  # the lower triangle only: the strict upper one not written
     scale = np.abs(pt) @ np.abs(pt).T
-    assert np.all(np.abs(h - h_rows) <= 64 * EPS * scale)
+    assert np.all(np.abs(h - h_rows)[lower] <= 64 * EPS * scale[lower])
     # the block structure is real: entries between two groups' private variables are exactly 0
-    first, last = np.argsort(shuffle)[0], np.argsort(shuffle)[n - 6]  # variables 0 and n - 6 before
-    assert h[first, last] == 0.0 and h_rows[first, last] == 0.0
-    # given the variables' positions in the arrow order, the same sums land there: H[perm][:, perm]
+    first, last = np.argsort(shuffle)[[0, n - 6]]  # variables 0 and n - 6 before the shuffle
+    assert h[max(first, last), min(first, last)] == 0.0 and h_rows[first, last] == 0.0
+    # given the variables' positions in the arrow order (ascending per block), H[perm][:, perm]
+    # lands in the lower triangle
     perm = solver._arrow[0]
     assert not np.array_equal(perm, np.arange(n))
     h_perm = np.full((n, n), np.nan)
     assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, sp[0], *sp[2:],
-                                               solver._blockvars[0], solver._arrow_positions,
-                                               solver._blockvars[2], kk, lam, work[9], work[10], h_perm)
-    np.testing.assert_array_equal(h_perm, h[perm][:, perm])
+                                               solver._blockvars[0], *solver._arrow_local, kk, lam,
+                                               work[9], work[10], h_perm)
+    assert np.all(np.isnan(h_perm[~lower]))
+    want = h_rows[perm][:, perm]
+    assert np.all(np.abs(h_perm - want)[lower] <= 64 * EPS * scale[perm][:, perm][lower])
 
 
 def test_block_variables_and_the_arrow_order_of_a_vertex_like_problem():
@@ -208,10 +214,11 @@ def test_arrow_cholesky_is_the_cholesky_factor_of_the_permuted_matrix(seed):
     g = solver._g_mat
     h = g.T @ g + 1e-3 * np.eye(solver.n)
     hp = h[perm][:, perm]
+    want = cholesky(hp, lower=False)
+    hp[np.triu_indices_from(hp, 1)] = np.nan  # only the lower triangle is read
     r = np.full_like(h, np.nan)
     kept = hp.copy()
     assert arrow_cholesky(hp, grp_off, r) == 0
-    want = cholesky(hp, lower=False)
     assert np.max(np.abs(r - want)) <= 1e-12 * np.max(np.abs(want))
     np.testing.assert_array_equal(hp, kept)  # left as it is (the pivot test reads its diagonal)
     for a in range(len(grp_off) - 1):

@@ -208,7 +208,8 @@ class BlockData:
         self._formula = "rows"
         self._arrow: tuple[np.ndarray, np.ndarray] = (np.arange(n, dtype=np.int64),
                                                       np.zeros(1, dtype=np.int64))
-        self._arrow_positions = np.zeros(0, dtype=np.int64)
+        self._arrow_local: tuple[np.ndarray, np.ndarray] = (np.zeros(0, dtype=np.int64),
+                                                            np.zeros(0, dtype=np.int64))
         self._blockvars: tuple[np.ndarray, np.ndarray, np.ndarray] = block_variables(
             (np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)))
         self._const: list[np.ndarray] = [const for const, _ in checked]
@@ -303,9 +304,7 @@ class BlockData:
             self._formula = self._choose_formula()
             self._arrow = arrow_order(self._blockvars, self.n)
             # where each block's variables sit in that order (H is formed there directly)
-            position = np.empty(self.n, dtype=np.int64)
-            position[self._arrow[0]] = np.arange(self.n, dtype=np.int64)
-            self._arrow_positions = position[self._blockvars[1]]
+            self._arrow_local = arrow_local(self._blockvars, self._sparse[0], self._arrow[0])
 
     @property
     def _direct(self) -> bool:
@@ -429,6 +428,28 @@ def block_variables(sparse: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndar
     bv_off = np.cumsum([0, *(v.shape[0] for v in own)]).astype(np.int64)
     return (bv_off, np.concatenate([np.zeros(0, dtype=np.int64), *own]).astype(np.int64),
             np.concatenate([np.zeros(0, dtype=np.int64), *loc]).astype(np.int64))
+
+
+def arrow_local(blockvars: tuple[np.ndarray, ...], sp_off: np.ndarray,
+                perm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The blockwise kernel's ``bv_pos, sp_loc`` for forming ``H`` in the variable order ``perm``
+    (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`): block ``j``'s variables' positions in
+    that order, ascending, ``bv_pos[bv_off[j]:bv_off[j + 1]]``, and entry ``e``'s place among them
+    ``sp_loc[e]`` (``blockvars`` as :func:`block_variables` gives them, ``sp_off`` the blocks'
+    entry offsets). Ascending, so that a block's lower triangle lands in ``H``'s."""
+    bv_off, bv_var, sp_loc = blockvars
+    position = np.empty(perm.shape[0], dtype=np.int64)
+    position[perm] = np.arange(perm.shape[0], dtype=np.int64)
+    pos = position[bv_var]
+    bv_pos, loc = np.empty_like(pos), np.empty_like(sp_loc)
+    for j in range(bv_off.shape[0] - 1):
+        lo, hi = bv_off[j], bv_off[j + 1]
+        order = np.argsort(pos[lo:hi], kind="stable")
+        bv_pos[lo:hi] = pos[lo:hi][order]
+        rank = np.empty(hi - lo, dtype=np.int64)
+        rank[order] = np.arange(hi - lo, dtype=np.int64)
+        loc[sp_off[j]:sp_off[j + 1]] = rank[sp_loc[sp_off[j]:sp_off[j + 1]]]
+    return bv_pos, loc
 
 
 def arrow_order(blockvars: tuple[np.ndarray, ...], n: int) -> tuple[np.ndarray, np.ndarray]:

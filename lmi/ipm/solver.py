@@ -678,7 +678,7 @@ class BlockLMISolver(BlockData):
             # one compiled call: the scaling, H or P, its factor and the step (kernels.iteration)
             if self._formula == "blockwise":  # H block by block, P formed in the QR phase only
                 out = _kernels.blockwise_iteration(
-                    s_chol, z, *packing, *sp, self._blockvars[0], self._arrow_positions, self._blockvars[2],
+                    s_chol, z, *packing, *sp, self._blockvars[0], *self._arrow_local,
                     *self._arrow, gram_block, h_block, kk, lam,
                     pt_mat, no_pt, h_mat, h_work, r_fac, qr_h, qr_tau, *no_qr, use_qr, x, theta, r0, rd, rp,
                     g_kern, h_vec, mu, ref_scale, qr_switch, s_new, z_new, chol_new, err_limit)

@@ -144,7 +144,9 @@ def triangular_solve_blas(r_fac, b):
 
 @njit(**JIT)
 def arrow_cholesky(hp, grp_off, r_out):
-    """Upper Cholesky factor ``R`` (``R'R = H_p``) of a block-arrow ``H_p`` (``hp``, left as it is):
+    """Upper Cholesky factor ``R`` (``R'R = H_p``) of a block-arrow ``H_p`` (``hp``, left as it is;
+    only its lower triangle is read, :func:`~lmi.ipm.kernels.schur.scaling_and_schur_blockwise`
+    forms no more):
     the groups ``grp_off[g]:grp_off[g + 1]`` are coupled to no other group, only to the border
     (the variables from ``grp_off[-1]`` on). Each group's block ``D_g = R_g'R_g`` is factored on
     its own, its border rows ``X_g = R_g'^-1 E_g`` (``E_g`` the group's rows of the border
@@ -176,8 +178,12 @@ def arrow_cholesky(hp, grp_off, r_out):
         if nb == 0:
             continue
         # X_g (ng x nb, C-ordered) = R_g'^-1 E_g: its Fortran view X_g' = E_g' R_g^-1, with
-        # R_g's Fortran view R_g' lower: side R, uplo L, transa T
-        xg = np.ascontiguousarray(hp[lo:hi, nbor:])
+        # R_g's Fortran view R_g' lower: side R, uplo L, transa T. E_g from the lower triangle
+        xg = np.empty((ng, nb))
+        for b in range(nb):
+            src = hp[nbor + b]
+            for a in range(ng):
+                xg[a, b] = src[lo + a]
         ints = np.array([nb, ng], dtype=np.int32)
         _dtrsm(chars[0:].ctypes, chars[1:].ctypes, chars[2:].ctypes, chars[3:].ctypes, ints[0:].ctypes,
                ints[1:].ctypes, scalars[0:].ctypes, rg.ctypes, ints[1:].ctypes, xg.ctypes, ints[0:].ctypes)

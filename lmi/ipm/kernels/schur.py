@@ -123,7 +123,8 @@ def _block_rows(kk_out, j, k, size, pair_off, pair_row, pair_col, sp_off, sp_row
 
 @njit(**JIT)
 def _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_pair, sp_val, nj, work, hj):
-    """``P_j'P_j`` of block ``j`` on its ``nj`` own variables into ``hj``, without ``P_j``.
+    """``P_j'P_j`` of block ``j`` on its ``nj`` own variables into the lower triangle of ``hj``
+    (the strict upper triangle is not written), without ``P_j``.
 
     Row ``i`` of ``P_j'`` is ``sum_e v_e b_(q_e)`` over the block's entries of variable ``i``
     (:func:`_block_rows`), ``b_q`` the packed ``K S_q K'`` of position pair ``q = (a, c)`` (``S_q =
@@ -134,7 +135,9 @@ def _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_p
     then ``U = M V`` (one contiguous multiply-add of length ``p`` per entry) and ``V'U`` (one of
     length ``nj`` per entry), instead of ``nj x size`` rows of ``P_j'`` and an ``nj^2 size``
     ``dsyrk``: 22 times less arithmetic on the flexible satellite's vertex forms over 8 vertices.
-    ``work`` holds ``M``, ``U'`` and ``U`` (``p^2 + 2 p nj``)."""
+    ``V'U`` is formed on and below the diagonal only (``H`` is symmetric; its factor reads that
+    triangle), about half of that product's ``e_j nj``. ``work`` holds ``M``, ``U'`` and ``U``
+    (``p^2 + 2 p nj``)."""
     kj = np.ascontiguousarray(kk_out[j, :k, :k])
     w = kj.T @ kj
     first = pair_off[j]
@@ -162,12 +165,15 @@ def _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_p
     for i in range(nj):
         for t in range(p):
             u[t, i] = ut[i, t]
-    hj[:, :] = 0.0
-    for e in range(sp_off[j], sp_off[j + 1]):  # V'U, row i: sum_e v_e U[q_e]
+    for i in range(nj):
+        for t in range(i + 1):
+            hj[i, t] = 0.0
+    for e in range(sp_off[j], sp_off[j + 1]):  # V'U, row i: sum_e v_e U[q_e], up to the diagonal
         v = sp_val[e]
-        row = hj[sp_loc[e]]
+        i = sp_loc[e]
+        row = hj[i]
         src = u[sp_pair[e] - first]
-        for t in range(nj):
+        for t in range(i + 1):
             row[t] += v * src[t]
 
 
@@ -176,8 +182,11 @@ def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair
                                 bv_off, bv_var, sp_loc, kk_out, lam_out, gram_work, h_work, h_out):
     """NT scaling of every block and ``H = P'P`` formed block by block on each block's own variables.
 
-    Block ``j`` holds only the variables ``bv_var[bv_off[j]:bv_off[j + 1]]`` (``n_j`` of them,
-    ascending; ``sp_loc[e]`` is entry ``e``'s position among them): its ``P_j'P_j`` (``n_j x n_j``,
+    Only the lower triangle of ``H`` is formed (the strict upper triangle of ``h_out`` is not
+    written; :func:`~lmi.ipm.kernels.lapack.arrow_cholesky` reads the lower one). Block ``j``
+    holds only the variables ``bv_var[bv_off[j]:bv_off[j + 1]]`` (``n_j`` of them, ascending,
+    so that each block's lower triangle lands in ``H``'s; ``sp_loc[e]`` is entry ``e``'s
+    position among them): its ``P_j'P_j`` (``n_j x n_j``,
     in ``h_work``; :func:`_block_gram`, from the Gram matrix of the block's position pairs, ``P_j``
     never formed; ``gram_work`` its workspace) is added into ``H`` at those variables (``bv_var``
     their indices; the solver passes their positions in the order of its block-arrow factor,
@@ -191,7 +200,7 @@ def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair
     """
     n = h_out.shape[0]
     for a in range(n):
-        for b in range(n):
+        for b in range(a + 1):
             h_out[a, b] = 0.0
     for j in range(orders.shape[0]):
         k = orders[j]
@@ -204,9 +213,9 @@ def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair
         hj = h_work[: nj * nj].reshape((nj, nj))
         _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_pair, sp_val, nj,
                     gram_work, hj)
-        for a in range(nj):
+        for a in range(nj):  # ascending positions: the lower triangle lands in the lower triangle
             hrow = h_out[bv_var[lo + a]]
-            for b in range(nj):
+            for b in range(a + 1):
                 hrow[bv_var[lo + b]] += hj[a, b]
     return True
 
