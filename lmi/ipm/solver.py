@@ -226,6 +226,10 @@ class IPMResult:
     solve_time: float
     infeasibility_radius: float = float("nan")
     solver_status: str = ""
+    #: How many of the ``iterations`` took their step from the QR factorisation of ``P`` (the
+    #: phase after the Cholesky factor of ``H`` lost the accuracy the step needs, see
+    #: :data:`QR_SWITCH`, :data:`STEP_ACCURACY`); a warm start's failed run included.
+    qr_iterations: int = 0
 
 
 
@@ -379,14 +383,15 @@ class BlockLMISolver(BlockData):
         with self._blas.limit():
             self._refresh()
             res = None
-            spent = 0
+            spent = spent_qr = 0
             if warm_start and self._warm is not None:
                 res = self._run(self._warm, self.warm_max_iter)
                 if res.status not in ("optimal", "infeasible"):
-                    spent, res = res.iterations, None
+                    spent, spent_qr, res = res.iterations, res.qr_iterations, None
             if res is None:
                 res = self._run(None, self.max_iter)
         res.iterations += spent
+        res.qr_iterations += spent_qr
         res.solver_status = res.status
         res.status = SOLVER_STATUS_MAP[res.status]
         res.solve_time = time.perf_counter() - start
@@ -597,6 +602,7 @@ class BlockLMISolver(BlockData):
         pres = dres = gap = np.inf
         it = 0
         use_qr = False
+        qr_steps = 0
         qr_switch = self.qr_switch()
         no_qr = (np.zeros((0, 0)), np.zeros(0))  # no Householder factors (the Cholesky phase)
         best: tuple | None = None
@@ -693,6 +699,7 @@ class BlockLMISolver(BlockData):
                     use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_new, z_new,
                     chol_new, err_limit)
             code, x_new, theta, a_aff, sigma, alpha, use_qr = out
+            qr_steps += int(use_qr)
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
             if code != 0:
@@ -721,6 +728,7 @@ class BlockLMISolver(BlockData):
         return IPMResult(
             status, x * dscale, s_out, z_out, it, float(cvec @ x) / obj_scale, -float(h_vec @ zp) / obj_scale,
             pres, dres, gap / obj_scale, 0.0, radius if status == "infeasible" else np.nan,
+            qr_iterations=qr_steps,
         )
 
     def __getstate__(self) -> dict[str, Any]:
