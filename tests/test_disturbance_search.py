@@ -185,10 +185,10 @@ def test_a_minimum_near_the_previous_lam_is_found_by_the_bracket_and_refinement(
     assert prob._lam_prev == sol.lam  # the next state's bracket centre
 
 
-def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
-    """The objective ``1 + 2 (t - c)^2`` (``t`` the log-odds of lam): the first warm search finds
-    ``c`` and keeps the curvature 4; when ``c`` moves by 5e-3, one Newton step from the previous
-    lam lands where the slope is flat: two solves."""
+def after_a_first_warm_search() -> tuple:
+    """``(prob, calls, centre, first, x0)``: the objective ``1 + 2 (t - c)^2`` (``t`` the log-odds of
+    lam, ``c = centre[0]``) searched warm from lam 0.6; the search finds ``c`` in three solves and
+    keeps the curvature 4."""
     kw, _, x0 = kothare_ex1()
     prob = FormProblem(**kw)
     centre = [logit(0.62)]
@@ -197,6 +197,13 @@ def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
     first = prob.solve(x0)
     assert prob.last_lambda_search.how == "warm" and len(calls) == 3
     assert prob._lam_curvature == pytest.approx(4.0, rel=1e-4)
+    return prob, calls, centre, first, x0
+
+
+def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
+    """After the first warm search (:func:`after_a_first_warm_search`), ``c`` moves by 5e-3: one
+    Newton step from the previous lam lands where the slope is flat: two solves."""
+    prob, calls, centre, first, x0 = after_a_first_warm_search()
     assert abs(logit(first.lam) - centre[0]) < 1e-5
     centre[0] += 5e-3
     second = prob.solve(x0)
@@ -205,17 +212,11 @@ def test_the_next_state_starts_with_a_newton_step_on_the_kept_curvature():
 
 
 def test_no_step_when_the_kept_curvature_predicts_a_gain_below_the_flat_tolerance():
-    """The objective ``1 + 2 (t - c)^2``: after the first warm search keeps the curvature 4, ``c``
-    moves by 4e-4; a Newton step would gain ``(4 * 4e-4)^2 / (2 * 4) = 3.2e-7`` relative, less than
+    """After the first warm search (:func:`after_a_first_warm_search`), ``c`` moves by 4e-4; a
+    Newton step would gain ``(4 * 4e-4)^2 / (2 * 4) = 3.2e-7`` relative, less than
     :data:`LAMBDA_FLAT`: the search ends after the solve at the previous lam, within that of the
     minimum. At 5e-3 (a gain of 5e-5) it steps (the test above)."""
-    kw, _, x0 = kothare_ex1()
-    prob = FormProblem(**kw)
-    centre = [logit(0.62)]
-    calls = fake(prob, lambda lam: 1.0 + 2.0 * (logit(lam) - centre[0]) ** 2, slopes=True)
-    prob._lam_prev = 0.6
-    first = prob.solve(x0)
-    assert len(calls) == 3 and prob._lam_curvature == pytest.approx(4.0, rel=1e-4)
+    prob, calls, centre, first, x0 = after_a_first_warm_search()
     centre[0] += 4e-4
     second = prob.solve(x0)
     assert prob.last_lambda_search.how == "warm" and len(calls) == 3 + 1
