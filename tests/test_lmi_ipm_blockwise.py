@@ -30,7 +30,7 @@ import pytest
 from scipy.linalg import cholesky
 
 from lmi.ipm import BlockLMISolver, kernels
-from lmi.ipm.blocks import BlockData, arrow_order, block_variables
+from lmi.ipm.blocks import BlockData, arrow_local, arrow_order, block_variables
 from lmi.ipm.kernels.lapack import arrow_cholesky, schur_complement
 from lmi.ipm.kernels.packed import g_times, gt_times
 
@@ -120,8 +120,9 @@ def test_blockwise_schur_equals_the_rows_formula(seed):
     schur_complement(pt, h_rows)
     kk, lam, h = np.zeros_like(kk_rows), np.zeros_like(lam_rows), np.full((n, n), np.nan)
     work = solver._workspace()
-    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, sp[0], *sp[2:],
-                                               *solver._blockvars, kk, lam, work[9], work[10], h)
+    given_order = arrow_local(solver._blockvars, sp[0], np.arange(n))
+    assert kernels.scaling_and_schur_blockwise(s_chol, z, lay.orders, sp[0], *sp[2:], solver._blockvars[0],
+                                               *given_order, kk, lam, work[9], work[10], h)
     np.testing.assert_array_equal(kk, kk_rows)
     np.testing.assert_array_equal(lam, lam_rows)
     lower = np.tril(np.ones((n, n), dtype=bool))
@@ -163,6 +164,36 @@ def test_block_variables_and_the_arrow_order_of_a_vertex_like_problem():
     groups = [set(perm[grp_off[g]:grp_off[g + 1]].tolist()) for g in range(len(grp_off) - 1)]
     assert sorted(map(sorted, groups)) == [list(range(7 * g, 7 * g + 7)) for g in range(4)]
     assert set(perm[grp_off[-1]:].tolist()) == set(range(28, 33))
+
+
+def test_arrow_local_positions_ascend_and_their_runs_cover_them():
+    """On random structures and a random order: each block's positions ascend, each entry's place
+    maps back to its variable, and the runs ``(first, position, length)`` are maximal and give
+    every position exactly once."""
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        n, nb = int(rng.integers(2, 30)), int(rng.integers(1, 12))
+        held = [np.sort(rng.choice(n, size=int(rng.integers(1, n + 1)), replace=False)) for _ in range(nb)]
+        sp_off = np.cumsum([0, *(3 * h.size for h in held)]).astype(np.int64)
+        sp_var = np.concatenate([rng.permutation(np.repeat(h, 3)) for h in held]).astype(np.int64)
+        blockvars = block_variables((sp_off, sp_var))
+        perm = rng.permutation(n).astype(np.int64)
+        position = np.argsort(perm)
+        bv_pos, loc, run_off, runs = arrow_local(blockvars, sp_off, perm)
+        bv_off = blockvars[0]
+        for j in range(nb):
+            own = bv_pos[bv_off[j]:bv_off[j + 1]]
+            assert np.all(np.diff(own) > 0)
+            entries = slice(sp_off[j], sp_off[j + 1])
+            np.testing.assert_array_equal(own[loc[entries]], position[sp_var[entries]])
+            rebuilt = []
+            for first, pos, length in runs[run_off[j]:run_off[j + 1]]:
+                assert len(rebuilt) == first and length >= 1
+                rebuilt.extend(range(pos, pos + length))
+            np.testing.assert_array_equal(rebuilt, own)
+            starts = runs[run_off[j]:run_off[j + 1], 1]
+            ends = starts + runs[run_off[j]:run_off[j + 1], 2]
+            assert np.all(starts[1:] > ends[:-1])  # maximal: no run continues the one before
 
 
 def test_arrow_order_never_groups_two_classes_a_block_couples():

@@ -208,8 +208,9 @@ class BlockData:
         self._formula = "rows"
         self._arrow: tuple[np.ndarray, np.ndarray] = (np.arange(n, dtype=np.int64),
                                                       np.zeros(1, dtype=np.int64))
-        self._arrow_local: tuple[np.ndarray, np.ndarray] = (np.zeros(0, dtype=np.int64),
-                                                            np.zeros(0, dtype=np.int64))
+        self._arrow_local: tuple[np.ndarray, ...] = (
+            np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64),
+            np.zeros((0, 3), dtype=np.int64))
         self._blockvars: tuple[np.ndarray, np.ndarray, np.ndarray] = block_variables(
             (np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)))
         self._const: list[np.ndarray] = [const for const, _ in checked]
@@ -431,25 +432,35 @@ def block_variables(sparse: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndar
 
 
 def arrow_local(blockvars: tuple[np.ndarray, ...], sp_off: np.ndarray,
-                perm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The blockwise kernel's ``bv_pos, sp_loc`` for forming ``H`` in the variable order ``perm``
-    (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`): block ``j``'s variables' positions in
-    that order, ascending, ``bv_pos[bv_off[j]:bv_off[j + 1]]``, and entry ``e``'s place among them
-    ``sp_loc[e]`` (``blockvars`` as :func:`block_variables` gives them, ``sp_off`` the blocks'
-    entry offsets). Ascending, so that a block's lower triangle lands in ``H``'s."""
+                perm: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The blockwise kernel's ``bv_pos, sp_loc, run_off, runs`` for forming ``H`` in the variable
+    order ``perm`` (:func:`lmi.ipm.kernels.scaling_and_schur_blockwise`): block ``j``'s variables'
+    positions in that order, ascending, ``bv_pos[bv_off[j]:bv_off[j + 1]]``; entry ``e``'s place
+    among them ``sp_loc[e]`` (``blockvars`` as :func:`block_variables` gives them, ``sp_off`` the
+    blocks' entry offsets); and their contiguous runs ``runs[run_off[j]:run_off[j + 1]]``, each
+    ``(first, position, length)``: the block's variables ``first .. first + length - 1`` sit at
+    the positions ``position ..``. Ascending, so that a block's lower triangle lands in ``H``'s."""
     bv_off, bv_var, sp_loc = blockvars
     position = np.empty(perm.shape[0], dtype=np.int64)
     position[perm] = np.arange(perm.shape[0], dtype=np.int64)
     pos = position[bv_var]
     bv_pos, loc = np.empty_like(pos), np.empty_like(sp_loc)
+    runs: list[tuple[int, int, int]] = []
+    run_off = [0]
     for j in range(bv_off.shape[0] - 1):
         lo, hi = bv_off[j], bv_off[j + 1]
         order = np.argsort(pos[lo:hi], kind="stable")
-        bv_pos[lo:hi] = pos[lo:hi][order]
+        sorted_pos = pos[lo:hi][order]
+        bv_pos[lo:hi] = sorted_pos
         rank = np.empty(hi - lo, dtype=np.int64)
         rank[order] = np.arange(hi - lo, dtype=np.int64)
         loc[sp_off[j]:sp_off[j + 1]] = rank[sp_loc[sp_off[j]:sp_off[j + 1]]]
-    return bv_pos, loc
+        starts = np.flatnonzero(np.diff(sorted_pos, prepend=-2) != 1)
+        ends = np.append(starts[1:], hi - lo)
+        runs.extend((int(a), int(sorted_pos[a]), int(b - a)) for a, b in zip(starts, ends, strict=True))
+        run_off.append(len(runs))
+    return (bv_pos, loc, np.asarray(run_off, dtype=np.int64),
+            np.asarray(runs, dtype=np.int64).reshape(-1, 3))
 
 
 def arrow_order(blockvars: tuple[np.ndarray, ...], n: int) -> tuple[np.ndarray, np.ndarray]:

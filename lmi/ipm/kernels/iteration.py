@@ -158,7 +158,8 @@ def grouped_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_of
 
 @njit(**JIT)
 def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair,
-                        sp_val, pair_off, pair_row, pair_col, bv_off, bv_pos, sp_loc, perm, arrow_off,
+                        sp_val, pair_off, pair_row, pair_col, bv_off, bv_pos, sp_loc, run_off, runs, perm,
+                        arrow_off,
                         gram_work, hj_work, kk, lam, pt, no_pt, h, work, r_fac, qr_h, qr_tau, no_qr_h,
                         no_qr_tau, use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch,
                         s_out, z_out, chol_out, err_limit):
@@ -167,13 +168,15 @@ def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_
     workspaces), ``P`` not formed (``no_pt`` ``(n, 0)``: the Newton step's products come from the
     sparse coefficients) until the QR phase, which forms ``P`` in ``pt``; see
     :func:`rows_iteration`. ``H`` is formed in the variable order ``perm`` (block ``j``'s variables
-    at ``bv_pos[bv_off[j]:bv_off[j + 1]]`` of that order) and factored there as a block arrow (the
+    at ``bv_pos[bv_off[j]:bv_off[j + 1]]`` of that order, in the contiguous runs ``run_off``,
+    ``runs``) and factored there as a block arrow (the
     groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); the Newton solves map
     their vectors through ``perm``. ``work`` is not used."""
     ok = False
     if not use_qr:
         if not scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair_off, pair_row,
-                                           pair_col, bv_off, bv_pos, sp_loc, kk, lam, gram_work, hj_work, h):
+                                           pair_col, bv_off, bv_pos, sp_loc, run_off, runs, kk, lam,
+                                           gram_work, hj_work, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
         ok = arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
     return _cholesky_or_qr_step(ok, no_pt, r_fac, perm, pt, False, s_chol, z, orders, offsets, ent_row,

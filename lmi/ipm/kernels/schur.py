@@ -187,7 +187,8 @@ def _block_gram(kk_out, j, k, pair_off, pair_row, pair_col, sp_off, sp_loc, sp_p
 
 @njit(**JIT)
 def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair_off, pair_row, pair_col,
-                                bv_off, bv_var, sp_loc, kk_out, lam_out, gram_work, h_work, h_out):
+                                bv_off, bv_var, sp_loc, run_off, runs, kk_out, lam_out, gram_work, h_work,
+                                h_out):
     """NT scaling of every block and ``H = P'P`` formed block by block on each block's own variables.
 
     Only the lower triangle of ``H`` is formed (the strict upper triangle of ``h_out`` is not
@@ -198,13 +199,17 @@ def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair
     in ``h_work``; :func:`_block_gram`, from the Gram matrix of the block's position pairs, ``P_j``
     never formed; ``gram_work`` its workspace) is added into ``H`` at those variables (``bv_var``
     their indices; the solver passes their positions in the order of its block-arrow factor,
-    forming ``H`` in that order). A vertex form's blocks each hold one vertex's Lyapunov matrix
-    and the shared variables, so that ``H`` is block-arrow shaped. Measured on the 14-state
-    flexible satellite over 8 vertices (1184 variables): forming ``P_j'`` and one ``dsyrk`` per
-    block took ``sum_j n_j^2 size_j`` = 1.0e9 operations (33 ms at the solver's iterates) where
-    the rows formula's ``n^2 size`` was 1.06e10 (170 ms); the Gram formula's ``p_j^2 + e_j (p_j +
-    n_j)`` is 4.6e7 (25 ms, the scatter into ``H`` included). Returns ``False`` if a block lost
-    positive definiteness.
+    forming ``H`` in that order), one contiguous run of them at a time: the runs
+    ``runs[run_off[j]:run_off[j + 1]]``, each ``(first, position, length)``, are the block's
+    variables ``first .. first + length - 1`` (among its own), whose positions are ``position ..
+    position + length - 1`` (1-3 runs per block in the vertex forms, where a block holds one or
+    two vertices' Lyapunov matrices and the shared variables). A vertex form's blocks each hold
+    one vertex's Lyapunov matrix and the shared variables, so that ``H`` is block-arrow shaped.
+    Measured on the 14-state flexible satellite over 8 vertices (1184 variables): forming
+    ``P_j'`` and one ``dsyrk`` per block took ``sum_j n_j^2 size_j`` = 1.0e9 operations (33 ms at
+    the solver's iterates) where the rows formula's ``n^2 size`` was 1.06e10 (170 ms); the Gram
+    formula's ``p_j^2 + e_j (p_j + n_j)`` is 4.6e7 (25 ms, the scatter into ``H`` included).
+    Returns ``False`` if a block lost positive definiteness.
     """
     n = h_out.shape[0]
     for a in range(n):
@@ -223,8 +228,14 @@ def scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair
                     gram_work, hj)
         for a in range(nj):  # ascending positions: the lower triangle lands in the lower triangle
             hrow = h_out[bv_var[lo + a]]
-            for b in range(a + 1):
-                hrow[bv_var[lo + b]] += hj[a, b]
+            hja = hj[a]
+            for r in range(run_off[j], run_off[j + 1]):
+                first = runs[r, 0]
+                if first > a:
+                    break
+                position = runs[r, 1]
+                for t in range(min(runs[r, 2], a + 1 - first)):  # contiguous on both sides
+                    hrow[position + t] += hja[first + t]
     return True
 
 
