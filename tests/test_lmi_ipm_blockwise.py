@@ -167,13 +167,13 @@ def test_block_variables_and_the_arrow_order_of_a_vertex_like_problem():
 
 
 def test_arrow_local_positions_ascend_and_their_runs_cover_them():
-    """On random structures and a random order: each block's positions ascend, each entry's place
-    maps back to its variable, and the runs ``(first, position, length)`` are maximal and give
-    every position exactly once."""
+    """On random structures (a block may hold no variable) and a random order: each block's
+    positions ascend, each entry's place maps back to its variable, and the runs ``(first,
+    position, length)`` are maximal and give every position exactly once."""
     rng = np.random.default_rng(7)
     for _ in range(50):
         n, nb = int(rng.integers(2, 30)), int(rng.integers(1, 12))
-        held = [np.sort(rng.choice(n, size=int(rng.integers(1, n + 1)), replace=False)) for _ in range(nb)]
+        held = [np.sort(rng.choice(n, size=int(rng.integers(0, n + 1)), replace=False)) for _ in range(nb)]
         sp_off = np.cumsum([0, *(3 * h.size for h in held)]).astype(np.int64)
         sp_var = np.concatenate([rng.permutation(np.repeat(h, 3)) for h in held]).astype(np.int64)
         blockvars = block_variables((sp_off, sp_var))

@@ -455,9 +455,10 @@ def arrow_local(blockvars: tuple[np.ndarray, ...], sp_off: np.ndarray,
         rank = np.empty(hi - lo, dtype=np.int64)
         rank[order] = np.arange(hi - lo, dtype=np.int64)
         loc[sp_off[j]:sp_off[j + 1]] = rank[sp_loc[sp_off[j]:sp_off[j + 1]]]
-        starts = np.flatnonzero(np.diff(sorted_pos, prepend=-2) != 1)
-        ends = np.append(starts[1:], hi - lo)
-        runs.extend((int(a), int(sorted_pos[a]), int(b - a)) for a, b in zip(starts, ends, strict=True))
+        if hi > lo:  # a block may hold no variable (a constant block)
+            starts = np.flatnonzero(np.diff(sorted_pos, prepend=-2) != 1)
+            ends = np.append(starts[1:], hi - lo)
+            runs.extend((int(a), int(sorted_pos[a]), int(b - a)) for a, b in zip(starts, ends, strict=True))
         run_off.append(len(runs))
     return (bv_pos, loc, np.asarray(run_off, dtype=np.int64),
             np.asarray(runs, dtype=np.int64).reshape(-1, 3))
