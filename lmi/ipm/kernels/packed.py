@@ -7,7 +7,7 @@ from numba import njit
 
 __all__ = [
     "JIT", "blocks_within", "cholesky_blocks", "cholesky_into", "diagonal_entry", "pack", "pack_block",
-    "residuals", "unpack", "unpack_block",
+    "residuals", "unpack", "unpack_block", "unpack_block_into",
 ]
 
 #: numba's options for every kernel: compiled once and cached on disk, released from the GIL.
@@ -15,13 +15,21 @@ JIT = {"cache": True, "nogil": True}
 
 
 @njit(**JIT)
-def unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w):
-    """Block ``j`` (order ``k``) of a packed vector as a full symmetric ``(k, k)`` matrix."""
-    out = np.empty((k, k))
+def unpack_block_into(vec, j, offsets, ent_row, ent_col, ent_w, out):
+    """Block ``j`` of a packed vector, full and symmetric, into ``out[:k, :k]`` (``k`` its order;
+    no allocation: ``out`` may be a work array of any larger order, or a block of a
+    ``(nb, kmax, kmax)`` array)."""
     for t in range(offsets[j], offsets[j + 1]):
         v = vec[t] / ent_w[t]
         out[ent_row[t], ent_col[t]] = v
         out[ent_col[t], ent_row[t]] = v
+
+
+@njit(**JIT)
+def unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w):
+    """Block ``j`` (order ``k``) of a packed vector as a full symmetric ``(k, k)`` matrix."""
+    out = np.empty((k, k))
+    unpack_block_into(vec, j, offsets, ent_row, ent_col, ent_w, out)
     return out
 
 
