@@ -6,6 +6,8 @@
   products share one work array between blocks, so a block of a smaller order after a larger
   one, and position pairs no coefficient uses, are covered), with the NT scalings padded with
   NaN outside each block's ``[:k, :k]`` so that a read outside it shows;
+* the refinement's fused ``P dx + v`` and ``P'`` of it (:func:`~lmi.ipm.kernels.step._p_then_pt`)
+  equal the separate products bit for bit;
 * the step length :func:`~lmi.ipm.kernels.step._max_step` (a Cholesky test of each shifted
   block first, the eigenvalue bisection only where it fails) equals the largest ``a <= 1/0.99``
   with ``diag(lambda) + a d >= 0`` computed from numpy's eigenvalues, when no block limits the
@@ -23,7 +25,7 @@ import numpy as np
 import pytest
 
 from lmi.ipm import BlockLMISolver, kernels
-from lmi.ipm.kernels.step import _STEP_CAP, _max_step, _p_times, _pt_times
+from lmi.ipm.kernels.step import _STEP_CAP, _max_step, _p_then_pt, _p_times, _pt_times
 
 EPS = np.finfo(float).eps
 
@@ -88,6 +90,11 @@ def test_products_with_p_from_the_sparse_coefficients_equal_the_formed_ones(seed
         assert np.all(np.abs(got - pt.T @ dx) <= 16 * EPS * (np.abs(pt).T @ np.abs(dx)))
         # with P formed they are the products themselves
         assert np.array_equal(_pt_times(pt, v, kk, *lay.arrays, *sp, n), pt @ v)
+        # the fused pass of the refinement: P dx + v and P' of it, bit for bit the separate calls
+        dz, ptz = _p_then_pt(none, dx, v, kk, *lay.arrays, *sp, n)
+        want = _p_times(none, dx, kk, *lay.arrays, *sp) + v
+        assert np.array_equal(dz, want)
+        assert np.array_equal(ptz, _pt_times(none, want, kk, *lay.arrays, *sp, n))
 
 
 def _reference_step(lam: np.ndarray, dirs: list[np.ndarray], orders: tuple[int, ...]) -> float:

@@ -98,6 +98,52 @@ def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_va
 
 
 @njit(**JIT)
+def _p_then_pt(pt, dx, base, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+               pair_off, pair_row, pair_col, n):
+    """``(dz, P' dz)`` with ``dz = base + P dx`` (packed): :func:`_p_times`, the sum and
+    :func:`_pt_times` block by block in one pass (each block's ``dz`` entries formed, stored and
+    unpacked at once, its ``K`` copied once), the same operations in the same order as the three
+    calls, so the same results bit for bit."""
+    if pt.shape[1] > 0:
+        dz = base + pt.T @ dx
+        return dz, pt @ dz
+    dz = np.empty(offsets[-1])
+    out = np.zeros(n)
+    acc_pair = np.zeros(pair_row.shape[0])
+    mp = np.empty(pair_row.shape[0])
+    work = np.empty(4 * kk.shape[1] * kk.shape[2])
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        kj, acc, left, m = _squares(work, k)
+        for e in range(sp_off[j], sp_off[j + 1]):
+            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
+        acc[:, :] = 0.0
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            acc[a, b] = acc_pair[q]
+            acc[b, a] = acc_pair[q]
+        _contiguous_scaling(kk, j, k, kj)
+        np.dot(kj, acc, left)
+        np.dot(left, kj.T, m)  # block j of P dx, unpacked
+        vj = acc
+        for t in range(offsets[j], offsets[j + 1]):
+            r, c = ent_row[t], ent_col[t]
+            value = base[t] + m[r, c] * ent_w[t]
+            dz[t] = value
+            value = value / ent_w[t]
+            vj[r, c] = value
+            vj[c, r] = value
+        np.dot(kj.T, vj, left)
+        np.dot(left, kj, m)  # K' dz_j K
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            mp[q] = m[a, a] if a == b else m[a, b] + m[b, a]
+        for e in range(sp_off[j], sp_off[j + 1]):
+            out[sp_var[e]] += sp_val[e] * mp[sp_pair[e]]
+    return dz, out
+
+
+@njit(**JIT)
 def _forward(r_fac, b):
     """``y`` with ``R' y = b`` for upper triangular ``R``."""
     n = b.shape[0]
@@ -156,15 +202,15 @@ def _newton(pt, r_fac, perm, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row
     lay = (orders, offsets, ent_row, ent_col, ent_w)
     v = u + rpt
     dx = _factor_solve(r_fac, perm, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
-    dzt = _p_times(pt, dx, kk, *lay, *sp) + v
-    err = _pt_times(pt, dzt, kk, *lay, *sp, n) + rd
+    dzt, ptz = _p_then_pt(pt, dx, v, kk, *lay, *sp, n)  # P dx + v and P' of it
+    err = ptz + rd
     err_norm = np.linalg.norm(err)
     for _ in range(REFINE_STEPS):
         if err_norm <= 1e-14 * ref_scale:
             break
         ddx = _factor_solve(r_fac, perm, -err)
-        dzt_new = dzt + _p_times(pt, ddx, kk, *lay, *sp)
-        err_new = _pt_times(pt, dzt_new, kk, *lay, *sp, n) + rd
+        dzt_new, ptz = _p_then_pt(pt, ddx, dzt, kk, *lay, *sp, n)
+        err_new = ptz + rd
         new_norm = np.linalg.norm(err_new)
         if new_norm >= err_norm:
             break
