@@ -503,14 +503,12 @@ def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp,
         unpack_block_into(dza, j, offsets, ent_row, ent_col, ent_w, db)
         np.dot(da, db, prod)
         rc = _square(work, 3, k)
-        for a in range(k):
-            for b in range(k):
-                rc[a, b] = -0.5 * (prod[a, b] + prod[b, a])
-        for a in range(k):
-            rc[a, a] += sigma * mu - lam[j, a] * lam[j, a]
-        for a in range(k):
-            for b in range(k):
-                rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
+        for a in range(k):  # the upper triangle, which the packing reads
+            for b in range(a, k):
+                value = -0.5 * (prod[a, b] + prod[b, a])
+                if a == b:
+                    value += sigma * mu - lam[j, a] * lam[j, a]
+                rc[a, b] = value * (2.0 / (lam[j, a] + lam[j, b]))
         pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
     if qr_h.shape[0] > 0:
         dx, dst, dzt = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u_cor, ref_scale)
