@@ -7,7 +7,7 @@ from numba import njit
 
 __all__ = [
     "JIT", "blocks_within", "cholesky_blocks", "cholesky_into", "diagonal_entry", "pack", "pack_block",
-    "residuals", "unpack", "unpack_block",
+    "residuals", "unpack", "unpack_block", "unpack_block_into",
 ]
 
 #: numba's options for every kernel: compiled once and cached on disk, released from the GIL.
@@ -15,13 +15,21 @@ JIT = {"cache": True, "nogil": True}
 
 
 @njit(**JIT)
-def unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w):
-    """Block ``j`` (order ``k``) of a packed vector as a full symmetric ``(k, k)`` matrix."""
-    out = np.empty((k, k))
+def unpack_block_into(vec, j, offsets, ent_row, ent_col, ent_w, out):
+    """Block ``j`` of a packed vector, full and symmetric, into ``out[:k, :k]`` (``k`` its order;
+    no allocation: ``out`` may be a work array of any larger order, or a block of a
+    ``(nb, kmax, kmax)`` array)."""
     for t in range(offsets[j], offsets[j + 1]):
         v = vec[t] / ent_w[t]
         out[ent_row[t], ent_col[t]] = v
         out[ent_col[t], ent_row[t]] = v
+
+
+@njit(**JIT)
+def unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w):
+    """Block ``j`` (order ``k``) of a packed vector as a full symmetric ``(k, k)`` matrix."""
+    out = np.empty((k, k))
+    unpack_block_into(vec, j, offsets, ent_row, ent_col, ent_w, out)
     return out
 
 
@@ -112,17 +120,28 @@ def _pair_position(offsets, orders, j, a, b):
 
 
 @njit(**JIT)
+def _pair_positions(orders, offsets, pair_off, pair_row, pair_col):
+    """Packed position of every position pair ``q`` (:func:`_pair_position`), computed once per
+    pair instead of once per coefficient entry (the products with ``G`` below: about 4 entries
+    per pair on the vertex forms; the integer arithmetic cost more than the multiply-adds)."""
+    pos = np.empty(pair_row.shape[0], dtype=np.int64)
+    for j in range(orders.shape[0]):
+        for q in range(pair_off[j], pair_off[j + 1]):
+            pos[q] = _pair_position(offsets, orders, j, pair_row[q], pair_col[q])
+    return pos
+
+
+@njit(**JIT)
 def g_times(g_mat, x, orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col):
     """``G x`` (packed ``sum_i x_i A_ij``, scaled): ``g_mat @ x``, or, when ``g_mat`` has no rows
     (not formed), from the sparse coefficients (one multiply-add per entry, then the packing
     weights), which is far less work on problems whose blocks hold few of the variables."""
     if g_mat.shape[0] > 0:
         return g_mat @ x
+    pos = _pair_positions(orders, offsets, pair_off, pair_row, pair_col)
     out = np.zeros(offsets[-1])
-    for j in range(orders.shape[0]):
-        for e in range(sp_off[j], sp_off[j + 1]):
-            q = sp_pair[e]
-            out[_pair_position(offsets, orders, j, pair_row[q], pair_col[q])] += sp_val[e] * x[sp_var[e]]
+    for e in range(sp_off[-1]):
+        out[pos[sp_pair[e]]] += sp_val[e] * x[sp_var[e]]
     return out * ent_w
 
 
@@ -133,12 +152,11 @@ def gt_times(g_mat, v, n, orders, offsets, ent_w, sp_off, sp_var, sp_pair, sp_va
     has no rows (see :func:`g_times`)."""
     if g_mat.shape[0] > 0:
         return g_mat.T @ v
+    pos = _pair_positions(orders, offsets, pair_off, pair_row, pair_col)
     out = np.zeros(n)
-    for j in range(orders.shape[0]):
-        for e in range(sp_off[j], sp_off[j + 1]):
-            q = sp_pair[e]
-            t = _pair_position(offsets, orders, j, pair_row[q], pair_col[q])
-            out[sp_var[e]] += sp_val[e] * ent_w[t] * v[t]
+    for e in range(sp_off[-1]):
+        t = pos[sp_pair[e]]
+        out[sp_var[e]] += sp_val[e] * ent_w[t] * v[t]
     return out
 
 

@@ -23,19 +23,43 @@ __all__ = [
 @njit(**JIT)
 def _nt_block(s_chol, z, j, k, kk_out, lam_out):
     """NT scaling of block ``j`` (see :func:`scaling_and_schur_rows`) into ``kk_out[j]`` and
-    ``lam_out[j]``; ``False`` if the block lost positive definiteness."""
-    ell = np.ascontiguousarray(s_chol[j, :k, :k])
-    zj = np.ascontiguousarray(z[j, :k, :k])
-    m = ell.T @ (zj @ ell)
-    m = 0.5 * (m + m.T)
-    if not np.all(np.isfinite(m)):
-        return False
+    ``lam_out[j]``; ``False`` if the block lost positive definiteness. The block's matrices in
+    one work array, the products BLAS calls into it (``np.dot`` with ``out``) and the scalings
+    loops: the operations of ``ell.T @ (zj @ ell)``, ``(ell @ qv) / sqrt(lambda)`` and ``(rr.T @
+    zj) / lambda`` in the same order, without their temporaries."""
+    size = k * k
+    work = np.empty(5 * size)
+    ell = work[:size].reshape((k, k))
+    zj = work[size: 2 * size].reshape((k, k))
+    prod = work[2 * size: 3 * size].reshape((k, k))
+    out = work[3 * size: 4 * size].reshape((k, k))
+    m = work[4 * size:].reshape((k, k))
+    for a in range(k):
+        for b in range(k):
+            ell[a, b] = s_chol[j, a, b]
+            zj[a, b] = z[j, a, b]
+    np.dot(zj, ell, prod)
+    np.dot(ell.T, prod, out)
+    for a in range(k):
+        for b in range(k):
+            value = 0.5 * (out[a, b] + out[b, a])
+            if not np.isfinite(value):
+                return False
+            m[a, b] = value
     d, qv = np.linalg.eigh(m)
     if not d[0] > 0.0:
         return False
     lam = np.sqrt(d)
-    rr = (ell @ qv) / np.sqrt(lam)  # columns scaled
-    kk_out[j, :k, :k] = (rr.T @ zj) / lam.reshape(k, 1)  # rows scaled
+    root = np.sqrt(lam)
+    rr = prod
+    np.dot(ell, qv, rr)
+    for a in range(k):
+        for b in range(k):
+            rr[a, b] /= root[b]  # columns scaled
+    np.dot(rr.T, zj, out)
+    for a in range(k):
+        for b in range(k):
+            kk_out[j, a, b] = out[a, b] / lam[a]  # rows scaled
     lam_out[j, :k] = lam
     return True
 

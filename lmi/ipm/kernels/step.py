@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 
 from lmi.ipm.kernels.lapack import triangular_solve_blas
-from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, g_times, pack_block, unpack_block
+from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, g_times, pack_block, unpack_block_into
 
 __all__ = ["REFINE_STEPS", "STEP_INACCURATE", "newton_step", "smallest_eigenvalue"]
 
@@ -21,20 +21,46 @@ REFINE_STEPS = 3
 
 
 @njit(**JIT)
+def _square(work, slot, k):
+    """Slot ``slot`` of the flat work array ``work`` (``slots x kmax^2``) as a contiguous ``(k, k)``
+    matrix (a view: no allocation)."""
+    return work[slot * k * k: (slot + 1) * k * k].reshape((k, k))
+
+
+@njit(**JIT)
+def _squares(work, k):
+    """The four slots of ``work`` as ``(k, k)`` matrices (:func:`_square`)."""
+    return _square(work, 0, k), _square(work, 1, k), _square(work, 2, k), _square(work, 3, k)
+
+
+@njit(**JIT)
+def _contiguous_scaling(kk, j, k, out):
+    """``out = kk[j, :k, :k]`` (contiguous ``(k, k)``), as ``np.ascontiguousarray`` copies it."""
+    for a in range(k):
+        for b in range(k):
+            out[a, b] = kk[j, a, b]
+
+
+@njit(**JIT)
 def _pt_times(pt, v, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
               pair_off, pair_row, pair_col, n):
     """``P' v`` for a packed ``v``: ``pt @ v`` if ``P`` is formed (``pt`` has columns), else
     ``sum_j <A_ij, K_j' V_j K_j>`` from the sparse coefficients: ``M = K_j' V_j K_j``, then
     ``M_ab + M_ba`` (``M_aa`` on the diagonal) once per position pair, then one multiply-add
-    per coefficient entry."""
+    per coefficient entry. The blocks' matrices live in one work array (:func:`_square`) and
+    the products are BLAS calls into it (``np.dot`` with ``out``): no allocation per block."""
     if pt.shape[1] > 0:
         return pt @ v
     out = np.zeros(n)
     mp = np.empty(pair_row.shape[0])
+    work = np.empty(4 * kk.shape[1] * kk.shape[2])
     for j in range(orders.shape[0]):
         k = orders[j]
-        kj = np.ascontiguousarray(kk[j, :k, :k])
-        m = kj.T @ unpack_block(v, j, k, offsets, ent_row, ent_col, ent_w) @ kj
+        kj, vj, left, m = _squares(work, k)
+        _contiguous_scaling(kk, j, k, kj)
+        unpack_block_into(v, j, offsets, ent_row, ent_col, ent_w, vj)
+        np.dot(kj.T, vj, left)
+        np.dot(left, kj, m)
         for q in range(pair_off[j], pair_off[j + 1]):
             a, b = pair_row[q], pair_col[q]
             mp[q] = m[a, a] if a == b else m[a, b] + m[b, a]
@@ -48,23 +74,73 @@ def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_va
              pair_off, pair_row, pair_col):
     """``P dx`` (packed): ``pt.T @ dx`` if ``P`` is formed, else the packed
     ``K_j (sum_i dx_i A_ij) K_j'`` from the sparse coefficients (summed per position pair, in
-    entry order)."""
+    entry order; the products in a work array, see :func:`_pt_times`)."""
     if pt.shape[1] > 0:
         return pt.T @ dx
     out = np.empty(offsets[-1])
     acc_pair = np.zeros(pair_row.shape[0])
+    work = np.empty(4 * kk.shape[1] * kk.shape[2])
     for j in range(orders.shape[0]):
         k = orders[j]
+        kj, acc, left, m = _squares(work, k)
         for e in range(sp_off[j], sp_off[j + 1]):
             acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
-        acc = np.zeros((k, k))
+        acc[:, :] = 0.0
         for q in range(pair_off[j], pair_off[j + 1]):
             a, b = pair_row[q], pair_col[q]
             acc[a, b] = acc_pair[q]
             acc[b, a] = acc_pair[q]
-        kj = np.ascontiguousarray(kk[j, :k, :k])
-        pack_block(kj @ acc @ kj.T, j, offsets, ent_row, ent_col, ent_w, out)
+        _contiguous_scaling(kk, j, k, kj)
+        np.dot(kj, acc, left)
+        np.dot(left, kj.T, m)
+        pack_block(m, j, offsets, ent_row, ent_col, ent_w, out)
     return out
+
+
+@njit(**JIT)
+def _p_then_pt(pt, dx, base, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val,
+               pair_off, pair_row, pair_col, n):
+    """``(dz, P' dz)`` with ``dz = base + P dx`` (packed): :func:`_p_times`, the sum and
+    :func:`_pt_times` block by block in one pass (each block's ``dz`` entries formed, stored and
+    unpacked at once, its ``K`` copied once), the same operations in the same order as the three
+    calls, so the same results bit for bit."""
+    if pt.shape[1] > 0:
+        dz = base + pt.T @ dx
+        return dz, pt @ dz
+    dz = np.empty(offsets[-1])
+    out = np.zeros(n)
+    acc_pair = np.zeros(pair_row.shape[0])
+    mp = np.empty(pair_row.shape[0])
+    work = np.empty(4 * kk.shape[1] * kk.shape[2])
+    for j in range(orders.shape[0]):
+        k = orders[j]
+        kj, acc, left, m = _squares(work, k)
+        for e in range(sp_off[j], sp_off[j + 1]):
+            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
+        acc[:, :] = 0.0
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            acc[a, b] = acc_pair[q]
+            acc[b, a] = acc_pair[q]
+        _contiguous_scaling(kk, j, k, kj)
+        np.dot(kj, acc, left)
+        np.dot(left, kj.T, m)  # block j of P dx, unpacked
+        vj = acc
+        for t in range(offsets[j], offsets[j + 1]):
+            r, c = ent_row[t], ent_col[t]
+            value = base[t] + m[r, c] * ent_w[t]
+            dz[t] = value
+            value = value / ent_w[t]
+            vj[r, c] = value
+            vj[c, r] = value
+        np.dot(kj.T, vj, left)
+        np.dot(left, kj, m)  # K' dz_j K
+        for q in range(pair_off[j], pair_off[j + 1]):
+            a, b = pair_row[q], pair_col[q]
+            mp[q] = m[a, a] if a == b else m[a, b] + m[b, a]
+        for e in range(sp_off[j], sp_off[j + 1]):
+            out[sp_var[e]] += sp_val[e] * mp[sp_pair[e]]
+    return dz, out
 
 
 @njit(**JIT)
@@ -126,15 +202,15 @@ def _newton(pt, r_fac, perm, rd, rpt, u, ref_scale, kk, orders, offsets, ent_row
     lay = (orders, offsets, ent_row, ent_col, ent_w)
     v = u + rpt
     dx = _factor_solve(r_fac, perm, -rd - _pt_times(pt, v, kk, *lay, *sp, n))
-    dzt = _p_times(pt, dx, kk, *lay, *sp) + v
-    err = _pt_times(pt, dzt, kk, *lay, *sp, n) + rd
+    dzt, ptz = _p_then_pt(pt, dx, v, kk, *lay, *sp, n)  # P dx + v and P' of it
+    err = ptz + rd
     err_norm = np.linalg.norm(err)
     for _ in range(REFINE_STEPS):
         if err_norm <= 1e-14 * ref_scale:
             break
         ddx = _factor_solve(r_fac, perm, -err)
-        dzt_new = dzt + _p_times(pt, ddx, kk, *lay, *sp)
-        err_new = _pt_times(pt, dzt_new, kk, *lay, *sp, n) + rd
+        dzt_new, ptz = _p_then_pt(pt, ddx, dzt, kk, *lay, *sp, n)
+        err_new = ptz + rd
         new_norm = np.linalg.norm(err_new)
         if new_norm >= err_norm:
             break
@@ -305,18 +381,50 @@ _STEP_RTOL = 1e-9
 
 
 @njit(**JIT)
+def _shifted_positive_definite(a, k, shift, work):
+    """Whether ``a[:k, :k] + shift I`` is positive definite: its Cholesky factorisation (into
+    ``work``) meets no non-positive or non-finite pivot."""
+    for j in range(k):
+        s = a[j, j] + shift
+        for p in range(j):
+            s -= work[j, p] * work[j, p]
+        if not 0.0 < s < np.inf:
+            return False
+        d = np.sqrt(s)
+        work[j, j] = d
+        for i in range(j + 1, k):
+            s = a[i, j]
+            for p in range(j):
+                s -= work[i, p] * work[j, p]
+            work[i, j] = s / d
+    return True
+
+
+@njit(**JIT)
 def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
     """Largest ``a`` (up to ``_STEP_CAP``) with ``diag(lambda) + a d >= 0`` for ``d`` = ``ds``
-    and ``dz``, every block."""
+    and ``dz``, every block.
+
+    With ``D = diag(lambda)^-1/2 d diag(lambda)^-1/2``, a block limits the step below the current
+    ``a`` only if the smallest eigenvalue of ``D`` is below ``-1 / a``. Most blocks do not: a
+    Cholesky factorisation of ``D + I / a`` (``k^3 / 6`` operations) shows it, and
+    :func:`smallest_eigenvalue` (a tridiagonalisation, ``4 k^3 / 3``, and a bisection) is called
+    only for a block whose shifted matrix is not positive definite; it returns ``-1 / a`` itself
+    for a block that rounding alone failed there."""
     alpha = _STEP_CAP
+    kmax = lam.shape[1]
+    dd = np.empty((kmax, kmax))
+    work = np.empty((kmax, kmax))
     for j in range(orders.shape[0]):
         k = orders[j]
         isq = 1.0 / np.sqrt(lam[j, :k])
         for vec in (ds, dz):
-            dd = unpack_block(vec, j, k, offsets, ent_row, ent_col, ent_w)
+            unpack_block_into(vec, j, offsets, ent_row, ent_col, ent_w, dd)
             for a in range(k):
                 for b in range(k):
                     dd[a, b] *= isq[a] * isq[b]
+            if _shifted_positive_definite(dd, k, 1.0 / alpha, work):
+                continue
             t = smallest_eigenvalue(dd, k, -1.0 / alpha, _STEP_RTOL)
             if t < -1.0 / alpha:
                 alpha = -1.0 / t
@@ -360,13 +468,18 @@ def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp,
     """
     nb = orders.shape[0]
     m = offsets[-1]
+    # the blocks' matrices in one work array (_square), the products BLAS calls into it
+    work = np.empty(4 * kk.shape[1] * kk.shape[2])
     # scaled primal residual K rp K'
     rpt = np.empty(m)
     for j in range(nb):
         k = orders[j]
-        kj = np.ascontiguousarray(kk[j, :k, :k])
-        rj = unpack_block(rp, j, k, offsets, ent_row, ent_col, ent_w)
-        pack_block(kj @ rj @ kj.T, j, offsets, ent_row, ent_col, ent_w, rpt)
+        kj, rj, left, prod = _squares(work, k)
+        _contiguous_scaling(kk, j, k, kj)
+        unpack_block_into(rp, j, offsets, ent_row, ent_col, ent_w, rj)
+        np.dot(kj, rj, left)
+        np.dot(left, kj.T, prod)
+        pack_block(prod, j, offsets, ent_row, ent_col, ent_w, rpt)
     # predictor: u = lambda^{o-1}(-lambda o lambda) = -diag(lambda)
     u = np.zeros(m)
     for j in range(nb):
@@ -385,15 +498,17 @@ def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp,
     u_cor = np.empty(m)
     for j in range(nb):
         k = orders[j]
-        da = unpack_block(dsa, j, k, offsets, ent_row, ent_col, ent_w)
-        db = unpack_block(dza, j, k, offsets, ent_row, ent_col, ent_w)
-        prod = da @ db
-        rc = -0.5 * (prod + prod.T)
-        for a in range(k):
-            rc[a, a] += sigma * mu - lam[j, a] * lam[j, a]
-        for a in range(k):
-            for b in range(k):
-                rc[a, b] *= 2.0 / (lam[j, a] + lam[j, b])
+        da, db, prod = _square(work, 0, k), _square(work, 1, k), _square(work, 2, k)
+        unpack_block_into(dsa, j, offsets, ent_row, ent_col, ent_w, da)
+        unpack_block_into(dza, j, offsets, ent_row, ent_col, ent_w, db)
+        np.dot(da, db, prod)
+        rc = _square(work, 3, k)
+        for a in range(k):  # the upper triangle, which the packing reads
+            for b in range(a, k):
+                value = -0.5 * (prod[a, b] + prod[b, a])
+                if a == b:
+                    value += sigma * mu - lam[j, a] * lam[j, a]
+                rc[a, b] = value * (2.0 / (lam[j, a] + lam[j, b]))
         pack_block(rc, j, offsets, ent_row, ent_col, ent_w, u_cor)
     if qr_h.shape[0] > 0:
         dx, dst, dzt = _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u_cor, ref_scale)
@@ -413,7 +528,7 @@ def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp,
         ok = True
         for j in range(nb):
             k = orders[j]
-            s_out[j, :k, :k] = unpack_block(s_vec, j, k, offsets, ent_row, ent_col, ent_w)
+            unpack_block_into(s_vec, j, offsets, ent_row, ent_col, ent_w, s_out[j])
             if not cholesky_into(s_out[j], k, chol_out[j]):
                 ok = False
                 break
@@ -422,16 +537,27 @@ def newton_step(pt, r_fac, perm, qr_h, qr_tau, kk, lam, x, z, theta, r0, rd, rp,
             continue
         for j in range(nb):
             k = orders[j]
-            kj = np.ascontiguousarray(kk[j, :k, :k])
-            dz = kj.T @ unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w) @ kj
-            z_out[j, :k, :k] = z[j, :k, :k] + (0.5 * alpha) * (dz + dz.T)
+            kj, dj, left, dz = _squares(work, k)
+            _contiguous_scaling(kk, j, k, kj)
+            unpack_block_into(dzt, j, offsets, ent_row, ent_col, ent_w, dj)
+            np.dot(kj.T, dj, left)
+            np.dot(left, kj, dz)
+            for a in range(k):
+                for b in range(k):
+                    z_out[j, a, b] = z[j, a, b] + (0.5 * alpha) * (dz[a, b] + dz[b, a])
             if not cholesky_into(z_out[j], k, scratch):
                 # rounding left Z + alpha dZ not positive definite: the same point through the
                 # scaling, K'(lambda + alpha dz~)K, positive definite by the step length
-                lz = alpha * unpack_block(dzt, j, k, offsets, ent_row, ent_col, ent_w)
+                unpack_block_into(dzt, j, offsets, ent_row, ent_col, ent_w, dj)
                 for a in range(k):
-                    lz[a, a] += lam[j, a]
-                zn = kj.T @ lz @ kj
-                z_out[j, :k, :k] = 0.5 * (zn + zn.T)
+                    for b in range(k):
+                        dj[a, b] = alpha * dj[a, b]
+                for a in range(k):
+                    dj[a, a] += lam[j, a]
+                np.dot(kj.T, dj, left)
+                np.dot(left, kj, dz)
+                for a in range(k):
+                    for b in range(k):
+                        z_out[j, a, b] = 0.5 * (dz[a, b] + dz[b, a])
         return 0, x_new, theta_new, alpha_aff, sigma, alpha
     return 2, x, theta, alpha_aff, sigma, alpha
