@@ -42,24 +42,29 @@ from lmi.threads import SingleThreadBlas
 from toolkit_common.errors import InvalidArgumentError
 from toolkit_common.validation import is_integer, is_real
 
-__all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "REBALANCE_QR_SHARE",
+__all__ = ["CORE_CHOICES", "DEFAULT_IPM_OPTIONS", "REBALANCE_MAX_RESIDUAL", "REBALANCE_QR_GAP",
            "IPMKothare", "check_ipm_values"]
 
 #: A failed cold solve is retried in coordinates balanced on its last ``Q`` (option
 #: ``rebalance``) only if its relative primal and dual residuals came below this.
 REBALANCE_MAX_RESIDUAL = 1e-3
 
-#: An on-line solve that ends ``"optimal"`` with at least this share of its iterations in the QR
-#: phase (the Cholesky factor of the Schur complement lost the step's accuracy, see
-#: :data:`lmi.ipm.solver.QR_SWITCH`) rebuilds the problem in coordinates balanced on its answer's
-#: ``Q~`` for the next solves (option ``rebalance``; :meth:`IPMKothare.solve`). The QR steps are
-#: the costly ones (``P`` formed and factored) and they come from the coordinates: on the generic
-#: stress set's ``n20-v2-generic-none-s0`` (:mod:`dev.generic_stress`; 481 variables) every
-#: iteration of every warm solve took the QR phase (10 of 10; 87 ms each against about 11 ms
-#: for a Cholesky step), its iterate's slacks spanning 1e-6..1e4 at a relative gap of 1e-2, the
-#: Schur complement scaled to a unit diagonal with 211 eigenvalues below 1e-12 of the largest;
-#: balanced on the previous answer, 3-4 of 9. Paper P's solves take 2 of 320 iterations there.
-REBALANCE_QR_SHARE = 0.5
+#: An on-line solve that ends ``"optimal"`` and whose QR phase began at a relative gap of at least
+#: this (the Cholesky factor of the Schur complement lost the step's accuracy far from the optimum,
+#: see :data:`lmi.ipm.solver.QR_SWITCH`) rebuilds the problem in coordinates balanced on its
+#: answer's ``Q~`` for the next solves (option ``rebalance``; :meth:`IPMKothare.solve`). Near the
+#: optimum the QR phase is the end game of any IPM (the Schur complement's condition number grows
+#: as the gap closes); far from it, it comes from the coordinates, and its steps are the costly
+#: ones (``P`` formed and factored). On the generic stress set's ``n20-v2-generic-none-s0``
+#: (:mod:`dev.generic_stress`; 481 variables) every step of every warm solve was a QR step, from a
+#: relative gap of 1.2e-3 (87 ms a step against about 11 ms for a Cholesky step), its iterate's
+#: slacks spanning 1e-6..1e4 and the Schur complement, scaled to a unit diagonal, with 211
+#: eigenvalues below 1e-12 of the largest; balanced on the previous answer, 3-4 of 9, from 1.6e-6.
+#: Paper P's closed loop on the numba path (E1, 40 samples, 2 and 8 vertices) began its QR phases
+#: at relative gaps of at most 1.0e-6 and 4.7e-6 (medians 3e-7, 7e-7): those solves keep their
+#: coordinates. (A rule on the share of QR steps instead, half of a solve's, rebalanced paper P's
+#: 8-vertex loop again and again: its solves end with 4-5 QR steps of 8-10.)
+REBALANCE_QR_GAP = 1e-4
 
 #: Settings. Tolerances: relative residuals and gap 1e-8, as for Clarabel (see
 #: :data:`lmi.backends.clarabel.DEFAULT_CLARABEL_OPTIONS`); on paper P's closed loop gamma then
@@ -97,8 +102,8 @@ REBALANCE_QR_SHARE = 0.5
 #: the cold solves at rest 13-20 deg about the slew axis and with the modal bound at 10 deg ended
 #: "inaccurate" or "insufficient_progress" after 35-48 iterations. Rebalanced, they ended
 #: "optimal" in 48-69 iterations in all (0.4-1.4 s at load 1-2), gamma within 7e-10 of cvxpy +
-#: Clarabel at 1e-10 on the delta form at 14 deg. An on-line solve that ends ``"optimal"`` with at
-#: least :data:`REBALANCE_QR_SHARE` of its iterations in the QR phase rebalances the next solves
+#: Clarabel at 1e-10 on the delta form at 14 deg. An on-line solve that ends ``"optimal"`` but began
+#: its QR phase at a relative gap of at least :data:`REBALANCE_QR_GAP` rebalances the next solves
 #: the same way, on its answer's ``Q~`` (:meth:`IPMKothare.solve`).
 #: ``infeasibility_radius``: a run ends ``"infeasible"`` when its dual iterate proves that no
 #: solution of norm below this exists (:meth:`lmi.ipm.BlockLMISolver.solve`; ``inf`` switches the
@@ -408,8 +413,8 @@ class IPMKothare(KothareBackend):
         rebuilt in the new coordinates (about 0.05-0.1 s at 14 states, counted in ``solve_time``)
         and kept for the next solves. ``solver_status`` then reads ``"<word>; rebalanced
         <word>"``. A solve that ends ``"optimal"`` never gets here: paper P's answers are
-        unchanged. An ``"optimal"`` on-line solve that spent at least :data:`REBALANCE_QR_SHARE`
-        of its iterations in the QR phase is returned as it is, and the problem is rebuilt in
+        unchanged. An ``"optimal"`` on-line solve whose QR phase began at a relative gap of at
+        least :data:`REBALANCE_QR_GAP` is returned as it is, and the problem is rebuilt in
         coordinates balanced on its ``Q~`` for the next solves (:meth:`_rebalanced_after`).
         Times and iterations are the sums over every stage.
         """
@@ -472,14 +477,14 @@ class IPMKothare(KothareBackend):
 
     def _rebalanced_after(self, raw: RawResult, xs: np.ndarray, answer: RawResult) -> RawResult:
         """``answer`` (``raw``, an ``"optimal"`` on-line solve at the normalised state ``xs``, in
-        the caller's coordinates) as it is; when at least :data:`REBALANCE_QR_SHARE` of its
-        iterations took the QR phase (``rebalance`` on, no nesting block), the problem is rebuilt
+        the caller's coordinates) as it is; when its QR phase began at a relative gap of at least
+        :data:`REBALANCE_QR_GAP` (``rebalance`` on, no nesting block), the problem is rebuilt
         for the next solves in coordinates in which ``raw``'s ``Q~`` is a multiple of the identity
         (:meth:`_balanced_on`), the rebuild's time added to ``answer``'s. The next solve then
         starts cold (the warm-start point belongs to the old coordinates); :meth:`reset` returns
         to the construction's coordinates."""
         if (not self._rebalance or self.nesting or raw.Q is None
-                or self._last_qr_share < REBALANCE_QR_SHARE):
+                or not self._last_qr_gap >= REBALANCE_QR_GAP):
             return answer
         start = time.perf_counter()
         t_new = self._balanced_on(0.5 * (raw.Q + raw.Q.T), xs)
@@ -713,12 +718,12 @@ class IPMKothare(KothareBackend):
             with self._blas.limit():
                 res = self._solver.solve(warm_start=self._warm_start)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as err:
-            self._last_residual, self._last_qr_share = np.inf, 0.0
+            self._last_residual, self._last_qr_gap = np.inf, np.nan
             return RawResult(NUMERICAL_ERROR, repr(err), np.nan, None, None, None,
                              time.perf_counter() - start)
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
-        self._last_qr_share = res.qr_iterations / max(res.iterations, 1)
+        self._last_qr_gap = res.qr_start_gap
         return self._raw(res.status, res.solver_status, res.x, res.Z, res.iterations, elapsed,
                          (x, u_max, y_max, *_nest_args(outer)))
 
@@ -744,7 +749,7 @@ class IPMKothare(KothareBackend):
         res = self._core.solve(x, u_max, y_max, self._warm_start)
         elapsed = time.perf_counter() - start
         self._last_residual = max(res.primal_residual, res.dual_residual)
-        self._last_qr_share = 0.0  # the C core does not count its QR steps
+        self._last_qr_gap = np.nan  # the C core does not report its QR phase
         status = SOLVER_STATUS_MAP[res.word]
         if status != OPTIMAL:
             self._update_blocks(x, u_max, y_max)

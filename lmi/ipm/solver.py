@@ -230,6 +230,10 @@ class IPMResult:
     #: phase after the Cholesky factor of ``H`` lost the accuracy the step needs, see
     #: :data:`QR_SWITCH`, :data:`STEP_ACCURACY`); a warm start's failed run included.
     qr_iterations: int = 0
+    #: The relative gap at the iteration whose step was the first from the QR factorisation (NaN
+    #: without one): near the optimum the QR phase is the end game of a badly conditioned ``H``;
+    #: far from it, a sign of badly scaled coordinates (:data:`lmi.backends.ipm.REBALANCE_QR_GAP`).
+    qr_start_gap: float = float("nan")
 
 
 
@@ -603,6 +607,7 @@ class BlockLMISolver(BlockData):
         it = 0
         use_qr = False
         qr_steps = 0
+        qr_start_gap = np.nan
         qr_switch = self.qr_switch()
         no_qr = (np.zeros((0, 0)), np.zeros(0))  # no Householder factors (the Cholesky phase)
         best: tuple | None = None
@@ -699,6 +704,8 @@ class BlockLMISolver(BlockData):
                     use_qr, x, theta, r0, rd, rp, g_mat, h_vec, mu, ref_scale, qr_switch, s_new, z_new,
                     chol_new, err_limit)
             code, x_new, theta, a_aff, sigma, alpha, use_qr = out
+            if use_qr and qr_steps == 0:
+                qr_start_gap = rel_gap
             qr_steps += int(use_qr)
             if debug:
                 _LOG.debug("    sigma %.2e alpha_aff %.3f alpha %.3f qr %s", sigma, a_aff, alpha, use_qr)
@@ -728,7 +735,7 @@ class BlockLMISolver(BlockData):
         return IPMResult(
             status, x * dscale, s_out, z_out, it, float(cvec @ x) / obj_scale, -float(h_vec @ zp) / obj_scale,
             pres, dres, gap / obj_scale, 0.0, radius if status == "infeasible" else np.nan,
-            qr_iterations=qr_steps,
+            qr_iterations=qr_steps, qr_start_gap=qr_start_gap,
         )
 
     def __getstate__(self) -> dict[str, Any]:
