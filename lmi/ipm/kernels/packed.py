@@ -59,13 +59,14 @@ def unpack(vec, orders, offsets, ent_row, ent_col, ent_w, kmax):
 
 
 @njit(**JIT)
-def cholesky_into(a, k, out):
-    """Lower Cholesky factor of ``a[:k, :k]`` into ``out[:k, :k]``; ``False`` if not positive
-    definite (a non-positive or non-finite pivot)."""
+def cholesky_into(a, k, out, shift=0.0):
+    """Lower Cholesky factor of ``a[:k, :k] + shift I`` into ``out[:k, :k]``; ``False`` if not
+    positive definite (a non-positive or non-finite pivot). (``shift`` 0 adds nothing: ``x + 0.0``
+    is ``x`` for every pivot that can pass.)"""
     for j in range(k):
         for i in range(j):
             out[i, j] = 0.0
-        s = a[j, j]
+        s = a[j, j] + shift
         for p in range(j):
             s -= out[j, p] * out[j, p]
         if not 0.0 < s < np.inf:

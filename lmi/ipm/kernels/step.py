@@ -83,18 +83,28 @@ def _p_times(pt, dx, kk, orders, offsets, ent_row, ent_col, ent_w, sp_off, sp_va
     for j in range(orders.shape[0]):
         k = orders[j]
         kj, acc, left, m = _squares(work, k)
-        for e in range(sp_off[j], sp_off[j + 1]):
-            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
-        acc[:, :] = 0.0
-        for q in range(pair_off[j], pair_off[j + 1]):
-            a, b = pair_row[q], pair_col[q]
-            acc[a, b] = acc_pair[q]
-            acc[b, a] = acc_pair[q]
-        _contiguous_scaling(kk, j, k, kj)
-        np.dot(kj, acc, left)
-        np.dot(left, kj.T, m)
+        _block_p_times(kk, j, k, dx, acc_pair, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col,
+                       kj, acc, left, m)
         pack_block(m, j, offsets, ent_row, ent_col, ent_w, out)
     return out
+
+
+@njit(**JIT)
+def _block_p_times(kk, j, k, dx, acc_pair, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col, kj,
+                   acc, left, m):
+    """Block ``j`` of ``P dx``, unpacked into ``m``: ``K_j (sum_i dx_i A_ij) K_j'``, the sum per
+    position pair in entry order (``acc_pair``), ``K_j`` copied into ``kj``, ``acc`` and ``left``
+    work arrays (of :func:`_squares`)."""
+    for e in range(sp_off[j], sp_off[j + 1]):
+        acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
+    acc[:, :] = 0.0
+    for q in range(pair_off[j], pair_off[j + 1]):
+        a, b = pair_row[q], pair_col[q]
+        acc[a, b] = acc_pair[q]
+        acc[b, a] = acc_pair[q]
+    _contiguous_scaling(kk, j, k, kj)
+    np.dot(kj, acc, left)
+    np.dot(left, kj.T, m)
 
 
 @njit(**JIT)
@@ -115,16 +125,8 @@ def _p_then_pt(pt, dx, base, kk, orders, offsets, ent_row, ent_col, ent_w, sp_of
     for j in range(orders.shape[0]):
         k = orders[j]
         kj, acc, left, m = _squares(work, k)
-        for e in range(sp_off[j], sp_off[j + 1]):
-            acc_pair[sp_pair[e]] += sp_val[e] * dx[sp_var[e]]
-        acc[:, :] = 0.0
-        for q in range(pair_off[j], pair_off[j + 1]):
-            a, b = pair_row[q], pair_col[q]
-            acc[a, b] = acc_pair[q]
-            acc[b, a] = acc_pair[q]
-        _contiguous_scaling(kk, j, k, kj)
-        np.dot(kj, acc, left)
-        np.dot(left, kj.T, m)  # block j of P dx, unpacked
+        _block_p_times(kk, j, k, dx, acc_pair, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col,
+                       kj, acc, left, m)  # block j of P dx, unpacked
         vj = acc
         for t in range(offsets[j], offsets[j + 1]):
             r, c = ent_row[t], ent_col[t]
@@ -383,21 +385,9 @@ _STEP_RTOL = 1e-9
 @njit(**JIT)
 def _shifted_positive_definite(a, k, shift, work):
     """Whether ``a[:k, :k] + shift I`` is positive definite: its Cholesky factorisation (into
-    ``work``) meets no non-positive or non-finite pivot."""
-    for j in range(k):
-        s = a[j, j] + shift
-        for p in range(j):
-            s -= work[j, p] * work[j, p]
-        if not 0.0 < s < np.inf:
-            return False
-        d = np.sqrt(s)
-        work[j, j] = d
-        for i in range(j + 1, k):
-            s = a[i, j]
-            for p in range(j):
-                s -= work[i, p] * work[j, p]
-            work[i, j] = s / d
-    return True
+    ``work``, :func:`~lmi.ipm.kernels.packed.cholesky_into`) meets no non-positive or non-finite
+    pivot."""
+    return cholesky_into(a, k, work, shift)
 
 
 @njit(**JIT)
