@@ -383,14 +383,6 @@ _STEP_RTOL = 1e-9
 
 
 @njit(**JIT)
-def _shifted_positive_definite(a, k, shift, work):
-    """Whether ``a[:k, :k] + shift I`` is positive definite: its Cholesky factorisation (into
-    ``work``, :func:`~lmi.ipm.kernels.packed.cholesky_into`) meets no non-positive or non-finite
-    pivot."""
-    return cholesky_into(a, k, work, shift)
-
-
-@njit(**JIT)
 def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
     """Largest ``a`` (up to ``_STEP_CAP``) with ``diag(lambda) + a d >= 0`` for ``d`` = ``ds``
     and ``dz``, every block.
@@ -413,7 +405,7 @@ def _max_step(lam, ds, dz, orders, offsets, ent_row, ent_col, ent_w):
             for a in range(k):
                 for b in range(k):
                     dd[a, b] *= isq[a] * isq[b]
-            if _shifted_positive_definite(dd, k, 1.0 / alpha, work):
+            if cholesky_into(dd, k, work, 1.0 / alpha):  # D + I / a positive definite
                 continue
             t = smallest_eigenvalue(dd, k, -1.0 / alpha, _STEP_RTOL)
             if t < -1.0 / alpha:
