@@ -310,3 +310,26 @@ def test_an_unknown_search_is_refused_naming_the_setting(value):
     kw, _, _ = kothare_ex1()
     with pytest.raises(InvalidArgumentError, match=r"solver_options\['lambda_search'\].*'warm' or 'grid'"):
         FormProblem(**kw, solver_options={"lambda_search": value})
+
+
+def test_retuning_writes_the_symbolic_programs_numbers_at_the_new_lam():
+    """``_retune`` forms the lam blocks from their coefficients at lam = 0 and their slope, with
+    no symbolic program: constants and coefficients bit for bit those of the symbolic program
+    written at that lam (three lams, one of them not a short binary fraction)."""
+    kw, a, x0 = kothare_ex1()
+    prob = FormProblem(**kw)
+    for x in closed_loop_states(kw, a, x0, 2):  # the warm search's kept solver from the second on
+        prob.solve(x)
+    solver = prob._solvers[("ipm", "warm", False)]
+    lam_blocks = prob._lam_coefficients(prob._form_data(x0, prob.data.u_max, prob.data.y_max, 0.1, 0.5))
+    assert lam_blocks  # the invariance blocks
+    for lam in (0.3, 0.7071067811865476, 0.93):
+        fd = prob._form_data(x0 / np.linalg.norm(x0), prob.data.u_max, prob.data.y_max, 0.1, lam)
+        prob._retune(solver, fd)
+        assert solver.form_lam == lam
+        symbolic = prob._symbolic(fd)
+        for name in lam_blocks:
+            j = solver.form_blocks[name]
+            coef = symbolic.solver_coef(name)
+            assert np.array_equal(solver._coef[j], -coef[1:]), (lam, name)
+            assert np.array_equal(solver._const[j], coef[0]), (lam, name)

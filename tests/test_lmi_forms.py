@@ -169,3 +169,26 @@ def test_a_failed_solve_is_retried_in_coordinates_balanced_on_its_lyapunov_matri
     prob.reset()
     again = prob.solve(x)
     assert again.solver_status == sol.solver_status and again.gamma == sol.gamma
+
+
+def test_layout_values_are_the_affine_variables_values_bit_for_bit():
+    """``Layout.values`` gathers the entries from ``z`` by index; each equals the value of the
+    variable's affine matrix at ``z`` exactly (a symmetric variable's both triangles, a full
+    variable row-major), also for a variable declared after a first call."""
+    from lmi.forms.program import Layout
+
+    lay = Layout()
+    lay.full("gamma", 1, 1)
+    lay.symmetric("Q0", 5)
+    lay.full("Y", 2, 5)
+    rng = np.random.default_rng(3)
+    z = rng.normal(size=lay.size)
+    got = lay.values(z)
+    assert set(got) == {"gamma", "Q0", "Y"}
+    for name in got:
+        assert np.array_equal(got[name], lay.affine(name).value(z)), name
+    assert np.array_equal(got["Q0"], got["Q0"].T)
+    lay.symmetric("Q1", 3)
+    z = np.concatenate([z, rng.normal(size=6)])
+    assert np.array_equal(lay.values(z)["Q1"], lay.affine("Q1").value(z))
+    assert np.array_equal(lay.vector(lay.values(z)), z)  # the inverse of Layout.vector

@@ -216,6 +216,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
         return delta_congruence(n, extra, fd.dt, rest_scale)
 
     cost_delta = delta(p + m, math.sqrt(fd.dt))
+    pair_delta = delta(0, 1.0)  # one matrix for every [[T_i, M'], [M, Q_j]] block (read, never written)
     vertex_pairs = pairs(opts, nv, m)
     disturbed = fd.E is not None and fd.w_max > 0.0
     shared = shares_cost(opts, nv, m)
@@ -250,7 +251,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
                 assert a is not None and b is not None
                 mid = g_var.lmul(a) + ys.lmul(b)
                 block = prog.bmat([[top(now(i)) - w_dt, mid.T], [mid, q_next(j)]])
-                prog.add(name, block, congruence=delta(0, 1.0))
+                prog.add(name, block, congruence=pair_delta)
         elif opts.cost == "worst_case":
             for i, j in vertex_pairs:
                 if prog.wants(f"cost_{i}_{j}{tag}"):
@@ -278,7 +279,7 @@ def write(prog: Program, opts: FormOptions, fd: FormData) -> Program:
                 if not prog.wants(f"invariance_{i}_{j}{tag}"):
                     continue
                 block = invariance_block(fd.A[i], fd.B[i], top(now(i)), q_next(j), ys)
-                prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else delta(0, 1.0))
+                prog.add(f"invariance_{i}_{j}{tag}", block, congruence=None if disturbed else pair_delta)
     if fd.q_outer is not None:  # Wan & Kothare's nesting, Q_outer - Q >= 0
         prog.add("nesting", prog.const(fd.q_outer) - lyap[0])
     _state_blocks(prog, opts, fd, lyap, vertex_pairs)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lmi.affine import AffineMatrix, svec_matrix
+from lmi.affine import AffineMatrix, svec_indices, svec_matrix
 
 __all__ = ["Layout", "Program", "relative_margins"]
 
@@ -36,6 +36,7 @@ class Layout:
 
     def __init__(self) -> None:
         self._vars: dict[str, _Var] = {}
+        self._gather_index: dict[str, np.ndarray] | None = None
         self.size = 0
 
     def symmetric(self, name: str, size: int) -> None:
@@ -50,6 +51,7 @@ class Layout:
         if name in self._vars:
             raise ValueError(f"variable {name!r} declared twice")
         self._vars[name] = var
+        self._gather_index = None
         self.size += var.size
 
     def __contains__(self, name: str) -> bool:
@@ -77,8 +79,26 @@ class Layout:
         return AffineMatrix.full_variable(*var.shape, var.offset, self.size)
 
     def values(self, z: np.ndarray) -> dict[str, np.ndarray]:
-        """Every variable's value at ``z``."""
-        return {name: self.affine(name).value(z) for name in self._vars}
+        """Every variable's value at ``z`` (the entries of :meth:`affine`'s value, gathered from
+        ``z`` by index instead of through the ``(size + 1, rows, cols)`` coefficients)."""
+        z = np.asarray(z, dtype=float)
+        return {name: z[index] for name, index in self._gather().items()}
+
+    def _gather(self) -> dict[str, np.ndarray]:
+        """Per variable, the index into ``z`` of each of its entries (made once per layout)."""
+        if self._gather_index is None:
+            index = {}
+            for name, var in self._vars.items():
+                rows, cols = var.shape
+                if var.symmetric:
+                    full = np.empty((rows, rows), dtype=np.int64)
+                    for k, (i, j) in enumerate(zip(*svec_indices(rows), strict=True)):
+                        full[i, j] = full[j, i] = var.offset + k
+                else:
+                    full = var.offset + np.arange(rows * cols, dtype=np.int64).reshape(rows, cols)
+                index[name] = full
+            self._gather_index = index
+        return self._gather_index
 
     def vector(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
         """The ``z`` holding the given values (missing variables are zero)."""

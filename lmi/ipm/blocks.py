@@ -22,7 +22,7 @@ powers of two): the kernels see ``w_j S_j = w_j C_j - sum_i x_i w_j A_ij`` and t
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -235,6 +235,38 @@ class BlockData:
                 self._dirty.add(int(j))
                 self._fact_parts[int(j)] = ()
             self._factor_raw[int(j)] = checked_factor
+
+    def set_constants(self, constants: Mapping[int, np.ndarray]) -> None:
+        """Replace the constants ``C_j`` of several blocks (``{j: C_j}``), the coefficients kept.
+
+        The same checks as :meth:`set_block` (square, the block's order, finite, symmetric), made
+        on each order's stack at once; a block that fails them is named as :meth:`set_block`
+        names it, and no block is set. A warm-started form sets a dozen or more small constants
+        per state, where the checks block by block cost more than the setting."""
+        items = list(constants.items())
+        count = len(self.block_orders)
+        for j, _ in items:
+            if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < count):
+                raise InvalidArgumentError("j", f"a block index in [0, {count})", repr(j))
+        by_order: dict[int, list[tuple[int, np.ndarray]]] = {}
+        for j, const in items:
+            c_mat = np.asarray(const)
+            order = self.block_orders[int(j)]
+            if c_mat.dtype != np.float64 or c_mat.shape != (order, order):
+                check_block(int(j), const, None, self.n, order)  # raises if it is wrong
+                c_mat = np.asarray(const, dtype=float)
+            by_order.setdefault(order, []).append((int(j), c_mat))
+        for group in by_order.values():  # every block checked before any is set
+            stack = np.stack([c_mat for _, c_mat in group])
+            scale = np.maximum(1.0, np.max(np.abs(stack), axis=(1, 2)))
+            asym = np.max(np.abs(stack - np.swapaxes(stack, 1, 2)), axis=(1, 2))
+            bad = ~(np.all(np.isfinite(stack), axis=(1, 2)) & (asym <= 1e-12 * scale))
+            for (j, c_mat), wrong in zip(group, bad, strict=True):
+                if wrong:
+                    check_block(j, c_mat, None, self.n, self.block_orders[j])  # names the fault
+        for group in by_order.values():
+            for j, c_mat in group:
+                self._set_checked(j, c_mat, None)
 
     def _set_checked(self, j: int, const: np.ndarray, coef: np.ndarray | None) -> None:
         rows = self._layout.rows(j)
