@@ -242,7 +242,23 @@ class BlockData:
         The same checks as :meth:`set_block` (square, the block's order, finite, symmetric), made
         on each order's stack at once; a block that fails them is named as :meth:`set_block`
         names it, and no block is set. A warm-started form sets a dozen or more small constants
-        per state, where the checks block by block cost more than the setting."""
+        per state, where the checks block by block cost more than the setting.
+
+        Examples
+        --------
+        ``min z`` subject to ``(1 - z) I >= 0`` and ``3 + z >= 0``; then the constants become
+        ``2 I`` and ``1`` (the lower bound moves to ``z >= -1``):
+
+        >>> import numpy as np
+        >>> from lmi.ipm import BlockLMISolver
+        >>> blocks = [(np.eye(2), np.stack([np.eye(2)])), (np.eye(1) * 3.0, -np.ones((1, 1, 1)))]
+        >>> solver = BlockLMISolver(np.array([1.0]), blocks)
+        >>> round(float(solver.solve().x[0]), 6)
+        -3.0
+        >>> solver.set_constants({0: 2.0 * np.eye(2), 1: np.eye(1)})
+        >>> round(float(solver.solve().x[0]), 6)
+        -1.0
+        """
         items = list(constants.items())
         count = len(self.block_orders)
         for j, _ in items:
