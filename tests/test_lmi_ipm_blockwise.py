@@ -248,8 +248,9 @@ def test_arrow_cholesky_is_the_cholesky_factor_of_the_permuted_matrix(seed):
     want = cholesky(hp, lower=False)
     hp[np.triu_indices_from(hp, 1)] = np.nan  # only the lower triangle is read
     r = np.full_like(h, np.nan)
+    work = np.full_like(h, np.nan)  # the workspace's old contents are not read
     kept = hp.copy()
-    assert arrow_cholesky(hp, grp_off, r) == 0
+    assert arrow_cholesky(hp, grp_off, r, work) == 0
     assert np.max(np.abs(r - want)) <= 1e-12 * np.max(np.abs(want))
     np.testing.assert_array_equal(hp, kept)  # left as it is (the pivot test reads its diagonal)
     for a in range(len(grp_off) - 1):
@@ -257,10 +258,31 @@ def test_arrow_cholesky_is_the_cholesky_factor_of_the_permuted_matrix(seed):
             assert np.all(r[grp_off[a]:grp_off[a + 1], grp_off[b]:grp_off[b + 1]] == 0.0)
     bad = hp.copy()
     bad[-1, -1] = -1.0  # a border pivot
-    assert arrow_cholesky(bad, grp_off, r) != 0
+    assert arrow_cholesky(bad, grp_off, r, work) != 0
     bad = hp.copy()
     bad[0, 0] = -1.0  # a group's pivot
-    assert arrow_cholesky(bad, grp_off, r) != 0
+    assert arrow_cholesky(bad, grp_off, r, work) != 0
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_arrow_cholesky_without_groups_is_dpotrf_of_the_whole_matrix_bit_for_bit(seed):
+    """With no group (every variable in the border, as in the vertex-pair forms) the factor is
+    ``cholesky_upper``'s of the whole symmetric matrix bit for bit, from its lower triangle alone
+    (the upper one NaN, the workspace NaN), and the matrix is left as it is."""
+    from lmi.ipm.kernels.lapack import cholesky_upper
+
+    rng = np.random.default_rng(seed)
+    n = 70
+    h = _rand_pd(rng, n) * rng.uniform(0.5, 2.0)
+    want = np.zeros((n, n))
+    assert cholesky_upper(h, np.zeros((n, n)), want) == 0
+    lower = h.copy()
+    lower[np.triu_indices(n, 1)] = np.nan
+    kept = lower.copy()
+    r, work = np.full((n, n), np.nan), np.full((n, n), np.nan)
+    assert arrow_cholesky(lower, np.zeros(1, dtype=np.int64), r, work) == 0
+    assert np.array_equal(r, want)
+    np.testing.assert_array_equal(lower, kept)
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -171,14 +171,14 @@ def blockwise_iteration(s_chol, z, orders, offsets, ent_row, ent_col, ent_w, sp_
     at ``bv_pos[bv_off[j]:bv_off[j + 1]]`` of that order, in the contiguous runs ``run_off``,
     ``runs``) and factored there as a block arrow (the
     groups ``arrow_off``, :func:`~lmi.ipm.kernels.lapack.arrow_cholesky`); the Newton solves map
-    their vectors through ``perm``. ``work`` is not used."""
+    their vectors through ``perm``. ``work`` (``n x n``) is the factor's workspace."""
     ok = False
     if not use_qr:
         if not scaling_and_schur_blockwise(s_chol, z, orders, sp_off, sp_pair, sp_val, pair_off, pair_row,
                                            pair_col, bv_off, bv_pos, sp_loc, run_off, runs, kk, lam,
                                            gram_work, hj_work, h):
             return STEP_LOST_DEFINITENESS, x, theta, 0.0, 0.0, 0.0, use_qr
-        ok = arrow_cholesky(h, arrow_off, r_fac) == 0 and _factor_ok(h, r_fac, qr_switch)
+        ok = arrow_cholesky(h, arrow_off, r_fac, work) == 0 and _factor_ok(h, r_fac, qr_switch)
     return _cholesky_or_qr_step(ok, no_pt, r_fac, perm, pt, False, s_chol, z, orders, offsets, ent_row,
                                 ent_col, ent_w, sp_off, sp_var, sp_pair, sp_val, pair_off, pair_row, pair_col,
                                 kk, lam, qr_h, qr_tau, no_qr_h, no_qr_tau, x, theta, r0, rd, rp, g_mat, h_vec,
