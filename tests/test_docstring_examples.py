@@ -63,6 +63,7 @@ MODULES_WITH_EXAMPLES = (
     "lmi.backends.ipm",
     "lmi.data",
     "lmi.forms.problem",
+    "lmi.ipm.blocks",
     "lmi.ipm.kernels.notice",
     "lmi.ipm.solver",
     "lmi.kothare",
