@@ -26,6 +26,7 @@ from numba import njit, types
 from numba.extending import get_cython_function_address
 
 from lmi.ipm.kernels.packed import JIT
+from lmi.ipm.kernels.schur import TRANSPOSE_TILE
 
 __all__ = ["arrow_cholesky", "cholesky_upper", "householder_qr", "schur_complement", "triangular_solve_blas"]
 
@@ -142,11 +143,6 @@ def triangular_solve_blas(r_fac, b):
     return x
 
 
-#: The side of the tiles in which :func:`arrow_cholesky` transposes the border's factor into
-#: ``R`` (row by row, its reads went down the columns of a 1184 x 1184 factor).
-TRANSPOSE_TILE = 32
-
-
 @njit(**JIT)
 def arrow_cholesky(hp, grp_off, r_out, work):
     """Upper Cholesky factor ``R`` (``R'R = H_p``) of a block-arrow ``H_p`` (``hp``, left as it is;
@@ -166,7 +162,7 @@ def arrow_cholesky(hp, grp_off, r_out, work):
     so the upper one is neither mirrored nor copied. Measured on the flexible satellite's
     vertex-pair form (1184 variables, no group: all border): 31.6 ms per factorisation, of which
     ``dpotrf`` 17, the rest two fresh ``n x n`` arrays (page faults), a mirror and a transpose
-    that went down columns.
+    that went down columns. The tiles are :data:`~lmi.ipm.kernels.schur.TRANSPOSE_TILE`'s.
     """
     n = hp.shape[0]
     for a in range(n):
