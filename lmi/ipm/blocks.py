@@ -32,11 +32,17 @@ from toolkit_common.validation import as_real_array
 
 __all__ = [
     "ARROW_SHARE", "BLOCKWISE_SHARE", "BLOCK_WEIGHT_PASSES", "BLOCK_WEIGHT_SPREAD", "DIRECT_MIN_VARIABLES",
-    "SCHUR_PAIR_COST", "SCHUR_PRODUCT_COST", "SCHUR_SCATTER_COST", "SCHUR_STREAM_COST", "BlockData",
+    "SCHUR_PAIR_COST", "SCHUR_PRODUCT_COST", "SCHUR_SCATTER_COST", "SCHUR_STREAM_COST", "SYMMETRY_TOL",
+    "BlockData",
     "BlockFactor", "PackedLayout", "arrow_order", "block_pairs", "block_variables",
     "block_weights", "check_block", "check_factor", "concatenate_factors", "concatenate_sparse",
     "entry_weight", "factor_groups",
 ]
+
+#: A block's constant and coefficients count as symmetric when their largest asymmetry is at most
+#: this times their largest entry (or 1, whichever is larger): :func:`check_block` and
+#: :meth:`BlockData.set_constants`.
+SYMMETRY_TOL = 1e-12
 
 #: A block's coefficients in factored form ``A_ij = D N_ij D'``: ``(D, var, p, q, value)``, the
 #: dictionary ``D`` (``k x d``) and the entries ``N_ij[p, q] = N_ij[q, p] = value`` (``i = var``,
@@ -223,8 +229,7 @@ class BlockData:
                   factor: BlockFactor | None = None) -> None:
         """Replace block ``j``'s constant (and coefficients, if given, with their factored form
         ``factor`` or none)."""
-        if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < len(self.block_orders)):
-            raise InvalidArgumentError("j", f"a block index in [0, {len(self.block_orders)})", repr(j))
+        self._check_index(j)
         if factor is not None and coef is None:
             raise InvalidArgumentError("factor", "None unless coef is given", "a factor without coef")
         const_c, coef_c = check_block(int(j), const, coef, self.n, self.block_orders[j])
@@ -260,10 +265,8 @@ class BlockData:
         -1.0
         """
         items = list(constants.items())
-        count = len(self.block_orders)
         for j, _ in items:
-            if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < count):
-                raise InvalidArgumentError("j", f"a block index in [0, {count})", repr(j))
+            self._check_index(j)
         by_order: dict[int, list[tuple[int, np.ndarray]]] = {}
         for j, const in items:
             c_mat = np.asarray(const)
@@ -276,13 +279,19 @@ class BlockData:
             stack = np.stack([c_mat for _, c_mat in group])
             scale = np.maximum(1.0, np.max(np.abs(stack), axis=(1, 2)))
             asym = np.max(np.abs(stack - np.swapaxes(stack, 1, 2)), axis=(1, 2))
-            bad = ~(np.all(np.isfinite(stack), axis=(1, 2)) & (asym <= 1e-12 * scale))
+            bad = ~(np.all(np.isfinite(stack), axis=(1, 2)) & (asym <= SYMMETRY_TOL * scale))
             for (j, c_mat), wrong in zip(group, bad, strict=True):
                 if wrong:
                     check_block(j, c_mat, None, self.n, self.block_orders[j])  # names the fault
         for group in by_order.values():
             for j, c_mat in group:
                 self._set_checked(j, c_mat, None)
+
+    def _check_index(self, j: Any) -> None:
+        """``j`` must be a block index (an integer, not a bool, in range)."""
+        count = len(self.block_orders)
+        if isinstance(j, bool) or not (isinstance(j, int | np.integer) and 0 <= j < count):
+            raise InvalidArgumentError("j", f"a block index in [0, {count})", repr(j))
 
     def _set_checked(self, j: int, const: np.ndarray, coef: np.ndarray | None) -> None:
         rows = self._layout.rows(j)
@@ -736,7 +745,7 @@ def check_block(
         if not np.all(np.isfinite(arr)):
             raise InvalidArgumentError(f"{name} {label}", "finite values", "NaN or inf")
         asym = float(np.max(np.abs(arr - np.swapaxes(arr, -1, -2)), initial=0.0))
-        if asym > 1e-12 * max(1.0, float(np.max(np.abs(arr), initial=0.0))):
+        if asym > SYMMETRY_TOL * max(1.0, float(np.max(np.abs(arr), initial=0.0))):
             raise InvalidArgumentError(f"{name} {label}", "symmetric matrices", f"asymmetry {asym:.1e}")
     return c_mat, a_mat
 
