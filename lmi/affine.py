@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["AffineMatrix", "smat_matrix", "svec_indices", "svec_matrix"]
+__all__ = ["AffineMatrix", "smat_matrix", "svec_index_map", "svec_indices", "svec_matrix"]
 
 
 class AffineMatrix:
@@ -125,6 +125,16 @@ def svec_indices(size: int) -> tuple[np.ndarray, np.ndarray]:
             rows.append(i)
             cols.append(j)
     return np.asarray(rows), np.asarray(cols)
+
+
+def svec_index_map(size: int, offset: int) -> np.ndarray:
+    """The ``(size, size)`` map of a symmetric variable's entries to their places in ``z``: entry
+    ``(i, j)`` and ``(j, i)`` at ``offset + k``, ``k`` the entry's place in :func:`svec_indices`."""
+    rows, cols = svec_indices(size)
+    out = np.empty((size, size), dtype=np.int64)
+    out[rows, cols] = offset + np.arange(rows.size)
+    out[cols, rows] = offset + np.arange(rows.size)
+    return out
 
 
 def svec_matrix(stack: np.ndarray) -> np.ndarray:

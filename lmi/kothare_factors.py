@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lmi.affine import svec_indices
+from lmi.affine import svec_index_map
 from lmi.data import KothareData
 
 __all__ = ["VariableLayout", "cost_block_factors"]
@@ -40,16 +40,8 @@ class VariableLayout:
     def of(cls, n: int, m: int, o_q: int, o_y: int, o_w: int | None) -> VariableLayout:
         """The layout of :class:`~lmi.backends.conic.KothareConic` (``gamma`` first, then
         ``svec(Q)`` upper triangle column by column, ``vec(Y)`` row-major, ..., ``svec(W)``)."""
-        return cls(0, _symmetric_map(n, o_q), o_y + np.arange(m * n).reshape(m, n),
-                   None if o_w is None else _symmetric_map(n, o_w))
-
-
-def _symmetric_map(size: int, offset: int) -> np.ndarray:
-    rows, cols = svec_indices(size)
-    out = np.empty((size, size), dtype=np.int64)
-    out[rows, cols] = offset + np.arange(rows.size)
-    out[cols, rows] = offset + np.arange(rows.size)
-    return out
+        return cls(0, svec_index_map(n, o_q), o_y + np.arange(m * n).reshape(m, n),
+                   None if o_w is None else svec_index_map(n, o_w))
 
 
 class _Builder:

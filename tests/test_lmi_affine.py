@@ -31,3 +31,17 @@ def test_the_algebra_commutes_with_evaluation() -> None:
     np.testing.assert_array_equal(m.rmul(right).value(Z), m.value(Z) @ right)
     np.testing.assert_array_equal(m.T.value(Z), m.value(Z).T)
     np.testing.assert_array_equal((-m).value(Z), -m.value(Z))
+
+
+def test_svec_index_map_places_each_entry_where_the_symmetric_variable_reads_it():
+    """Entry ``(i, j)`` of ``svec_index_map(size, offset)`` is the index of ``z`` whose coefficient
+    in ``AffineMatrix.symmetric_variable(size, offset, n)`` is one at ``(i, j)`` (both triangles)."""
+    from lmi.affine import svec_index_map
+
+    size, offset, n = 4, 3, 15
+    index = svec_index_map(size, offset)
+    coef = AffineMatrix.symmetric_variable(size, offset, n).coef
+    for i in range(size):
+        for j in range(size):
+            assert coef[1 + index[i, j], i, j] == 1.0
+            assert np.count_nonzero(coef[1:, i, j]) == 1

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lmi.affine import AffineMatrix, svec_indices, svec_matrix
+from lmi.affine import AffineMatrix, svec_index_map, svec_matrix
 
 __all__ = ["Layout", "Program", "relative_margins"]
 
@@ -91,9 +91,7 @@ class Layout:
             for name, var in self._vars.items():
                 rows, cols = var.shape
                 if var.symmetric:
-                    full = np.empty((rows, rows), dtype=np.int64)
-                    for k, (i, j) in enumerate(zip(*svec_indices(rows), strict=True)):
-                        full[i, j] = full[j, i] = var.offset + k
+                    full = svec_index_map(rows, var.offset)
                 else:
                     full = var.offset + np.arange(rows * cols, dtype=np.int64).reshape(rows, cols)
                 index[name] = full
