@@ -8,6 +8,10 @@
   NaN outside each block's ``[:k, :k]`` so that a read outside it shows;
 * the refinement's fused ``P dx + v`` and ``P'`` of it (:func:`~lmi.ipm.kernels.step._p_then_pt`)
   equal the separate products bit for bit;
+* the Newton solve's iterative refinement (:func:`~lmi.ipm.kernels.step._newton`) stops at
+  :data:`~lmi.ipm.kernels.step.REFINE_TARGET` of the reference scale: a solve whose dual equation
+  already meets it is not refined, one that misses it is refined until it meets it; the C core
+  uses the same target;
 * the step length :func:`~lmi.ipm.kernels.step._max_step` (a Cholesky test of each shifted
   block first, the eigenvalue bisection only where it fails) equals the largest ``a <= 1/0.99``
   with ``diag(lambda) + a d >= 0`` computed from numpy's eigenvalues, when no block limits the
@@ -21,11 +25,15 @@ above; measured 1.4e-9 below and never above over 400 draws).
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+import lmi.ccore
 from lmi.ipm import BlockLMISolver, kernels
-from lmi.ipm.kernels.step import _STEP_CAP, _max_step, _p_then_pt, _p_times, _pt_times
+from lmi.ipm.kernels.step import _STEP_CAP, REFINE_TARGET, _max_step, _newton, _p_then_pt, _p_times, _pt_times
 
 EPS = np.finfo(float).eps
 
@@ -95,6 +103,57 @@ def test_products_with_p_from_the_sparse_coefficients_equal_the_formed_ones(seed
         want = _p_times(none, dx, kk, *lay.arrays, *sp) + v
         assert np.array_equal(dz, want)
         assert np.array_equal(ptz, _pt_times(none, want, kk, *lay.arrays, *sp, n))
+
+
+def _newton_case(seed: int):
+    """``_newton``'s arguments at an NT point of :func:`_problem` with ``P`` formed, and a factor
+    of ``H + 1e-6 diag(H)`` instead of ``H = P'P``: the first solve misses the dual equation by
+    about 1e-6 relative, and each refinement step gains about six orders of magnitude."""
+    orders = (6, 9, 4, 9)
+    solver = _problem(seed, orders)
+    rng = np.random.default_rng(70 + seed)
+    lay, sp = solver._layout, solver._sparse
+    n, nb, kmax = solver.n, len(orders), solver._kmax
+    s_chol = _padded([np.linalg.cholesky(_rand_pd(rng, k)) for k in orders])
+    z = _padded([_rand_pd(rng, k) for k in orders])
+    kk, lam, pt = np.zeros((nb, kmax, kmax)), np.zeros((nb, kmax)), np.zeros((n, lay.size))
+    assert kernels.scaling_and_schur_rows(s_chol, z, *lay.arrays, *sp, kk, lam, pt)
+    h = pt @ pt.T
+    r_fac = np.ascontiguousarray(np.linalg.cholesky(h + 1e-6 * np.diag(np.diag(h))).T)
+    rd, rpt, u = rng.normal(size=n), rng.normal(size=lay.size), rng.normal(size=lay.size)
+
+    def solve(ref_scale: float):
+        return _newton(pt, r_fac, np.zeros(0, dtype=np.int64), rd, rpt, u, ref_scale, kk, *lay.arrays, sp)
+
+    return solve, pt, rd
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_refinement_stops_at_the_target(seed):
+    """With ``ref_scale = inf`` nothing is refined: the first solve and its residual ``e0``. A
+    reference scale at which ``e0`` already meets ``REFINE_TARGET`` (twice the target: a margin
+    for the product's rounding) returns that first solve bit for bit; one at which the target is
+    ``e0 / 1000`` refines: the residual returned meets the target, and it is the exact equation's
+    residual of the step returned (``P' dz~ + r_d`` recomputed from ``dx``: the step and its
+    residual belong together)."""
+    solve, pt, rd = _newton_case(seed)
+    dx0, _, dz0, e0 = solve(np.inf)
+    assert e0 > 1e-12  # the inexact factor leaves a residual to refine
+    dx, _, dz, e = solve(2.0 * e0 / REFINE_TARGET)
+    assert e == e0 and np.array_equal(dx, dx0) and np.array_equal(dz, dz0)
+    ref_scale = 1e-3 * e0 / REFINE_TARGET
+    dx, _, dz, e = solve(ref_scale)
+    assert e <= REFINE_TARGET * ref_scale and e < 1e-3 * e0
+    assert not np.array_equal(dx, dx0)
+    assert abs(np.linalg.norm(pt @ dz + rd) - e) <= 1e-3 * e
+
+
+def test_the_c_core_refines_to_the_same_target():
+    """The C core (``lmi/ccore/ipm.c``) defines ``REFINE_TARGET`` as the numba kernels' value."""
+    source = (Path(lmi.ccore.__file__).parent / "ipm.c").read_text()
+    found = re.search(r"^#define REFINE_TARGET (\S+)", source, re.MULTILINE)
+    assert found is not None, "ipm.c defines no REFINE_TARGET"
+    assert float(found.group(1)) == REFINE_TARGET
 
 
 def _reference_step(lam: np.ndarray, dirs: list[np.ndarray], orders: tuple[int, ...]) -> float:

@@ -41,6 +41,7 @@
 #define REDUCED_TOL 1e-6
 #define RAY_TOL 1e-6
 #define REFINE_STEPS 3
+#define REFINE_TARGET 1e-12 /* lmi.ipm.kernels.step.REFINE_TARGET */
 #define SQRT2 1.4142135623730951
 
 /* Phase times, in a profiling build only (KOTHARE_PHASE_TIMES, see ipm.h): PHASE_NOW() reads
@@ -698,7 +699,7 @@ static double newton_chol(const double *u, double ref_scale, double *dx, double 
     err_norm = norm2(ws.err, NV);
     for (it = 0; it < REFINE_STEPS; ++it) {
         double new_norm;
-        if (err_norm <= 1e-14 * ref_scale) {
+        if (err_norm <= REFINE_TARGET * ref_scale) {
             break;
         }
         for (i = 0; i < NV; ++i) {
@@ -856,7 +857,7 @@ static void newton_qr(const double *u, double ref_scale, double *dx, double *ds,
     err_norm = norm2(ws.err, NV);
     for (it = 0; it < REFINE_STEPS; ++it) {
         double new_norm;
-        if (err_norm <= 1e-14 * ref_scale) {
+        if (err_norm <= REFINE_TARGET * ref_scale) {
             break;
         }
         memcpy(ws.vn, ws.err, NBYTES(NV));
