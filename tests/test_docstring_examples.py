@@ -64,6 +64,7 @@ MODULES_WITH_EXAMPLES = (
     "lmi.data",
     "lmi.forms.problem",
     "lmi.ipm.blocks",
+    "lmi.ipm.kernels.eigen",
     "lmi.ipm.kernels.notice",
     "lmi.ipm.solver",
     "lmi.kothare",

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from lmi.ipm.kernels.eigen import symmetric_eigen
 from lmi.ipm.kernels.packed import JIT
 
 __all__ = [
@@ -26,14 +27,20 @@ def _nt_block(s_chol, z, j, k, kk_out, lam_out):
     ``lam_out[j]``; ``False`` if the block lost positive definiteness. The block's matrices in
     one work array, the products BLAS calls into it (``np.dot`` with ``out``) and the scalings
     loops: the operations of ``ell.T @ (zj @ ell)``, ``(ell @ qv) / sqrt(lambda)`` and ``(rr.T @
-    zj) / lambda`` in the same order, without their temporaries."""
+    zj) / lambda`` in the same order, without their temporaries. The eigenvalues and vectors of
+    ``ell.T zj ell`` come from :func:`~lmi.ipm.kernels.eigen.symmetric_eigen` (the C core's
+    algorithm; a non-finite matrix or a QL iteration that does not converge is a lost block)."""
     size = k * k
-    work = np.empty(5 * size)
+    work = np.empty(7 * size + 2 * k)
     ell = work[:size].reshape((k, k))
     zj = work[size: 2 * size].reshape((k, k))
     prod = work[2 * size: 3 * size].reshape((k, k))
     out = work[3 * size: 4 * size].reshape((k, k))
-    m = work[4 * size:].reshape((k, k))
+    m = work[4 * size: 5 * size].reshape((k, k))
+    qvt = work[5 * size: 6 * size].reshape((k, k))  # the eigenvectors as rows
+    v_work = work[6 * size: 7 * size].reshape((k, k))
+    d = work[7 * size: 7 * size + k]
+    e_work = work[7 * size + k:]
     for a in range(k):
         for b in range(k):
             ell[a, b] = s_chol[j, a, b]
@@ -46,13 +53,12 @@ def _nt_block(s_chol, z, j, k, kk_out, lam_out):
             if not np.isfinite(value):
                 return False
             m[a, b] = value
-    d, qv = np.linalg.eigh(m)
-    if not d[0] > 0.0:
+    if symmetric_eigen(m, k, d, qvt, v_work, e_work) != 0 or not d[0] > 0.0:
         return False
     lam = np.sqrt(d)
     root = np.sqrt(lam)
     rr = prod
-    np.dot(ell, qv, rr)
+    np.dot(ell, qvt.T, rr)
     for a in range(k):
         for b in range(k):
             rr[a, b] /= root[b]  # columns scaled
