@@ -74,24 +74,34 @@ def test_c_core_agrees_with_numba_on_paper_p(vertices):
 @pytest.mark.parametrize("name", ["kothare_ex1", "kothare_ex2"])
 def test_c_core_agrees_with_numba_on_kothares_examples(name):
     """Kothare, Balakrishnan and Morari's examples 1 and 2 (the methods suite's closed loops, 40
-    samples, input bound as there)."""
+    samples, input bound as there), both cores solving at the same states: those of the C core's
+    closed loop, each core warm-starting from its own previous solve. gamma within 1e-7 relative
+    (the solves' relative gap is 1e-8; measured worst 3.2e-9 and 4.8e-9). Two closed loops, each
+    on its own moves, drift apart on example 2 (the moves agree to 1e-4 of the bound, the lightly
+    damped masses carry the difference): gamma's 1.4e-8 at the third sample grew to 1.1e-6 by the
+    fortieth, which says nothing of the solvers."""
     from benchmarks.suites.methods_problems import build_problem
     from models import PolytopicModel
     from rmpc import RMPC
 
     pb = build_problem(name)
     true_plant = PolytopicModel([pb.true_plant], dt=pb.plant.dt)
-    rows = {}
+    ctrls = {}
     for core in ("c", "numba"):
-        ctrl = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint,
-                    solver_options={"core": core})
-        assert ctrl.problem._backend.core == core
-        rows[core] = _closed_loop(ctrl, true_plant, pb.x0, 40)
-    for (s_c, g_c, _, u_c), (s_n, g_n, _, u_n) in zip(rows["c"], rows["numba"], strict=True):
+        ctrls[core] = RMPC(pb.plant, pb.Q, pb.R, u_max=pb.u_max, input_constraint=pb.input_constraint,
+                           solver_options={"core": core})
+        assert ctrls[core].problem._backend.core == core
+    x = pb.x0.copy()
+    for _ in range(40):
+        u_c = ctrls["c"].step(x)
+        s_c, g_c = str(ctrls["c"].last.status), ctrls["c"].last.gamma
+        u_n = ctrls["numba"].step(x)
+        s_n, g_n = str(ctrls["numba"].last.status), ctrls["numba"].last.gamma
         assert s_c == s_n
         if g_n is not None and np.isfinite(g_n):
-            assert abs(g_c / g_n - 1.0) <= 1e-6
+            assert abs(g_c / g_n - 1.0) <= 1e-7
         assert np.max(np.abs(u_c - u_n)) <= 1e-4 * max(1.0, float(np.max(np.abs(u_n))))
+        x = true_plant.A[0] @ x + true_plant.B[0] @ u_c
 
 
 def test_far_out_state_is_proved_infeasible_by_the_c_core():
