@@ -74,6 +74,19 @@ def _problem(seed: int, orders: tuple[int, ...], n: int = 9, density: float = 0.
     return solver
 
 
+def _nt_point(solver: BlockLMISolver, orders: tuple[int, ...],
+              rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(K, lambda, P')`` by the rows formula at random ``S`` and ``Z`` of the blocks' orders,
+    ``K`` padded with NaN outside each block's ``[:k, :k]``."""
+    nb, kmax = len(orders), solver._kmax
+    s_chol = _padded([np.linalg.cholesky(_rand_pd(rng, k)) for k in orders])
+    z = _padded([_rand_pd(rng, k) for k in orders])
+    kk, lam = np.full((nb, kmax, kmax), np.nan), np.zeros((nb, kmax))
+    pt = np.zeros((solver.n, solver._layout.size))
+    assert kernels.scaling_and_schur_rows(s_chol, z, *solver._layout.arrays, *solver._sparse, kk, lam, pt)
+    return kk, lam, pt
+
+
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("orders", [(6, 9, 4, 9), (9, 3, 7, 2, 5)])
 def test_products_with_p_from_the_sparse_coefficients_equal_the_formed_ones(seed, orders):
@@ -82,12 +95,8 @@ def test_products_with_p_from_the_sparse_coefficients_equal_the_formed_ones(seed
     the sums of magnitudes ``|P'| |v|`` and ``|P| |dx|`` (measured worst 1.1 and 4.0)."""
     solver = _problem(seed, orders)
     rng = np.random.default_rng(50 + seed)
-    lay, sp = solver._layout, solver._sparse
-    n, nb, kmax = solver.n, len(orders), solver._kmax
-    s_chol = _padded([np.linalg.cholesky(_rand_pd(rng, k)) for k in orders])
-    z = _padded([_rand_pd(rng, k) for k in orders])
-    kk, lam, pt = np.full((nb, kmax, kmax), np.nan), np.zeros((nb, kmax)), np.zeros((n, lay.size))
-    assert kernels.scaling_and_schur_rows(s_chol, z, *lay.arrays, *sp, kk, lam, pt)
+    lay, sp, n = solver._layout, solver._sparse, solver.n
+    kk, _, pt = _nt_point(solver, orders, rng)
     assert np.isnan(kk).any()  # the padding a product must not read
     none = np.zeros((n, 0))
     for _ in range(3):
@@ -112,12 +121,8 @@ def _newton_case(seed: int):
     orders = (6, 9, 4, 9)
     solver = _problem(seed, orders)
     rng = np.random.default_rng(70 + seed)
-    lay, sp = solver._layout, solver._sparse
-    n, nb, kmax = solver.n, len(orders), solver._kmax
-    s_chol = _padded([np.linalg.cholesky(_rand_pd(rng, k)) for k in orders])
-    z = _padded([_rand_pd(rng, k) for k in orders])
-    kk, lam, pt = np.zeros((nb, kmax, kmax)), np.zeros((nb, kmax)), np.zeros((n, lay.size))
-    assert kernels.scaling_and_schur_rows(s_chol, z, *lay.arrays, *sp, kk, lam, pt)
+    lay, sp, n = solver._layout, solver._sparse, solver.n
+    kk, _, pt = _nt_point(solver, orders, rng)
     h = pt @ pt.T
     r_fac = np.ascontiguousarray(np.linalg.cholesky(h + 1e-6 * np.diag(np.diag(h))).T)
     rd, rpt, u = rng.normal(size=n), rng.normal(size=lay.size), rng.normal(size=lay.size)
