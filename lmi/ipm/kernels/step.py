@@ -16,7 +16,7 @@ __all__ = ["REFINE_STEPS", "REFINE_TARGET", "STEP_INACCURATE", "newton_step", "s
 STEP_INACCURATE = 5
 
 #: At most this many steps of iterative refinement per Newton solve (each stops early once
-#: the residual of ``P' dz = -r_d`` stops shrinking).
+#: the residual of ``P' dz = -r_d`` stops shrinking or meets :data:`REFINE_TARGET`).
 REFINE_STEPS = 3
 
 #: Iterative refinement of a Newton solve stops once the residual of ``P' dz = -r_d`` is at most
@@ -24,8 +24,8 @@ REFINE_STEPS = 3
 #: dual residual for ``tol_feas`` (1e-8) of that scale, so 1e-12 leaves four orders of magnitude.
 #: Measured at the iterates of warm solves: paper W's vertex form's residual cannot be evaluated
 #: below 2-4e-14 of the scale, so a target of 1e-14 (before) ran every refinement to its limit and
-#: discarded the last step (49 refinement steps in 9 iterations; 18 with 1e-12, each iteration's
-#: residuals 1e-13 or less); on paper P's vertex forms 28 -> 24 and 50 -> 42.
+#: discarded the last step (49 refinement steps in 9 iterations; 18 with 1e-12, the residuals
+#: reached 2e-14..9e-13 of the scale); on paper P's vertex forms 28 -> 24 and 50 -> 42.
 REFINE_TARGET = 1e-12
 
 
