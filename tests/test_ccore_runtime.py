@@ -78,7 +78,7 @@ def test_c_core_agrees_with_numba_on_kothares_examples(name):
     closed loop, each core warm-starting from its own previous solve. gamma within 1e-7 relative
     (the solves' relative gap is 1e-8; measured worst 3.2e-9 and 4.8e-9). Two closed loops, each
     on its own moves, drift apart on example 2 (the moves agree to 1e-4 of the bound, the lightly
-    damped masses carry the difference): gamma's 1.4e-8 at the third sample grew to 1.1e-6 by the
+    damped masses carry the difference): gamma's 1.4e-8 at the fourth sample grew to 1.1e-6 by the
     fortieth, which says nothing of the solvers."""
     from benchmarks.suites.methods_problems import build_problem
     from models import PolytopicModel

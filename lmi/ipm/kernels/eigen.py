@@ -10,8 +10,10 @@ rotations act on them, so that each rotation reads two contiguous rows.
 
 Why not ``np.linalg.eigh``: on the blocks of the LMI forms (orders 7-16) LAPACK's ``dsyevd`` spends
 most of its time in the calls between its level-2 routines, not in arithmetic. Measured over 64
-random positive definite matrices each (single-threaded BLAS): order 7 7.6 -> 3.7 us, 12 16.9 ->
-10.5 us, 16 26.5 -> 18.5 us; at order 28 the two are even (68 against 70 us).
+random positive definite matrices per order, the two called alternately 40 times in one process
+(single-threaded BLAS, a test run busy on the other core): ``np.linalg.eigh`` from compiled code
+against this function, order 7 7.8 -> 3.7 us, 12 19.2 -> 10.2 us, 16 33.9 -> 18.2 us, 28 96 -> 69 us
+(paired ratios 0.47, 0.53, 0.53, 0.72; an idle run earlier had them even at order 28).
 """
 
 from __future__ import annotations
