@@ -6,10 +6,10 @@ arithmetic (measured on paper P at 2 vertices: 0.55 of 0.8 ms per iteration). An
 two calls: :func:`residuals`, then :func:`rows_iteration` (or :func:`grouped_iteration` when
 ``H`` is formed from factored coefficients), which scales, forms and factors the Schur
 complement and takes the predictor-corrector step (:mod:`lmi.ipm.kernels.iteration`). Matrix
-products and eigen-decompositions are BLAS/LAPACK calls made from compiled code (the Schur
-complement's ``dsyrk``, ``dpotrf`` and ``dgeqrf`` through :mod:`lmi.ipm.kernels.lapack`); the
-Cholesky factorisations of the blocks and the smallest eigenvalues of the step-length test are
-plain loops.
+products are BLAS/LAPACK calls made from compiled code (the Schur complement's ``dsyrk``,
+``dpotrf`` and ``dgeqrf`` through :mod:`lmi.ipm.kernels.lapack`); the Cholesky factorisations of
+the blocks and their eigenvalues (:mod:`lmi.ipm.kernels.eigen`: the NT scaling's eigen-decompositions
+and the smallest eigenvalues of the step-length test) are plain loops.
 
 Layout shared by every kernel. ``nb`` blocks of orders ``orders[j]``; block matrices are held
 in ``(nb, kmax, kmax)`` arrays, only ``[:k, :k]`` used. A packed vector holds, block after
@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING
 from toolkit_common.lazy import lazy_exports
 
 if TYPE_CHECKING:
+    from lmi.ipm.kernels.eigen import smallest_eigenvalue
     from lmi.ipm.kernels.iteration import (
         STEP_LOST_DEFINITENESS,
         STEP_OK,
@@ -58,7 +59,7 @@ if TYPE_CHECKING:
         scaling_and_schur_grouped,
         scaling_and_schur_rows,
     )
-    from lmi.ipm.kernels.step import REFINE_STEPS, newton_step, smallest_eigenvalue
+    from lmi.ipm.kernels.step import REFINE_STEPS, newton_step
 
 
 # the module defining each public name, imported when the name is first looked up
@@ -73,7 +74,8 @@ _EXPORTS = {
         "scaling_and_schur_rows",
     ),
     "lmi.ipm.kernels.notice": ("compile_notice",),
-    "lmi.ipm.kernels.step": ("REFINE_STEPS", "newton_step", "smallest_eigenvalue"),
+    "lmi.ipm.kernels.eigen": ("smallest_eigenvalue",),
+    "lmi.ipm.kernels.step": ("REFINE_STEPS", "newton_step"),
 }
 
 __all__ = [

@@ -6,10 +6,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from lmi.ipm.kernels.eigen import smallest_eigenvalue
 from lmi.ipm.kernels.lapack import triangular_solve_blas
 from lmi.ipm.kernels.packed import JIT, cholesky_into, diagonal_entry, g_times, pack_block, unpack_block_into
 
-__all__ = ["REFINE_STEPS", "REFINE_TARGET", "STEP_INACCURATE", "newton_step", "smallest_eigenvalue"]
+__all__ = ["REFINE_STEPS", "REFINE_TARGET", "STEP_INACCURATE", "newton_step"]
 
 #: :func:`newton_step`'s code for a corrector whose dual equation missed the accuracy asked
 #: (outside the QR phase); no step was taken.
@@ -289,100 +290,6 @@ def _newton_qr(pt, qr_h, qr_tau, r_fac, rd, rpt, u, ref_scale):
         dx = dx - _backward(r_fac, cw)
         dzt, err, err_norm = dzt_new, err_new, new_norm
     return dx, u - dzt, dzt
-
-
-@njit(**JIT)
-def _sturm_count(d, e, k, sigma):
-    """Number of eigenvalues below ``sigma`` of the tridiagonal matrix ``(d, e)`` (LDL' inertia)."""
-    count = 0
-    q = d[0] - sigma
-    for i in range(k):
-        if i > 0:
-            if q == 0.0:
-                q = 1e-300
-            q = d[i] - sigma - e[i - 1] * e[i - 1] / q
-        if q < 0.0:
-            count += 1
-    return count
-
-
-@njit(**JIT)
-def _tridiagonalize(a, k):
-    """Diagonal ``d`` and sub-diagonal ``e`` of a tridiagonal matrix similar to symmetric
-    ``a[:k, :k]`` (Householder reflections; overwrites ``a``)."""
-    d = np.empty(k)
-    e = np.zeros(k)
-    v = np.zeros(k)
-    w = np.zeros(k)
-    for c in range(k - 2):
-        s = 0.0
-        for i in range(c + 1, k):
-            s += a[i, c] * a[i, c]
-        if s == 0.0:
-            e[c] = 0.0
-            continue
-        alpha = -np.sqrt(s) if a[c + 1, c] > 0.0 else np.sqrt(s)
-        for i in range(c + 1, k):
-            v[i] = a[i, c]
-        v[c + 1] -= alpha
-        vv = s - a[c + 1, c] * a[c + 1, c] + v[c + 1] * v[c + 1]
-        beta = 2.0 / vv
-        for i in range(c + 1, k):  # w = beta A v - (beta^2 v'Av / 2) v
-            t = 0.0
-            for j in range(c + 1, k):
-                t += a[i, j] * v[j]
-            w[i] = beta * t
-        half = 0.0
-        for i in range(c + 1, k):
-            half += v[i] * w[i]
-        half *= 0.5 * beta
-        for i in range(c + 1, k):
-            w[i] -= half * v[i]
-        for i in range(c + 1, k):  # H A H = A - v w' - w v'
-            for j in range(c + 1, k):
-                a[i, j] -= v[i] * w[j] + w[i] * v[j]
-        e[c] = alpha
-    for i in range(k):
-        d[i] = a[i, i]
-    if k >= 2:
-        e[k - 2] = a[k - 1, k - 2]
-    return d, e
-
-
-@njit(**JIT)
-def smallest_eigenvalue(a, k, upper=np.inf, rtol=4.0 * 2.220446049250313e-16):
-    """A lower bound on the smallest eigenvalue of symmetric ``a[:k, :k]`` (overwrites ``a``).
-
-    Householder reduction to tridiagonal form, then bisection on Sturm counts from the
-    Gershgorin interval until the bracket is narrower than ``rtol`` times its largest end. The
-    lower end of the bracket is returned, so a step length ``-1 / lambda`` computed from it is
-    never too long. If the smallest eigenvalue is not below ``upper``, ``upper`` is returned
-    after one Sturm count (the step-length search only needs eigenvalues below ``-1 / cap``).
-    For the small blocks here this is several times faster than a LAPACK eigenvalue call from
-    compiled code, whose fixed cost (copies, workspace queries) dominates.
-    """
-    d, e = _tridiagonalize(a, k)
-    lo, hi = np.inf, -np.inf
-    for i in range(k):
-        radius = (abs(e[i - 1]) if i > 0 else 0.0) + (abs(e[i]) if i < k - 1 else 0.0)
-        lo = min(lo, d[i] - radius)
-        hi = max(hi, d[i] + radius)
-    if upper < hi:
-        if _sturm_count(d, e, k, upper) == 0:
-            return upper
-        hi = upper
-    if not lo < hi:
-        return lo
-    width = rtol * max(abs(lo), abs(hi)) + 1e-300
-    for _ in range(200):
-        if hi - lo <= width:
-            break
-        mid = 0.5 * (lo + hi)
-        if _sturm_count(d, e, k, mid) >= 1:
-            hi = mid
-        else:
-            lo = mid
-    return lo
 
 
 #: Step lengths are computed up to this cap (the callers use ``min(1, a)`` and
